@@ -1,0 +1,51 @@
+// URDF loading: URDF text -> ArticulationDesc (no scene needed) -> Articulation in a Scene.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+
+#include "partsim/physics/description.h"
+#include "partsim/physics/scene.h"
+
+namespace partsim {
+
+/// Per-link overrides of the loader's defaults.
+struct UrdfLinkOverride {
+  std::optional<double> density;              ///< kg/m^3 for the link's collision shapes
+  std::optional<PhysicalMaterial> material;
+};
+
+/// Loads URDF files (SAPIEN's URDFLoader). Links become links, joints become joints (revolute,
+/// continuous, prismatic, fixed; `floating` joining the root to the world makes a free root;
+/// `mimic` joints become couplings; `planar` is rejected). Mesh paths may be relative to the file
+/// or use package://NAME/..., resolved through `package_dirs` or by searching the file's parent
+/// folders for a folder NAME.
+class UrdfLoader {
+ public:
+  explicit UrdfLoader(Scene* scene = nullptr) : scene_(scene) {}
+
+  bool fix_root_link = true;
+  double scale = 1.0;  ///< uniform scale on geometry, origins and prismatic limits
+  /// Each mesh file (and each connected component of it) becomes its own convex piece.
+  bool load_multiple_collisions_from_file = false;
+  double density = 1000.0;                       ///< kg/m^3 for links without <inertial>
+  std::optional<PhysicalMaterial> material;      ///< default material of collision shapes
+  std::map<std::string, UrdfLinkOverride> link_overrides;  ///< by link name
+  std::map<std::string, std::string> package_dirs;         ///< package name -> folder
+
+  /// Parses a URDF into a description. `source` names the text in error messages;
+  /// `base_dir` resolves relative mesh paths.
+  ArticulationDesc Parse(const std::string& text, const std::string& base_dir,
+                         const std::string& source = "<string>") const;
+  ArticulationDesc ParseFile(const std::string& path) const;
+
+  /// Parses and adds to the scene.
+  Articulation Load(const std::string& path);
+  Articulation LoadFromString(const std::string& text, const std::string& base_dir = ".");
+
+ private:
+  Scene* scene_;
+};
+
+}  // namespace partsim

@@ -1,0 +1,471 @@
+// The Scene owns the three stages of a world: the description (what was added), the compiled
+// model (mjModel plus partsim's tables) and the data (mjData plus drive targets). Actor,
+// Articulation, Link and Joint are light handles that index into them.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "partsim/core/error.h"
+#include "partsim/core/pose.h"
+#include "partsim/physics/description.h"
+
+struct mjModel_;
+struct mjData_;
+
+namespace partsim {
+
+class Scene;
+class ActorBuilder;
+class ArticulationBuilder;
+class UrdfLoader;
+
+/// Numerical integrator of the scene.
+enum class Integrator { kEuler, kImplicit, kRK4 };
+
+/// Scene-wide settings.
+struct SceneConfig {
+  double timestep = 1.0 / 500.0;                      ///< seconds, > 0
+  Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.81);  ///< m/s^2, world frame
+  PhysicalMaterial default_material;
+  int solver_iterations = 50;                         ///< constraint solver iterations, >= 1
+  Integrator integrator = Integrator::kImplicit;      ///< implicit handles stiff PD damping
+};
+
+/// Handle to an actor. Cheap to copy; valid until the actor is removed.
+class Actor {
+ public:
+  Actor() = default;
+  Actor(Scene* scene, int id) : scene_(scene), id_(id) {}
+
+  int GetId() const { return id_; }
+  const std::string& GetName() const;
+  ActorType GetType() const;
+  /// X_WA: the actor's frame in the world.
+  Pose GetPose() const;
+  /// Teleports the actor (dynamic or kinematic); static actors refuse.
+  void SetPose(const Pose& pose);
+  /// World-frame linear velocity of the actor's origin (m/s).
+  Eigen::Vector3d GetVelocity() const;
+  /// World-frame angular velocity (rad/s).
+  Eigen::Vector3d GetAngularVelocity() const;
+  void SetVelocity(const Eigen::Vector3d& v);
+  void SetAngularVelocity(const Eigen::Vector3d& w);
+  /// Mass (kg) as compiled.
+  double GetMass() const;
+  /// Adds a world-frame force (N) at a world point (m) for the next step.
+  void AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point);
+  /// Adds a world-frame force (N) at the centre of mass and a torque (N m) for the next step.
+  void AddForceTorque(const Eigen::Vector3d& force, const Eigen::Vector3d& torque);
+  const ActorDesc& GetDesc() const;
+  Scene* GetScene() const { return scene_; }
+  bool operator==(const Actor& o) const { return scene_ == o.scene_ && id_ == o.id_; }
+
+ private:
+  Scene* scene_ = nullptr;
+  int id_ = -1;
+};
+
+/// Handle to a link of an articulation.
+class Link {
+ public:
+  Link() = default;
+  Link(Scene* scene, int articulation_id, int index)
+      : scene_(scene), articulation_id_(articulation_id), index_(index) {}
+
+  const std::string& GetName() const;
+  /// Index of the link in its articulation (0 is the root).
+  int GetIndex() const { return index_; }
+  int GetArticulationId() const { return articulation_id_; }
+  /// Index of the parent link, -1 for the root.
+  int GetParentIndex() const;
+  /// X_WL: the link frame in the world.
+  Pose GetPose() const;
+  /// X_WC: the centre of mass frame (principal axes) in the world.
+  Pose GetCMassPose() const;
+  Eigen::Vector3d GetVelocity() const;         ///< world-frame, at the link origin (m/s)
+  Eigen::Vector3d GetAngularVelocity() const;  ///< world-frame (rad/s)
+  double GetMass() const;                       ///< kg
+  Eigen::Vector3d GetInertia() const;           ///< principal moments (kg m^2)
+  void AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point);
+  const LinkDesc& GetDesc() const;
+  Scene* GetScene() const { return scene_; }
+
+ private:
+  Scene* scene_ = nullptr;
+  int articulation_id_ = -1;
+  int index_ = -1;
+};
+
+/// Handle to the joint between a link and its parent (joint index == child link index).
+class Joint {
+ public:
+  Joint() = default;
+  Joint(Scene* scene, int articulation_id, int index)
+      : scene_(scene), articulation_id_(articulation_id), index_(index) {}
+
+  const std::string& GetName() const;
+  JointType GetType() const;
+  int GetIndex() const { return index_; }
+  /// Degrees of freedom of this joint (0 or 1; a joint coupled to another has 0).
+  int GetDof() const;
+  /// Index of this joint's dof in the articulation's qpos, -1 if it has none.
+  int GetDofIndex() const;
+  Link GetParentLink() const;
+  Link GetChildLink() const;
+  Pose GetPoseInParent() const;
+  Pose GetPoseInChild() const;
+  /// X_WJ: the joint frame in the world (moves with the child).
+  Pose GetGlobalPose() const;
+  /// Joint axis in world coordinates (the x axis of the joint frame).
+  Eigen::Vector3d GetGlobalAxis() const;
+  /// Limits (lower, upper); +-inf when unlimited.
+  Eigen::Vector2d GetLimits() const;
+  void SetLimits(double lower, double upper);
+  double GetFriction() const;
+  double GetDamping() const;
+  double GetArmature() const;
+  void SetFriction(double friction);
+  void SetDamping(double damping);
+  void SetArmature(double armature);
+  /// Screw pitch, metres per radian (0 for other joints).
+  double GetPitch() const;
+
+  /// PD drive: force = stiffness (target - q) + damping (velocity_target - qdot), clamped to
+  /// +-force_limit (inf for no clamp).
+  void SetDriveProperty(double stiffness, double damping, double force_limit = kInf);
+  void SetDriveTarget(double target);
+  void SetDriveVelocityTarget(double velocity);
+  double GetDriveTarget() const;
+  double GetDriveVelocityTarget() const;
+  double GetDriveStiffness() const;
+  double GetDriveDamping() const;
+  double GetDriveForceLimit() const;
+  /// Joint position and velocity (m or rad); the joint must have a dof.
+  double GetQpos() const;
+  double GetQvel() const;
+  const JointDesc& GetDesc() const;
+
+ private:
+  Scene* scene_ = nullptr;
+  int articulation_id_ = -1;
+  int index_ = -1;
+};
+
+/// Handle to an articulation. Joint-space vectors have one entry per dof, ordered as
+/// GetActiveJoints(); a free root's 6 dof are not included (see GetRootPose).
+class Articulation {
+ public:
+  Articulation() = default;
+  Articulation(Scene* scene, int id) : scene_(scene), id_(id) {}
+
+  int GetId() const { return id_; }
+  const std::string& GetName() const;
+  bool IsKinematic() const;
+  bool HasFixedRoot() const;
+  int Dof() const;
+  std::vector<Link> GetLinks() const;
+  std::vector<Joint> GetJoints() const;        ///< one per non-root link
+  std::vector<Joint> GetActiveJoints() const;  ///< joints with a dof, in qpos order
+  Link GetLink(int index) const;
+  Joint GetJoint(int index) const;
+  /// Finds by name; throws partsim::Error naming the missing name.
+  Link FindLinkByName(const std::string& name) const;
+  Joint FindJointByName(const std::string& name) const;
+
+  Eigen::VectorXd GetQpos() const;
+  void SetQpos(const Eigen::VectorXd& qpos);
+  Eigen::VectorXd GetQvel() const;
+  void SetQvel(const Eigen::VectorXd& qvel);
+  /// Joint accelerations of the last step (m/s^2 or rad/s^2).
+  Eigen::VectorXd GetQacc() const;
+  /// Sets accelerations; they only seed the solver's warm start.
+  void SetQacc(const Eigen::VectorXd& qacc);
+  /// Generalized forces applied by the user (N or N m); they persist until changed.
+  Eigen::VectorXd GetQf() const;
+  void SetQf(const Eigen::VectorXd& qf);
+  /// dof x 2 matrix of (lower, upper).
+  Eigen::MatrixX2d GetQlimits() const;
+  void SetQlimits(const Eigen::MatrixX2d& limits);
+
+  Pose GetRootPose() const;
+  void SetRootPose(const Pose& pose);
+  Eigen::Vector3d GetRootVelocity() const;
+  Eigen::Vector3d GetRootAngularVelocity() const;
+  void SetRootVelocity(const Eigen::Vector3d& v);
+  void SetRootAngularVelocity(const Eigen::Vector3d& w);
+
+  /// Whole-articulation drive targets, one per dof.
+  void SetDriveTarget(const Eigen::VectorXd& target);
+  void SetDriveVelocityTarget(const Eigen::VectorXd& velocity);
+  Eigen::VectorXd GetDriveTarget() const;
+  Eigen::VectorXd GetDriveVelocityTarget() const;
+  /// Same drive parameters on every active joint.
+  void SetDriveProperty(double stiffness, double damping, double force_limit = kInf);
+
+  /// Generalized force that cancels gravity and/or Coriolis and centrifugal forces at the
+  /// current state (apply it with SetQf to hold a pose).
+  Eigen::VectorXd ComputePassiveForce(bool gravity = true,
+                                      bool coriolis_and_centrifugal = true) const;
+  /// Accelerations produced by generalized forces qf at the current state, without contacts,
+  /// limits or drives: M^-1 (qf - bias).
+  Eigen::VectorXd ComputeForwardDynamics(const Eigen::VectorXd& qf) const;
+  /// Generalized forces that produce accelerations qacc at the current state: M qacc + bias.
+  Eigen::VectorXd ComputeInverseDynamics(const Eigen::VectorXd& qacc) const;
+  /// Joint-space mass matrix (dof x dof).
+  Eigen::MatrixXd ComputeManipulatorInertiaMatrix() const;
+  /// World-frame Jacobian of link `index` at its origin: 6 x dof, rows (linear; angular).
+  Eigen::MatrixXd ComputeLinkJacobian(int index) const;
+  /// Stacked link Jacobians, 6 nlinks x dof.
+  Eigen::MatrixXd ComputeWorldCartesianJacobian() const;
+
+  const ArticulationDesc& GetDesc() const;
+  Scene* GetScene() const { return scene_; }
+  bool operator==(const Articulation& o) const { return scene_ == o.scene_ && id_ == o.id_; }
+
+ private:
+  Scene* scene_ = nullptr;
+  int id_ = -1;
+};
+
+/// One contact point between two bodies.
+struct ContactPoint {
+  Eigen::Vector3d position;   ///< world (m)
+  Eigen::Vector3d normal;     ///< world, pointing from body 0 to body 1
+  Eigen::Vector3d impulse;    ///< world, impulse on body 1 over the last step (N s)
+  Eigen::Vector3d force;      ///< world, force on body 1 (N)
+  double separation = 0.0;    ///< signed distance (m), negative when penetrating
+};
+
+/// What a contact touches: an actor or a link, and which of its collision shapes.
+struct ContactBody {
+  enum class Kind { kActor, kLink };
+  Kind kind = Kind::kActor;
+  int actor_id = -1;          ///< kActor
+  int articulation_id = -1;   ///< kLink
+  int link_index = -1;        ///< kLink
+  int shape_index = -1;       ///< index in the body's collisions
+  std::string name;           ///< actor or link name
+};
+
+/// The contact between two shapes, with its points.
+struct Contact {
+  ContactBody body0;
+  ContactBody body1;
+  std::vector<ContactPoint> points;
+};
+
+/// Warnings recorded during stepping (numerical trouble); the scene stays usable.
+struct Warning {
+  double time;
+  std::string message;
+};
+
+/// A simulated world. Non-copyable; use Clone().
+class Scene {
+ public:
+  explicit Scene(const SceneConfig& config = SceneConfig());
+  ~Scene();
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+
+  /// Independent copy with the same description and state.
+  std::unique_ptr<Scene> Clone() const;
+
+  const SceneConfig& GetConfig() const;
+  double GetTimestep() const;
+  void SetTimestep(double dt);
+  Eigen::Vector3d GetGravity() const;
+  void SetGravity(const Eigen::Vector3d& g);
+  /// Simulated time (s).
+  double GetTime() const;
+
+  ActorBuilder CreateActorBuilder();
+  ArticulationBuilder CreateArticulationBuilder();
+  UrdfLoader CreateUrdfLoader();
+
+  /// Adds a static ground plane at z = altitude.
+  Actor AddGround(double altitude = 0.0, const std::optional<PhysicalMaterial>& material = {},
+                  const std::string& name = "ground");
+  /// Adds an actor or articulation (validated first); the state of everything else is kept.
+  Actor AddActor(const ActorDesc& desc);
+  Articulation AddArticulation(const ArticulationDesc& desc);
+  void RemoveActor(const Actor& actor);
+  void RemoveArticulation(const Articulation& articulation);
+
+  std::vector<Actor> GetActors() const;
+  std::vector<Articulation> GetArticulations() const;
+  Actor FindActorByName(const std::string& name) const;
+  Articulation FindArticulationByName(const std::string& name) const;
+
+  /// Advances by one timestep (or n).
+  void Step(int n = 1);
+  /// Contacts of the last step.
+  std::vector<Contact> GetContacts() const;
+  /// Warnings recorded so far (NaN state reset, etc.).
+  const std::vector<Warning>& GetWarnings() const;
+  void ClearWarnings();
+
+  /// Whole dynamic state (time, positions, velocities, solver warm start, drive targets,
+  /// applied forces), bit-exact.
+  std::vector<char> Pack() const;
+  /// Restores a state from Pack() of this scene (same actors and articulations).
+  void Unpack(const std::vector<char>& state);
+
+  /// The compiled MuJoCo model and data (compiled on demand). Read freely; writing is at your
+  /// own risk.
+  const mjModel_* GetMjModel() const;
+  mjData_* GetMjData() const;
+  /// The MJCF text the last compile used (for debugging).
+  std::string GetMjcf() const;
+
+  // Internals used by the handles; not part of the stable API.
+  struct Impl;
+  Impl& impl() const { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Builds an actor piece by piece (SAPIEN's ActorBuilder).
+class ActorBuilder {
+ public:
+  explicit ActorBuilder(Scene* scene) : scene_(scene) {}
+
+  ActorBuilder& SetName(const std::string& name);
+  ActorBuilder& SetInitialPose(const Pose& pose);
+  ActorBuilder& AddBoxCollision(const Pose& pose, const Eigen::Vector3d& half_size,
+                                const std::optional<PhysicalMaterial>& material = {},
+                                double density = 1000.0);
+  ActorBuilder& AddSphereCollision(const Pose& pose, double radius,
+                                   const std::optional<PhysicalMaterial>& material = {},
+                                   double density = 1000.0);
+  ActorBuilder& AddCapsuleCollision(const Pose& pose, double radius, double half_length,
+                                    const std::optional<PhysicalMaterial>& material = {},
+                                    double density = 1000.0);
+  ActorBuilder& AddCylinderCollision(const Pose& pose, double radius, double half_length,
+                                     const std::optional<PhysicalMaterial>& material = {},
+                                     double density = 1000.0);
+  /// Convex hull of a mesh file's vertices (scaled).
+  ActorBuilder& AddConvexCollisionFromFile(const std::string& filename, const Pose& pose = Pose(),
+                                           const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
+                                           const std::optional<PhysicalMaterial>& material = {},
+                                           double density = 1000.0);
+  /// One convex piece per sub-mesh (or connected component) of a mesh file.
+  ActorBuilder& AddMultipleConvexCollisionsFromFile(
+      const std::string& filename, const Pose& pose = Pose(),
+      const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
+      const std::optional<PhysicalMaterial>& material = {}, double density = 1000.0);
+  ActorBuilder& AddConvexCollisionFromMesh(std::shared_ptr<const MeshData> mesh,
+                                           const Pose& pose = Pose(),
+                                           const std::optional<PhysicalMaterial>& material = {},
+                                           double density = 1000.0);
+  ActorBuilder& AddBoxVisual(const Pose& pose, const Eigen::Vector3d& half_size,
+                             const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                             const std::string& name = "");
+  ActorBuilder& AddSphereVisual(const Pose& pose, double radius,
+                                const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                                const std::string& name = "");
+  ActorBuilder& AddCapsuleVisual(const Pose& pose, double radius, double half_length,
+                                 const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                                 const std::string& name = "");
+  ActorBuilder& AddCylinderVisual(const Pose& pose, double radius, double half_length,
+                                  const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                                  const std::string& name = "");
+  ActorBuilder& AddVisualFromFile(const std::string& filename, const Pose& pose = Pose(),
+                                  const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
+                                  const std::string& name = "");
+  /// Explicit mass (kg), centre-of-mass pose in the body and principal inertia (kg m^2).
+  ActorBuilder& SetMassAndInertia(double mass, const Pose& cmass_local_pose,
+                                  const Eigen::Vector3d& inertia);
+
+  Actor Build(bool kinematic = false);
+  Actor BuildKinematic() { return Build(true); }
+  Actor BuildStatic();
+  const ActorDesc& GetDesc() const { return desc_; }
+
+ protected:
+  BodyDesc& body() { return desc_; }
+  Scene* scene_;
+  ActorDesc desc_;
+};
+
+/// Builds one link of an articulation; obtained from ArticulationBuilder::CreateLinkBuilder.
+class LinkBuilder {
+ public:
+  LinkBuilder(ArticulationBuilder* owner, int index) : owner_(owner), index_(index) {}
+  int GetIndex() const { return index_; }
+  LinkBuilder& SetName(const std::string& name);
+  LinkBuilder& SetJointName(const std::string& name);
+  /// Joint to the parent: type, limits (lower, upper), frames, friction and damping.
+  LinkBuilder& SetJointProperties(JointType type, const Eigen::Vector2d& limits,
+                                  const Pose& pose_in_parent, const Pose& pose_in_child,
+                                  double friction = 0.0, double damping = 0.0);
+  LinkBuilder& SetJointArmature(double armature);
+  LinkBuilder& SetScrewPitch(double pitch);
+  LinkBuilder& AddBoxCollision(const Pose& pose, const Eigen::Vector3d& half_size,
+                               const std::optional<PhysicalMaterial>& material = {},
+                               double density = 1000.0);
+  LinkBuilder& AddSphereCollision(const Pose& pose, double radius,
+                                  const std::optional<PhysicalMaterial>& material = {},
+                                  double density = 1000.0);
+  LinkBuilder& AddCapsuleCollision(const Pose& pose, double radius, double half_length,
+                                   const std::optional<PhysicalMaterial>& material = {},
+                                   double density = 1000.0);
+  LinkBuilder& AddCylinderCollision(const Pose& pose, double radius, double half_length,
+                                    const std::optional<PhysicalMaterial>& material = {},
+                                    double density = 1000.0);
+  LinkBuilder& AddConvexCollisionFromFile(const std::string& filename, const Pose& pose = Pose(),
+                                          const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
+                                          const std::optional<PhysicalMaterial>& material = {},
+                                          double density = 1000.0);
+  LinkBuilder& AddBoxVisual(const Pose& pose, const Eigen::Vector3d& half_size,
+                            const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                            const std::string& name = "");
+  LinkBuilder& AddSphereVisual(const Pose& pose, double radius,
+                               const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                               const std::string& name = "");
+  LinkBuilder& AddCapsuleVisual(const Pose& pose, double radius, double half_length,
+                                const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                                const std::string& name = "");
+  LinkBuilder& AddCylinderVisual(const Pose& pose, double radius, double half_length,
+                                 const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                                 const std::string& name = "");
+  LinkBuilder& AddVisualFromFile(const std::string& filename, const Pose& pose = Pose(),
+                                 const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
+                                 const std::string& name = "");
+  LinkBuilder& SetMassAndInertia(double mass, const Pose& cmass_local_pose,
+                                 const Eigen::Vector3d& inertia);
+
+ private:
+  LinkDesc& link();
+  ArticulationBuilder* owner_;
+  int index_;
+};
+
+/// Builds an articulation link by link (SAPIEN's ArticulationBuilder).
+class ArticulationBuilder {
+ public:
+  explicit ArticulationBuilder(Scene* scene) : scene_(scene) {}
+  ArticulationBuilder(const ArticulationBuilder&) = delete;
+  ArticulationBuilder(ArticulationBuilder&&) = default;
+
+  ArticulationBuilder& SetName(const std::string& name);
+  ArticulationBuilder& SetInitialPose(const Pose& pose);
+  /// New link whose parent is `parent` (nullptr for the root). The returned builder stays valid
+  /// as long as this ArticulationBuilder.
+  LinkBuilder* CreateLinkBuilder(LinkBuilder* parent = nullptr);
+  Articulation Build(bool fix_root_link = false);
+  Articulation BuildKinematic();
+  ArticulationDesc& GetDesc() { return desc_; }
+
+ private:
+  friend class LinkBuilder;
+  Scene* scene_;
+  ArticulationDesc desc_;
+  std::vector<std::unique_ptr<LinkBuilder>> link_builders_;
+};
+
+}  // namespace partsim
