@@ -1,0 +1,191 @@
+#include "partsim/assets/mesh.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "partsim/core/error.h"
+
+namespace partsim {
+namespace {
+
+const std::string kMeshDir = std::string(PARTSIM_TEST_DATA_DIR) + "/meshes/";
+
+// Axis-aligned bounds of a mesh.
+struct Bounds {
+  Eigen::Vector3f lo, hi;
+};
+
+Bounds BoundsOf(const MeshData& m) {
+  Bounds b{Eigen::Vector3f::Constant(1e30f), Eigen::Vector3f::Constant(-1e30f)};
+  for (const Eigen::Vector3f& v : m.vertices) {
+    b.lo = b.lo.cwiseMin(v);
+    b.hi = b.hi.cwiseMax(v);
+  }
+  return b;
+}
+
+void ExpectBounds(const MeshData& m, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi,
+                  float tol = 1e-5f) {
+  Bounds b = BoundsOf(m);
+  EXPECT_TRUE(b.lo.isApprox(lo, tol) || (b.lo - lo).norm() < tol)
+      << "lo " << b.lo.transpose() << " expected " << lo.transpose();
+  EXPECT_TRUE(b.hi.isApprox(hi, tol) || (b.hi - hi).norm() < tol)
+      << "hi " << b.hi.transpose() << " expected " << hi.transpose();
+}
+
+// Signed volume of a closed mesh: positive when triangles wind counter-clockwise from outside.
+double SignedVolume(const MeshData& m) {
+  double v = 0;
+  for (const Eigen::Vector3i& f : m.faces) {
+    v += m.vertices[f[0]].cast<double>().dot(
+             m.vertices[f[1]].cast<double>().cross(m.vertices[f[2]].cast<double>())) /
+         6.0;
+  }
+  return v;
+}
+
+TEST(MeshTest, ObjCubeWithMtlColour) {
+  std::vector<LoadedMesh> meshes = LoadMeshFile(kMeshDir + "cube.obj");
+  ASSERT_EQ(meshes.size(), 1u);
+  const MeshData& m = *meshes[0].mesh;
+  EXPECT_EQ(m.faces.size(), 12u);
+  // flat normals: each vertex belongs to one face direction, each normal has unit length
+  ASSERT_EQ(m.normals.size(), m.vertices.size());
+  for (const Eigen::Vector3f& n : m.normals) EXPECT_NEAR(n.norm(), 1.0f, 1e-5);
+  ExpectBounds(m, Eigen::Vector3f::Constant(-0.5f), Eigen::Vector3f::Constant(0.5f));
+  EXPECT_NEAR(SignedVolume(m), 1.0, 1e-5);
+  EXPECT_EQ(m.source, kMeshDir + "cube.obj");
+  EXPECT_TRUE(meshes[0].material.base_color.isApprox(Eigen::Vector4f(0.8f, 0.2f, 0.1f, 1.0f)))
+      << meshes[0].material.base_color.transpose();
+}
+
+TEST(MeshTest, ScaleMultipliesVerticesPerAxis) {
+  std::vector<LoadedMesh> meshes = LoadMeshFile(kMeshDir + "cube.obj", Eigen::Vector3d(2, 3, 4));
+  ASSERT_EQ(meshes.size(), 1u);
+  ExpectBounds(*meshes[0].mesh, Eigen::Vector3f(-1, -1.5f, -2), Eigen::Vector3f(1, 1.5f, 2));
+  EXPECT_NEAR(SignedVolume(*meshes[0].mesh), 24.0, 1e-4);
+}
+
+TEST(MeshTest, MirroringScaleKeepsOutwardWinding) {
+  std::vector<LoadedMesh> meshes = LoadMeshFile(kMeshDir + "cube.obj", Eigen::Vector3d(-1, 1, 1));
+  EXPECT_NEAR(SignedVolume(*meshes[0].mesh), 1.0, 1e-5);
+}
+
+TEST(MeshTest, AsciiStl) {
+  std::shared_ptr<MeshData> m = LoadMergedMesh(kMeshDir + "box.stl");
+  EXPECT_EQ(m->faces.size(), 12u);
+  ExpectBounds(*m, Eigen::Vector3f::Zero(), Eigen::Vector3f(0.2f, 0.1f, 0.05f));
+  EXPECT_NEAR(SignedVolume(*m), 0.2 * 0.1 * 0.05, 1e-7);
+}
+
+TEST(MeshTest, ColladaUnitsAndZUp) {
+  // 10 x 20 x 30 cm box translated 10 cm along x, written in centimetres with Z_UP
+  std::vector<LoadedMesh> meshes = LoadMeshFile(kMeshDir + "box_cm.dae");
+  ASSERT_EQ(meshes.size(), 1u);
+  ExpectBounds(*meshes[0].mesh, Eigen::Vector3f(0.1f, 0, 0), Eigen::Vector3f(0.2f, 0.2f, 0.3f));
+  EXPECT_NEAR(SignedVolume(*meshes[0].mesh), 0.1 * 0.2 * 0.3, 1e-6);
+  EXPECT_TRUE(meshes[0].material.base_color.isApprox(Eigen::Vector4f(0.1f, 0.2f, 0.7f, 1.0f)))
+      << meshes[0].material.base_color.transpose();
+}
+
+TEST(MeshTest, ColladaYUpStandsUpAlongZ) {
+  // box 0.1 x 0.2 x 0.3 m with y up: its height (file y) becomes z, file z becomes -y
+  std::vector<LoadedMesh> meshes = LoadMeshFile(kMeshDir + "box_yup.dae");
+  ASSERT_EQ(meshes.size(), 1u);
+  ExpectBounds(*meshes[0].mesh, Eigen::Vector3f(0, -0.3f, 0), Eigen::Vector3f(0.1f, 0, 0.2f));
+  EXPECT_NEAR(SignedVolume(*meshes[0].mesh), 0.1 * 0.2 * 0.3, 1e-6);
+}
+
+TEST(MeshTest, GltfEmbeddedBufferAndBaseColour) {
+  std::vector<LoadedMesh> meshes = LoadMeshFile(kMeshDir + "box.gltf", Eigen::Vector3d::Constant(2));
+  ASSERT_EQ(meshes.size(), 1u);
+  ExpectBounds(*meshes[0].mesh, Eigen::Vector3f(-0.2f, -0.4f, -0.6f),
+               Eigen::Vector3f(0.2f, 0.4f, 0.6f));
+  EXPECT_TRUE(meshes[0].material.base_color.isApprox(Eigen::Vector4f(0.1f, 0.9f, 0.2f, 1.0f)))
+      << meshes[0].material.base_color.transpose();
+  EXPECT_NEAR(meshes[0].material.metallic, 0.25f, 1e-6);
+  EXPECT_NEAR(meshes[0].material.roughness, 0.5f, 1e-6);
+}
+
+TEST(MeshTest, SubMeshesKeepTheirMaterials) {
+  std::vector<LoadedMesh> meshes = LoadMeshFile(kMeshDir + "parts.obj");
+  ASSERT_EQ(meshes.size(), 2u);
+  // order follows the file; find each by colour
+  int red = meshes[0].material.base_color.x() > 0.5f ? 0 : 1;
+  EXPECT_TRUE(meshes[red].material.base_color.head<3>().isApprox(Eigen::Vector3f(1, 0, 0)));
+  EXPECT_TRUE(meshes[1 - red].material.base_color.head<3>().isApprox(Eigen::Vector3f(0, 0, 1)));
+  ExpectBounds(*meshes[red].mesh, Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(1, 1, 1));
+  ExpectBounds(*meshes[1 - red].mesh, Eigen::Vector3f(2, 0, 0), Eigen::Vector3f(3, 2, 1));
+
+  std::shared_ptr<MeshData> merged = LoadMergedMesh(kMeshDir + "parts.obj");
+  EXPECT_EQ(merged->faces.size(), 24u);
+  ExpectBounds(*merged, Eigen::Vector3f(0, 0, 0), Eigen::Vector3f(3, 2, 1));
+  EXPECT_NEAR(SignedVolume(*merged), 1.0 + 2.0, 1e-5);
+}
+
+TEST(MeshTest, SplitTwoBoxesIntoTwoComponents) {
+  std::shared_ptr<MeshData> m = LoadMergedMesh(kMeshDir + "two_boxes.obj");
+  std::vector<std::shared_ptr<MeshData>> pieces = SplitConnectedComponents(*m);
+  ASSERT_EQ(pieces.size(), 2u);
+  for (const auto& p : pieces) {
+    EXPECT_EQ(p->faces.size(), 12u);
+    // flat-shaded corners are welded for the split but stay apart in the piece
+    EXPECT_GE(p->vertices.size(), 8u);
+    EXPECT_NEAR(SignedVolume(*p), 1.0, 1e-5);
+  }
+  Bounds a = BoundsOf(*pieces[0]), b = BoundsOf(*pieces[1]);
+  EXPECT_NEAR(std::min(a.lo.x(), b.lo.x()), 0.0f, 1e-6);
+  EXPECT_NEAR(std::max(a.lo.x(), b.lo.x()), 3.0f, 1e-6);
+}
+
+TEST(MeshTest, SplitWeldsDuplicatedVertices) {
+  // two triangles of a square that share an edge only through duplicated vertices
+  MeshData m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  m.faces = {{0, 1, 2}, {3, 4, 5}};
+  EXPECT_EQ(SplitConnectedComponents(m).size(), 1u);
+  // moving the second triangle away disconnects it
+  for (int i = 3; i < 6; ++i) m.vertices[i].z() += 1.0f;
+  EXPECT_EQ(SplitConnectedComponents(m).size(), 2u);
+}
+
+TEST(MeshTest, ConvexPiecesPerSubMeshAndComponent) {
+  EXPECT_EQ(LoadConvexPieces(kMeshDir + "two_boxes.obj").size(), 2u);
+  EXPECT_EQ(LoadConvexPieces(kMeshDir + "parts.obj").size(), 2u);
+  EXPECT_EQ(LoadConvexPieces(kMeshDir + "cube.obj").size(), 1u);
+}
+
+TEST(MeshTest, MissingFileNamesTheFile) {
+  try {
+    LoadMeshFile(kMeshDir + "no_such_mesh.obj");
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no_such_mesh.obj"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MeshTest, BrokenFileNamesTheFile) {
+  std::filesystem::path p = std::filesystem::temp_directory_path() / "partsim_broken_mesh.stl";
+  {
+    std::ofstream f(p);
+    f << "this is not a mesh at all\n";
+  }
+  try {
+    LoadMeshFile(p.string());
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("partsim_broken_mesh.stl"), std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove(p);
+}
+
+TEST(MeshTest, DirectoryIsNotAMesh) {
+  EXPECT_THROW(LoadMeshFile(kMeshDir), Error);
+}
+
+}  // namespace
+}  // namespace partsim
