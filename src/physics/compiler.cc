@@ -1,0 +1,413 @@
+// Compiles partsim's scene description into MJCF text for MuJoCo, and after MuJoCo has loaded it,
+// resolves the ids that partsim's handles use.
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include "physics/scene_internal.h"
+
+namespace partsim {
+namespace internal {
+namespace {
+
+// MuJoCo capsules and cylinders lie along z; partsim's along x: rotate z onto x.
+const Eigen::Quaterniond kZToX(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()));
+
+// Shortest round-tripping text for a double.
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.17g", v);
+  return buf;
+}
+
+std::string Vec(const Eigen::Vector3d& v) { return Num(v.x()) + " " + Num(v.y()) + " " + Num(v.z()); }
+
+std::string Quat(const Eigen::Quaterniond& q) {
+  Eigen::Quaterniond n = q.normalized();
+  return Num(n.w()) + " " + Num(n.x()) + " " + Num(n.y()) + " " + Num(n.z());
+}
+
+std::string PoseAttrs(const Pose& pose) {
+  return " pos=\"" + Vec(pose.p) + "\" quat=\"" + Quat(pose.q) + "\"";
+}
+
+// Writes the MJCF of a scene. Kept as a class so that the emitters share the output stream and
+// the mesh asset table.
+class MjcfWriter {
+ public:
+  explicit MjcfWriter(const SceneImpl& scene) : scene_(scene) {}
+
+  std::string Write() {
+    const SceneConfig& c = scene_.config;
+    const char* integrator = c.integrator == Integrator::kEuler     ? "Euler"
+                             : c.integrator == Integrator::kRK4     ? "RK4"
+                                                                    : "implicit";
+    // bodies first: they collect mesh assets and equality constraints
+    for (const auto& a : scene_.actors) WriteActor(a.id, a.desc);
+    for (const auto& a : scene_.articulations) WriteArticulation(a.id, a.desc);
+
+    std::ostringstream out;
+    out << "<mujoco model=\"partsim\">\n"
+        << "  <compiler angle=\"radian\" inertiafromgeom=\"auto\" boundmass=\"1e-6\" "
+           "boundinertia=\"1e-9\"/>\n"
+        << "  <option timestep=\"" << Num(c.timestep) << "\" gravity=\"" << Vec(c.gravity)
+        << "\" iterations=\"" << c.solver_iterations << "\" integrator=\"" << integrator
+        << "\"/>\n";
+    // contact buffers sized from the scene: generous per collision geom, never tiny
+    int nconmax = 100 + 16 * num_collision_geoms_;
+    int njmax = 6 * nconmax + 4 * num_limits_ + 6 * num_equalities_ + 100;
+    out << "  <size nconmax=\"" << nconmax << "\" njmax=\"" << njmax << "\"/>\n";
+    if (!assets_.str().empty()) out << "  <asset>\n" << assets_.str() << "  </asset>\n";
+    out << "  <worldbody>\n" << bodies_.str() << "  </worldbody>\n";
+    if (!equality_.str().empty()) out << "  <equality>\n" << equality_.str() << "  </equality>\n";
+    if (!actuators_.str().empty())
+      out << "  <actuator>\n" << actuators_.str() << "  </actuator>\n";
+    out << "</mujoco>\n";
+    return out.str();
+  }
+
+ private:
+  void Indent(int depth) { bodies_ << std::string(2 * depth + 4, ' '); }
+
+  void WriteInertial(const std::optional<Inertial>& inertial, bool has_collision, int depth) {
+    if (inertial) {
+      Indent(depth);
+      bodies_ << "<inertial" << PoseAttrs(inertial->cmass_local_pose) << " mass=\""
+              << Num(inertial->mass) << "\" diaginertia=\"" << Vec(inertial->inertia) << "\"/>\n";
+    } else if (!has_collision) {
+      // a body with nothing to derive mass from gets a small one, so it can move
+      Indent(depth);
+      bodies_ << "<inertial pos=\"0 0 0\" mass=\"0.001\" diaginertia=\"1e-6 1e-6 1e-6\"/>\n";
+    }
+  }
+
+  void WriteShapes(const std::vector<CollisionShape>& shapes, const std::string& prefix,
+                   int depth) {
+    for (size_t i = 0; i < shapes.size(); ++i) {
+      const CollisionShape& s = shapes[i];
+      const PhysicalMaterial& mat = s.material ? *s.material : scene_.config.default_material;
+      Pose pose = s.pose;
+      std::string type, size;
+      switch (s.type) {
+        case ShapeType::kBox:
+          type = "box";
+          size = Vec(s.half_size);
+          break;
+        case ShapeType::kSphere:
+          type = "sphere";
+          size = Num(s.radius);
+          break;
+        case ShapeType::kCapsule:
+        case ShapeType::kCylinder:
+          type = s.type == ShapeType::kCapsule ? "capsule" : "cylinder";
+          size = Num(s.radius) + " " + Num(s.half_length);
+          pose.q = pose.q * kZToX;
+          break;
+        case ShapeType::kPlane:
+          type = "plane";
+          size = "0 0 1";
+          break;
+        case ShapeType::kConvexMesh: {
+          type = "mesh";
+          size = "";
+          break;
+        }
+      }
+      Indent(depth);
+      bodies_ << "<geom name=\"" << prefix << "_g" << i << "\" type=\"" << type << "\"";
+      if (!size.empty()) bodies_ << " size=\"" << size << "\"";
+      if (s.type == ShapeType::kConvexMesh) bodies_ << " mesh=\"" << MeshAsset(*s.mesh) << "\"";
+      bodies_ << PoseAttrs(pose) << " density=\"" << Num(s.density) << "\" friction=\""
+              << Num(mat.static_friction) << " 0.005 0.0001\" solref=\"0.02 "
+              << Num(RestitutionToDampingRatio(mat.restitution)) << "\"/>\n";
+      ++num_collision_geoms_;
+    }
+  }
+
+  // Registers a mesh asset (once per MeshData) and returns its name.
+  std::string MeshAsset(const MeshData& mesh) {
+    auto it = mesh_names_.find(&mesh);
+    if (it != mesh_names_.end()) return it->second;
+    std::string name = "mesh" + std::to_string(mesh_names_.size());
+    mesh_names_[&mesh] = name;
+    assets_ << "    <mesh name=\"" << name << "\" vertex=\"";
+    char buf[64];
+    for (const auto& v : mesh.vertices) {
+      std::snprintf(buf, sizeof(buf), "%.9g %.9g %.9g ", v.x(), v.y(), v.z());
+      assets_ << buf;
+    }
+    assets_ << "\"/>\n";
+    return name;
+  }
+
+  void WriteActor(int id, const ActorDesc& a) {
+    std::string name = ActorBodyName(id);
+    Indent(0);
+    bodies_ << "<body name=\"" << name << "\"" << PoseAttrs(a.pose);
+    if (a.type == ActorType::kKinematic) bodies_ << " mocap=\"true\"";
+    bodies_ << ">\n";
+    if (a.type == ActorType::kDynamic) {
+      Indent(1);
+      bodies_ << "<freejoint name=\"" << name << "_free\"/>\n";
+    }
+    if (a.type == ActorType::kDynamic) WriteInertial(a.inertial, !a.collisions.empty(), 1);
+    WriteShapes(a.collisions, name, 1);
+    Indent(0);
+    bodies_ << "</body>\n";
+  }
+
+  void WriteArticulation(int id, const ArticulationDesc& art) {
+    if (art.kinematic) {
+      // every link is a mocap body placed by forward kinematics
+      for (size_t i = 0; i < art.links.size(); ++i) {
+        std::string name = LinkBodyName(id, static_cast<int>(i));
+        Indent(0);
+        bodies_ << "<body name=\"" << name << "\" mocap=\"true\"" << PoseAttrs(art.root_pose)
+                << ">\n";
+        WriteShapes(art.links[i].collisions, name, 1);
+        Indent(0);
+        bodies_ << "</body>\n";
+      }
+      return;
+    }
+    std::vector<std::vector<int>> children(art.links.size());
+    int root = -1;
+    for (size_t i = 0; i < art.links.size(); ++i) {
+      if (art.links[i].parent < 0) root = static_cast<int>(i);
+      else children[art.links[i].parent].push_back(static_cast<int>(i));
+    }
+    WriteLink(id, art, root, children, 0);
+    for (const JointCoupling& c : art.couplings) {
+      int joint = FindJoint(art, c.joint), source = FindJoint(art, c.source);
+      equality_ << "    <joint joint1=\"" << JointMjName(id, joint) << "\" joint2=\""
+                << JointMjName(id, source) << "\" polycoef=\"" << Num(c.offset) << " "
+                << Num(c.multiplier) << " 0 0 0\" solref=\"" << Num(EqualityTimeConst())
+                << " 1\"/>\n";
+      ++num_equalities_;
+    }
+  }
+
+  static int FindJoint(const ArticulationDesc& art, const std::string& name) {
+    for (size_t i = 0; i < art.links.size(); ++i)
+      if (art.links[i].parent >= 0 && art.links[i].joint.name == name) return static_cast<int>(i);
+    return -1;  // Validate() has already rejected unknown names
+  }
+
+  double EqualityTimeConst() const { return 2.0 * scene_.config.timestep; }
+
+  void WriteLink(int id, const ArticulationDesc& art, int index,
+                 const std::vector<std::vector<int>>& children, int depth) {
+    const LinkDesc& link = art.links[index];
+    std::string name = LinkBodyName(id, index);
+    Pose X_PC = link.parent < 0 ? art.root_pose
+                                : link.joint.pose_in_parent * link.joint.pose_in_child.Inverse();
+    Indent(depth);
+    bodies_ << "<body name=\"" << name << "\"" << PoseAttrs(X_PC) << ">\n";
+    if (link.parent < 0 && !art.fix_root) {
+      Indent(depth + 1);
+      bodies_ << "<freejoint name=\"" << JointMjName(id, index) << "\"/>\n";
+    } else if (link.parent >= 0 && link.joint.type != JointType::kFixed) {
+      WriteJoint(id, index, link.joint, depth + 1);
+    }
+    bool moves = !(art.fix_root && link.parent < 0);
+    if (moves) WriteInertial(link.inertial, !link.collisions.empty(), depth + 1);
+    else if (link.inertial) WriteInertial(link.inertial, true, depth + 1);
+    WriteShapes(link.collisions, name, depth + 1);
+    for (int c : children[index]) WriteLink(id, art, c, children, depth + 1);
+    Indent(depth);
+    bodies_ << "</body>\n";
+  }
+
+  void WriteJoint(int id, int index, const JointDesc& j, int depth) {
+    Eigen::Vector3d axis = j.pose_in_child.q * Eigen::Vector3d::UnitX();
+    std::string where = " pos=\"" + Vec(j.pose_in_child.p) + "\" axis=\"" + Vec(axis) + "\"";
+    std::string dyn = " damping=\"" + Num(j.damping) + "\" frictionloss=\"" + Num(j.friction) +
+                      "\" armature=\"" + Num(j.armature) + "\"";
+    bool limited = std::isfinite(j.lower) && std::isfinite(j.upper) &&
+                   j.type != JointType::kContinuous;
+    std::string limits =
+        limited ? " limited=\"true\" range=\"" + Num(j.lower) + " " + Num(j.upper) + "\""
+                : " limited=\"false\"";
+    if (limited) ++num_limits_;
+    const char* type = j.type == JointType::kPrismatic ? "slide" : "hinge";
+    Indent(depth);
+    bodies_ << "<joint name=\"" << JointMjName(id, index) << "\" type=\"" << type << "\"" << where
+            << dyn << limits << "/>\n";
+    if (j.type == JointType::kScrew) {
+      // the translation follows the rotation through an equality constraint
+      Indent(depth);
+      bodies_ << "<joint name=\"" << ScrewSlideMjName(id, index) << "\" type=\"slide\"" << where
+              << " limited=\"false\"/>\n";
+      equality_ << "    <joint joint1=\"" << ScrewSlideMjName(id, index) << "\" joint2=\""
+                << JointMjName(id, index) << "\" polycoef=\"0 " << Num(j.pitch)
+                << " 0 0 0\" solref=\"" << Num(EqualityTimeConst()) << " 1\"/>\n";
+      ++num_equalities_;
+    }
+    // every joint with a dof gets a PD drive actuator; gains are set at run time
+    actuators_ << "    <general name=\"" << ActuatorMjName(id, index) << "\" joint=\""
+               << JointMjName(id, index) << "\" gaintype=\"fixed\" gainprm=\"1\" "
+               << "biastype=\"affine\" biasprm=\"0 " << Num(-j.drive.stiffness) << " "
+               << Num(-j.drive.damping) << "\" ctrllimited=\"false\"";
+    if (std::isfinite(j.drive.force_limit))
+      actuators_ << " forcelimited=\"true\" forcerange=\"" << Num(-j.drive.force_limit) << " "
+                 << Num(j.drive.force_limit) << "\"";
+    actuators_ << "/>\n";
+  }
+
+  const SceneImpl& scene_;
+  std::ostringstream bodies_, assets_, equality_, actuators_;
+  std::map<const MeshData*, std::string> mesh_names_;
+  int num_collision_geoms_ = 0;
+  int num_limits_ = 0;
+  int num_equalities_ = 0;
+};
+
+int Id(const mjModel* m, mjtObj type, const std::string& name) {
+  return mj_name2id(m, type, name.c_str());
+}
+
+}  // namespace
+
+std::string ActorBodyName(int id) { return "a" + std::to_string(id); }
+std::string LinkBodyName(int art, int link) {
+  return "r" + std::to_string(art) + "_l" + std::to_string(link);
+}
+std::string JointMjName(int art, int link) {
+  return "r" + std::to_string(art) + "_j" + std::to_string(link);
+}
+std::string ScrewSlideMjName(int art, int link) {
+  return "r" + std::to_string(art) + "_s" + std::to_string(link);
+}
+std::string ActuatorMjName(int art, int link) {
+  return "r" + std::to_string(art) + "_d" + std::to_string(link);
+}
+
+double RestitutionToDampingRatio(double e) {
+  // a linear spring-damper bounces back with e = exp(-zeta pi / sqrt(1 - zeta^2))
+  if (e <= 0.0) return 1.0;
+  if (e >= 1.0) e = 0.999;
+  double l = std::log(e);
+  return -l / std::sqrt(M_PI * M_PI + l * l);
+}
+
+std::string GenerateMjcf(const SceneImpl& scene) { return MjcfWriter(scene).Write(); }
+
+void BuildTables(SceneImpl& s) {
+  const mjModel* m = s.m;
+  s.compiled_actors.clear();
+  s.compiled_articulations.clear();
+  s.geom_owner.assign(m->ngeom, GeomOwner());
+
+  auto own_geoms = [&](const std::string& prefix, size_t count, GeomOwner owner) {
+    for (size_t i = 0; i < count; ++i) {
+      int g = Id(m, mjOBJ_GEOM, prefix + "_g" + std::to_string(i));
+      owner.shape_index = static_cast<int>(i);
+      if (g >= 0) s.geom_owner[g] = owner;
+    }
+  };
+
+  for (const auto& a : s.actors) {
+    CompiledActor c;
+    std::string name = ActorBodyName(a.id);
+    c.body = Id(m, mjOBJ_BODY, name);
+    c.mocap = m->body_mocapid[c.body];
+    int j = Id(m, mjOBJ_JOINT, name + "_free");
+    if (j >= 0) {
+      c.qposadr = m->jnt_qposadr[j];
+      c.dofadr = m->jnt_dofadr[j];
+    }
+    s.compiled_actors[a.id] = c;
+    GeomOwner owner;
+    owner.actor_id = a.id;
+    own_geoms(name, a.desc.collisions.size(), owner);
+  }
+
+  for (const auto& a : s.articulations) {
+    const ArticulationDesc& desc = a.desc;
+    CompiledArticulation c;
+    size_t n = desc.links.size();
+    c.link_body.resize(n);
+    c.link_mocap.assign(n, -1);
+    c.joints.resize(n);
+    std::map<std::string, int> link_of_joint;
+    for (size_t i = 0; i < n; ++i) {
+      std::string name = LinkBodyName(a.id, static_cast<int>(i));
+      c.link_body[i] = Id(m, mjOBJ_BODY, name);
+      c.link_mocap[i] = m->body_mocapid[c.link_body[i]];
+      GeomOwner owner;
+      owner.articulation_id = a.id;
+      owner.link_index = static_cast<int>(i);
+      own_geoms(name, desc.links[i].collisions.size(), owner);
+      if (desc.links[i].parent >= 0) link_of_joint[desc.links[i].joint.name] = static_cast<int>(i);
+    }
+    // free root
+    if (!desc.kinematic && !desc.fix_root) {
+      for (size_t i = 0; i < n; ++i) {
+        if (desc.links[i].parent >= 0) continue;
+        int j = Id(m, mjOBJ_JOINT, JointMjName(a.id, static_cast<int>(i)));
+        c.root_qposadr = m->jnt_qposadr[j];
+        c.root_dofadr = m->jnt_dofadr[j];
+      }
+    }
+    // dofs: one per non-fixed, non-coupled joint, in link order
+    std::map<int, const JointCoupling*> coupled;  // link index -> coupling
+    for (const JointCoupling& cp : desc.couplings) coupled[link_of_joint[cp.joint]] = &cp;
+    for (size_t i = 0; i < n; ++i) {
+      const LinkDesc& link = desc.links[i];
+      if (link.parent < 0 || link.joint.type == JointType::kFixed) continue;
+      CompiledJoint& cj = c.joints[i];
+      if (!desc.kinematic) {
+        cj.mj_joint = Id(m, mjOBJ_JOINT, JointMjName(a.id, static_cast<int>(i)));
+        cj.qposadr = m->jnt_qposadr[cj.mj_joint];
+        cj.dofadr = m->jnt_dofadr[cj.mj_joint];
+        if (link.joint.type == JointType::kScrew) {
+          int sj = Id(m, mjOBJ_JOINT, ScrewSlideMjName(a.id, static_cast<int>(i)));
+          cj.screw_slide_qposadr = m->jnt_qposadr[sj];
+          cj.screw_slide_dofadr = m->jnt_dofadr[sj];
+        }
+      }
+      if (coupled.count(static_cast<int>(i))) continue;
+      cj.dof_index = static_cast<int>(c.dof_links.size());
+      c.dof_links.push_back(static_cast<int>(i));
+      if (!desc.kinematic) cj.actuator = Id(m, mjOBJ_ACTUATOR, ActuatorMjName(a.id, static_cast<int>(i)));
+    }
+    for (const auto& [li, cp] : coupled) {
+      CompiledCoupling cc;
+      cc.qposadr = c.joints[li].qposadr;
+      cc.dofadr = c.joints[li].dofadr;
+      cc.source_dof = c.joints[link_of_joint[cp->source]].dof_index;
+      cc.multiplier = cp->multiplier;
+      cc.offset = cp->offset;
+      c.couplings.push_back(cc);
+    }
+    // G: partsim dof velocities -> MuJoCo dof velocities of this articulation
+    if (!desc.kinematic) {
+      std::vector<std::pair<int, std::pair<int, double>>> rows;  // mj dof -> (dof, factor)
+      for (int li : c.dof_links) {
+        const CompiledJoint& cj = c.joints[li];
+        rows.push_back({cj.dofadr, {cj.dof_index, 1.0}});
+        if (cj.screw_slide_dofadr >= 0)
+          rows.push_back({cj.screw_slide_dofadr, {cj.dof_index, desc.links[li].joint.pitch}});
+      }
+      for (const CompiledCoupling& cc : c.couplings) {
+        rows.push_back({cc.dofadr, {cc.source_dof, cc.multiplier}});
+        // a coupled screw joint's slide follows too
+        for (size_t i = 0; i < n; ++i)
+          if (c.joints[i].dofadr == cc.dofadr && c.joints[i].screw_slide_dofadr >= 0)
+            rows.push_back({c.joints[i].screw_slide_dofadr,
+                            {cc.source_dof, cc.multiplier * desc.links[i].joint.pitch}});
+      }
+      std::sort(rows.begin(), rows.end());
+      c.G = Eigen::MatrixXd::Zero(rows.size(), c.dof_links.size());
+      for (size_t r = 0; r < rows.size(); ++r) {
+        c.mj_dofs.push_back(rows[r].first);
+        if (rows[r].second.first >= 0) c.G(r, rows[r].second.first) = rows[r].second.second;
+      }
+    }
+    s.compiled_articulations[a.id] = std::move(c);
+  }
+}
+
+}  // namespace internal
+}  // namespace partsim

@@ -1,0 +1,200 @@
+// Names of enum values and validation of descriptions.
+#include "partsim/physics/description.h"
+
+#include <cmath>
+#include <set>
+
+#include "partsim/core/error.h"
+
+namespace partsim {
+
+const char* ShapeTypeName(ShapeType t) {
+  switch (t) {
+    case ShapeType::kBox: return "box";
+    case ShapeType::kSphere: return "sphere";
+    case ShapeType::kCapsule: return "capsule";
+    case ShapeType::kCylinder: return "cylinder";
+    case ShapeType::kConvexMesh: return "convex_mesh";
+    case ShapeType::kPlane: return "plane";
+  }
+  return "?";
+}
+
+const char* ActorTypeName(ActorType t) {
+  switch (t) {
+    case ActorType::kStatic: return "static";
+    case ActorType::kKinematic: return "kinematic";
+    case ActorType::kDynamic: return "dynamic";
+  }
+  return "?";
+}
+
+const char* JointTypeName(JointType t) {
+  switch (t) {
+    case JointType::kFixed: return "fixed";
+    case JointType::kRevolute: return "revolute";
+    case JointType::kContinuous: return "continuous";
+    case JointType::kPrismatic: return "prismatic";
+    case JointType::kScrew: return "screw";
+  }
+  return "?";
+}
+
+namespace {
+
+std::string Prefix(const std::string& where) { return where.empty() ? "" : where + ": "; }
+
+void Require(bool ok, const std::string& where, const std::string& what) {
+  if (!ok) throw Error(Prefix(where) + what);
+}
+
+void CheckPose(const Pose& pose, const std::string& where, const std::string& what) {
+  Require(pose.p.allFinite(), where, what + " has a non-finite position " + pose.ToString());
+  Require(pose.q.coeffs().allFinite() && pose.q.norm() > 1e-6, where,
+          what + " has an invalid rotation " + pose.ToString());
+}
+
+void CheckNonNegative(double v, const std::string& where, const std::string& what) {
+  Require(std::isfinite(v) && v >= 0.0, where, what + " must be finite and >= 0, got " +
+                                                   std::to_string(v));
+}
+
+void CheckPositive(double v, const std::string& where, const std::string& what) {
+  Require(std::isfinite(v) && v > 0.0, where, what + " must be finite and > 0, got " +
+                                                  std::to_string(v));
+}
+
+void CheckMaterial(const PhysicalMaterial& m, const std::string& where, const std::string& what) {
+  CheckNonNegative(m.static_friction, where, what + " static_friction");
+  CheckNonNegative(m.dynamic_friction, where, what + " dynamic_friction");
+  Require(std::isfinite(m.restitution) && m.restitution >= 0 && m.restitution <= 1, where,
+          what + " restitution must be in [0, 1], got " + std::to_string(m.restitution));
+}
+
+void CheckBody(const BodyDesc& b, const std::string& where, const std::string& what) {
+  for (size_t i = 0; i < b.collisions.size(); ++i) {
+    const CollisionShape& s = b.collisions[i];
+    std::string w = what + " collision shape " + std::to_string(i) + " (" +
+                    ShapeTypeName(s.type) + ")";
+    CheckPose(s.pose, where, w + " pose");
+    CheckPositive(s.density, where, w + " density");
+    if (s.material) CheckMaterial(*s.material, where, w + " material");
+    switch (s.type) {
+      case ShapeType::kBox:
+        for (int k = 0; k < 3; ++k) CheckPositive(s.half_size[k], where, w + " half_size");
+        break;
+      case ShapeType::kSphere:
+        CheckPositive(s.radius, where, w + " radius");
+        break;
+      case ShapeType::kCapsule:
+        CheckPositive(s.radius, where, w + " radius");
+        CheckNonNegative(s.half_length, where, w + " half_length");
+        break;
+      case ShapeType::kCylinder:
+        CheckPositive(s.radius, where, w + " radius");
+        CheckPositive(s.half_length, where, w + " half_length");
+        break;
+      case ShapeType::kPlane:
+        break;
+      case ShapeType::kConvexMesh: {
+        Require(s.mesh != nullptr, where, w + " has no mesh");
+        std::string src = s.mesh->source.empty() ? "" : " from " + s.mesh->source;
+        Require(s.mesh->vertices.size() >= 4, where,
+                w + src + " needs at least 4 vertices, has " +
+                    std::to_string(s.mesh->vertices.size()));
+        Eigen::Vector3f lo = s.mesh->vertices[0], hi = lo;
+        for (const auto& v : s.mesh->vertices) {
+          Require(v.allFinite(), where, w + src + " has a non-finite vertex");
+          lo = lo.cwiseMin(v);
+          hi = hi.cwiseMax(v);
+        }
+        Eigen::Vector3f ext = hi - lo;
+        Require(ext.minCoeff() > 1e-6f * std::max(1e-3f, ext.maxCoeff()), where,
+                w + src + " is flat (its convex hull has no volume)");
+        break;
+      }
+    }
+  }
+  if (b.inertial) {
+    CheckPositive(b.inertial->mass, where, what + " mass");
+    for (int k = 0; k < 3; ++k) CheckPositive(b.inertial->inertia[k], where, what + " inertia");
+    CheckPose(b.inertial->cmass_local_pose, where, what + " centre-of-mass pose");
+  }
+}
+
+}  // namespace
+
+void Validate(const ActorDesc& a, const std::string& where) {
+  std::string what = "actor '" + a.name + "'";
+  CheckPose(a.pose, where, what + " pose");
+  CheckBody(a, where, what);
+}
+
+void Validate(const ArticulationDesc& art, const std::string& where) {
+  std::string what = "articulation '" + art.name + "'";
+  Require(!art.links.empty(), where, what + " has no links");
+  CheckPose(art.root_pose, where, what + " root pose");
+  int roots = 0;
+  std::set<std::string> link_names, joint_names;
+  for (size_t i = 0; i < art.links.size(); ++i) {
+    const LinkDesc& l = art.links[i];
+    std::string lw = what + " link " + std::to_string(i) + " '" + l.name + "'";
+    if (!l.name.empty())
+      Require(link_names.insert(l.name).second, where, "duplicate link name '" + l.name + "'");
+    CheckBody(l, where, lw);
+    if (l.parent < 0) {
+      ++roots;
+      continue;
+    }
+    Require(l.parent < static_cast<int>(i), where,
+            lw + " has parent " + std::to_string(l.parent) +
+                ", which does not come before it (links must be listed parents first)");
+    const JointDesc& j = l.joint;
+    std::string jw = "joint '" + j.name + "' of " + lw;
+    if (!j.name.empty())
+      Require(joint_names.insert(j.name).second, where, "duplicate joint name '" + j.name + "'");
+    CheckPose(j.pose_in_parent, where, jw + " pose_in_parent");
+    CheckPose(j.pose_in_child, where, jw + " pose_in_child");
+    Require(!std::isnan(j.lower) && !std::isnan(j.upper), where, jw + " has a NaN limit");
+    Require(j.lower <= j.upper, where,
+            jw + " has lower limit " + std::to_string(j.lower) + " above upper limit " +
+                std::to_string(j.upper));
+    CheckNonNegative(j.friction, where, jw + " friction");
+    CheckNonNegative(j.damping, where, jw + " damping");
+    CheckNonNegative(j.armature, where, jw + " armature");
+    Require(std::isfinite(j.pitch), where, jw + " pitch must be finite");
+    CheckNonNegative(j.drive.stiffness, where, jw + " drive stiffness");
+    CheckNonNegative(j.drive.damping, where, jw + " drive damping");
+    Require(!std::isnan(j.drive.force_limit) && j.drive.force_limit > 0, where,
+            jw + " drive force_limit must be > 0");
+    Require(std::isfinite(j.drive.target) && std::isfinite(j.drive.velocity_target), where,
+            jw + " drive target must be finite");
+  }
+  Require(roots == 1, where, what + " must have exactly one root link, has " +
+                                 std::to_string(roots));
+  // couplings name existing, independent joints
+  std::set<std::string> coupled;
+  for (const JointCoupling& c : art.couplings) {
+    auto find = [&](const std::string& name) -> const LinkDesc* {
+      for (const LinkDesc& l : art.links)
+        if (l.parent >= 0 && l.joint.name == name) return &l;
+      return nullptr;
+    };
+    std::string cw = "coupling of joint '" + c.joint + "' to '" + c.source + "'";
+    const LinkDesc* j = find(c.joint);
+    const LinkDesc* s = find(c.source);
+    Require(j != nullptr, where, cw + ": joint '" + c.joint + "' does not exist");
+    Require(s != nullptr, where, cw + ": source joint '" + c.source + "' does not exist");
+    Require(c.joint != c.source, where, cw + ": a joint cannot follow itself");
+    Require(j->joint.type != JointType::kFixed && s->joint.type != JointType::kFixed, where,
+            cw + ": both joints must move");
+    Require(std::isfinite(c.multiplier) && std::isfinite(c.offset), where,
+            cw + ": multiplier and offset must be finite");
+    Require(coupled.insert(c.joint).second, where, cw + ": joint is coupled twice");
+  }
+  for (const JointCoupling& c : art.couplings)
+    Require(!coupled.count(c.source), where,
+            "joint '" + c.joint + "' follows '" + c.source + "', which itself follows another");
+}
+
+}  // namespace partsim

@@ -1,0 +1,792 @@
+// Actor, Link, Joint and Articulation handles: views into the scene's description and data.
+#include <cmath>
+
+#include "partsim/physics/scene.h"
+#include "physics/scene_internal.h"
+
+namespace partsim {
+
+using internal::CompiledArticulation;
+using internal::CompiledJoint;
+using internal::SceneImpl;
+
+namespace {
+
+SceneImpl& S(Scene* scene) {
+  if (!scene) throw Error("empty handle: it does not belong to a scene");
+  return scene->impl();
+}
+
+Eigen::Vector3d V3(const double* v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
+Eigen::Quaterniond Q4(const double* q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]); }
+
+void CheckFinite(const Eigen::Vector3d& v, const std::string& what) {
+  if (!v.allFinite()) throw Error(what + " must be finite, got [" + std::to_string(v.x()) + ", " +
+                                  std::to_string(v.y()) + ", " + std::to_string(v.z()) + "]");
+}
+
+void CheckPoseArg(const Pose& pose, const std::string& what) {
+  if (!pose.IsValid())
+    throw Error(what + " must hold finite numbers and a unit quaternion, got " + pose.ToString());
+}
+
+void CheckVector(const Eigen::VectorXd& v, int n, const std::string& what,
+                 const std::string& owner) {
+  if (v.size() != n)
+    throw Error(what + " has " + std::to_string(v.size()) + " entries, " + owner + " has " +
+                std::to_string(n) + " dof");
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(v[i]))
+      throw Error(what + "[" + std::to_string(i) + "] is " + std::to_string(v[i]) +
+                  ", must be finite");
+}
+
+// World-frame velocity of a body at its origin: (linear, angular).
+std::pair<Eigen::Vector3d, Eigen::Vector3d> BodyVelocity(SceneImpl& s, int body) {
+  s.EnsureKinematics();
+  mjtNum res[6];
+  mj_objectVelocity(s.m, s.d, mjOBJ_BODY, body, res, 0);
+  return {V3(res + 3), V3(res)};
+}
+
+void AddBodyForce(SceneImpl& s, int body, const Eigen::Vector3d& f, const Eigen::Vector3d& point) {
+  CheckFinite(f, "force");
+  CheckFinite(point, "point");
+  s.EnsureKinematics();
+  Eigen::Vector3d com = V3(s.d->xipos + 3 * body);
+  Eigen::Vector3d torque = (point - com).cross(f);
+  for (int k = 0; k < 3; ++k) {
+    s.d->xfrc_applied[6 * body + k] += f[k];
+    s.d->xfrc_applied[6 * body + 3 + k] += torque[k];
+  }
+  s.xfrc_dirty = true;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Actor
+
+const std::string& Actor::GetName() const { return S(scene_).GetActor(id_).desc.name; }
+ActorType Actor::GetType() const { return S(scene_).GetActor(id_).desc.type; }
+const ActorDesc& Actor::GetDesc() const { return S(scene_).GetActor(id_).desc; }
+
+Pose Actor::GetPose() const {
+  SceneImpl& s = S(scene_);
+  auto& a = s.GetActor(id_);
+  const auto& c = s.Compiled(a);
+  if (c.qposadr >= 0) return Pose(V3(s.d->qpos + c.qposadr), Q4(s.d->qpos + c.qposadr + 3));
+  if (c.mocap >= 0) return Pose(V3(s.d->mocap_pos + 3 * c.mocap), Q4(s.d->mocap_quat + 4 * c.mocap));
+  return a.desc.pose;
+}
+
+void Actor::SetPose(const Pose& pose) {
+  CheckPoseArg(pose, "actor pose");
+  SceneImpl& s = S(scene_);
+  auto& a = s.GetActor(id_);
+  const auto& c = s.Compiled(a);
+  Eigen::Quaterniond q = pose.q.normalized();
+  double* dst;
+  if (c.qposadr >= 0) {
+    dst = s.d->qpos + c.qposadr;
+    for (int k = 0; k < 3; ++k) dst[k] = pose.p[k];
+    dst += 3;
+  } else if (c.mocap >= 0) {
+    for (int k = 0; k < 3; ++k) s.d->mocap_pos[3 * c.mocap + k] = pose.p[k];
+    dst = s.d->mocap_quat + 4 * c.mocap;
+  } else {
+    throw Error("actor '" + a.desc.name + "' is static and cannot be moved");
+  }
+  dst[0] = q.w();
+  dst[1] = q.x();
+  dst[2] = q.y();
+  dst[3] = q.z();
+  a.desc.pose = pose;
+  s.Invalidate();
+}
+
+Eigen::Vector3d Actor::GetVelocity() const {
+  SceneImpl& s = S(scene_);
+  const auto& c = s.Compiled(s.GetActor(id_));
+  if (c.dofadr < 0) return Eigen::Vector3d::Zero();
+  return V3(s.d->qvel + c.dofadr);
+}
+
+Eigen::Vector3d Actor::GetAngularVelocity() const {
+  SceneImpl& s = S(scene_);
+  const auto& c = s.Compiled(s.GetActor(id_));
+  if (c.dofadr < 0) return Eigen::Vector3d::Zero();
+  // a free joint's angular velocity is in the body frame
+  return Q4(s.d->qpos + c.qposadr + 3).normalized() * V3(s.d->qvel + c.dofadr + 3);
+}
+
+void Actor::SetVelocity(const Eigen::Vector3d& v) {
+  CheckFinite(v, "velocity");
+  SceneImpl& s = S(scene_);
+  auto& a = s.GetActor(id_);
+  const auto& c = s.Compiled(a);
+  if (c.dofadr < 0) throw Error("actor '" + a.desc.name + "' is not dynamic: no velocity to set");
+  for (int k = 0; k < 3; ++k) s.d->qvel[c.dofadr + k] = v[k];
+  s.Invalidate();
+}
+
+void Actor::SetAngularVelocity(const Eigen::Vector3d& w) {
+  CheckFinite(w, "angular velocity");
+  SceneImpl& s = S(scene_);
+  auto& a = s.GetActor(id_);
+  const auto& c = s.Compiled(a);
+  if (c.dofadr < 0) throw Error("actor '" + a.desc.name + "' is not dynamic: no velocity to set");
+  Eigen::Vector3d local = Q4(s.d->qpos + c.qposadr + 3).normalized().conjugate() * w;
+  for (int k = 0; k < 3; ++k) s.d->qvel[c.dofadr + 3 + k] = local[k];
+  s.Invalidate();
+}
+
+double Actor::GetMass() const {
+  SceneImpl& s = S(scene_);
+  return s.m->body_mass[s.Compiled(s.GetActor(id_)).body];
+}
+
+void Actor::AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point) {
+  SceneImpl& s = S(scene_);
+  AddBodyForce(s, s.Compiled(s.GetActor(id_)).body, force, point);
+}
+
+void Actor::AddForceTorque(const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {
+  CheckFinite(force, "force");
+  CheckFinite(torque, "torque");
+  SceneImpl& s = S(scene_);
+  int body = s.Compiled(s.GetActor(id_)).body;
+  for (int k = 0; k < 3; ++k) {
+    s.d->xfrc_applied[6 * body + k] += force[k];
+    s.d->xfrc_applied[6 * body + 3 + k] += torque[k];
+  }
+  s.xfrc_dirty = true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Link
+
+namespace {
+
+const LinkDesc& LinkAt(SceneImpl& s, int art, int index) {
+  const auto& links = s.GetArticulation(art).desc.links;
+  if (index < 0 || index >= static_cast<int>(links.size()))
+    throw IndexError("link index " + std::to_string(index) + " out of range [0, " +
+                     std::to_string(links.size()) + ")");
+  return links[index];
+}
+
+int LinkBody(SceneImpl& s, int art, int index) {
+  LinkAt(s, art, index);
+  return s.Compiled(s.GetArticulation(art)).link_body[index];
+}
+
+}  // namespace
+
+const std::string& Link::GetName() const { return LinkAt(S(scene_), articulation_id_, index_).name; }
+int Link::GetParentIndex() const { return LinkAt(S(scene_), articulation_id_, index_).parent; }
+const LinkDesc& Link::GetDesc() const { return LinkAt(S(scene_), articulation_id_, index_); }
+
+Pose Link::GetPose() const {
+  SceneImpl& s = S(scene_);
+  int b = LinkBody(s, articulation_id_, index_);
+  s.EnsureKinematics();
+  return Pose(V3(s.d->xpos + 3 * b), Q4(s.d->xquat + 4 * b));
+}
+
+Pose Link::GetCMassPose() const {
+  SceneImpl& s = S(scene_);
+  int b = LinkBody(s, articulation_id_, index_);
+  s.EnsureKinematics();
+  Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> r(s.d->ximat + 9 * b);
+  return Pose(V3(s.d->xipos + 3 * b), Eigen::Quaterniond(Eigen::Matrix3d(r)));
+}
+
+Eigen::Vector3d Link::GetVelocity() const {
+  SceneImpl& s = S(scene_);
+  return BodyVelocity(s, LinkBody(s, articulation_id_, index_)).first;
+}
+
+Eigen::Vector3d Link::GetAngularVelocity() const {
+  SceneImpl& s = S(scene_);
+  return BodyVelocity(s, LinkBody(s, articulation_id_, index_)).second;
+}
+
+double Link::GetMass() const {
+  SceneImpl& s = S(scene_);
+  return s.m->body_mass[LinkBody(s, articulation_id_, index_)];
+}
+
+Eigen::Vector3d Link::GetInertia() const {
+  SceneImpl& s = S(scene_);
+  return V3(s.m->body_inertia + 3 * LinkBody(s, articulation_id_, index_));
+}
+
+void Link::AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point) {
+  SceneImpl& s = S(scene_);
+  AddBodyForce(s, LinkBody(s, articulation_id_, index_), force, point);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Joint
+
+namespace {
+
+struct JointRef {
+  SceneImpl::ArticulationEntry* entry;
+  JointDesc* desc;
+  const CompiledJoint* compiled;
+};
+
+JointRef GetJointRef(Scene* scene, int art, int index) {
+  SceneImpl& s = S(scene);
+  auto& a = s.GetArticulation(art);
+  if (index < 1 || index >= static_cast<int>(a.desc.links.size()))
+    throw IndexError("joint index " + std::to_string(index) + " out of range [1, " +
+                     std::to_string(a.desc.links.size()) + ") (joint i connects link i to its "
+                     "parent; the root has none)");
+  const auto& c = s.Compiled(a);
+  return {&a, &a.desc.links[index].joint, &c.joints[index]};
+}
+
+JointRef DofJoint(Scene* scene, int art, int index, const char* what) {
+  JointRef j = GetJointRef(scene, art, index);
+  if (j.compiled->dof_index < 0)
+    throw Error(std::string(what) + ": joint '" + j.desc->name + "' has no degree of freedom (" +
+                JointTypeName(j.desc->type) + (j.desc->type == JointType::kFixed ? "" : ", coupled") +
+                ")");
+  return j;
+}
+
+void CheckDriveParam(double v, const char* what) {
+  if (!std::isfinite(v) || v < 0) throw Error(std::string(what) + " must be finite and >= 0");
+}
+
+// Writes a drive's gains into the compiled model.
+void SyncDrive(SceneImpl& s, const JointRef& j) {
+  if (j.compiled->actuator < 0) return;
+  int a = j.compiled->actuator;
+  const DriveDesc& dr = j.desc->drive;
+  s.m->actuator_biasprm[a * mjNBIAS + 1] = -dr.stiffness;
+  s.m->actuator_biasprm[a * mjNBIAS + 2] = -dr.damping;
+  bool limited = std::isfinite(dr.force_limit);
+  s.m->actuator_forcelimited[a] = limited;
+  s.m->actuator_forcerange[2 * a] = limited ? -dr.force_limit : 0;
+  s.m->actuator_forcerange[2 * a + 1] = limited ? dr.force_limit : 0;
+  s.Invalidate();
+}
+
+}  // namespace
+
+const std::string& Joint::GetName() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->name;
+}
+JointType Joint::GetType() const { return GetJointRef(scene_, articulation_id_, index_).desc->type; }
+const JointDesc& Joint::GetDesc() const { return *GetJointRef(scene_, articulation_id_, index_).desc; }
+int Joint::GetDof() const {
+  return GetJointRef(scene_, articulation_id_, index_).compiled->dof_index >= 0 ? 1 : 0;
+}
+int Joint::GetDofIndex() const {
+  return GetJointRef(scene_, articulation_id_, index_).compiled->dof_index;
+}
+Link Joint::GetParentLink() const {
+  JointRef j = GetJointRef(scene_, articulation_id_, index_);
+  return Link(scene_, articulation_id_, j.entry->desc.links[index_].parent);
+}
+Link Joint::GetChildLink() const { return Link(scene_, articulation_id_, index_); }
+Pose Joint::GetPoseInParent() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->pose_in_parent;
+}
+Pose Joint::GetPoseInChild() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->pose_in_child;
+}
+Pose Joint::GetGlobalPose() const { return GetChildLink().GetPose() * GetPoseInChild(); }
+Eigen::Vector3d Joint::GetGlobalAxis() const {
+  return GetGlobalPose().q * Eigen::Vector3d::UnitX();
+}
+
+Eigen::Vector2d Joint::GetLimits() const {
+  JointRef j = GetJointRef(scene_, articulation_id_, index_);
+  return Eigen::Vector2d(j.desc->lower, j.desc->upper);
+}
+
+void Joint::SetLimits(double lower, double upper) {
+  JointRef j = GetJointRef(scene_, articulation_id_, index_);
+  if (std::isnan(lower) || std::isnan(upper) || lower > upper)
+    throw Error("joint '" + j.desc->name + "': limits must satisfy lower <= upper, got (" +
+                std::to_string(lower) + ", " + std::to_string(upper) + ")");
+  if (j.desc->type == JointType::kFixed || j.desc->type == JointType::kContinuous)
+    throw Error("joint '" + j.desc->name + "' is " + JointTypeName(j.desc->type) +
+                " and has no limits to set");
+  j.desc->lower = lower;
+  j.desc->upper = upper;
+  // whether a joint is limited is fixed at compile time: recompile, keeping the state
+  SceneImpl& s = S(scene_);
+  s.dirty = true;
+  s.EnsureCompiled();
+}
+
+double Joint::GetFriction() const { return GetJointRef(scene_, articulation_id_, index_).desc->friction; }
+double Joint::GetDamping() const { return GetJointRef(scene_, articulation_id_, index_).desc->damping; }
+double Joint::GetArmature() const { return GetJointRef(scene_, articulation_id_, index_).desc->armature; }
+double Joint::GetPitch() const { return GetJointRef(scene_, articulation_id_, index_).desc->pitch; }
+
+void Joint::SetFriction(double v) {
+  CheckDriveParam(v, "friction");
+  JointRef j = GetJointRef(scene_, articulation_id_, index_);
+  j.desc->friction = v;
+  if (j.compiled->dofadr >= 0) S(scene_).m->dof_frictionloss[j.compiled->dofadr] = v;
+}
+
+void Joint::SetDamping(double v) {
+  CheckDriveParam(v, "damping");
+  JointRef j = GetJointRef(scene_, articulation_id_, index_);
+  j.desc->damping = v;
+  if (j.compiled->dofadr >= 0) S(scene_).m->dof_damping[j.compiled->dofadr] = v;
+}
+
+void Joint::SetArmature(double v) {
+  CheckDriveParam(v, "armature");
+  JointRef j = GetJointRef(scene_, articulation_id_, index_);
+  j.desc->armature = v;
+  if (j.compiled->dofadr >= 0) S(scene_).m->dof_armature[j.compiled->dofadr] = v;
+  S(scene_).Invalidate();
+}
+
+void Joint::SetDriveProperty(double stiffness, double damping, double force_limit) {
+  CheckDriveParam(stiffness, "drive stiffness");
+  CheckDriveParam(damping, "drive damping");
+  if (std::isnan(force_limit) || force_limit <= 0)
+    throw Error("drive force_limit must be > 0 (inf for no limit)");
+  JointRef j = DofJoint(scene_, articulation_id_, index_, "set_drive_property");
+  j.desc->drive.stiffness = stiffness;
+  j.desc->drive.damping = damping;
+  j.desc->drive.force_limit = force_limit;
+  SyncDrive(S(scene_), j);
+}
+
+void Joint::SetDriveTarget(double target) {
+  if (!std::isfinite(target)) throw Error("drive target must be finite");
+  DofJoint(scene_, articulation_id_, index_, "set_drive_target").desc->drive.target = target;
+  S(scene_).Invalidate();
+}
+
+void Joint::SetDriveVelocityTarget(double v) {
+  if (!std::isfinite(v)) throw Error("drive velocity target must be finite");
+  DofJoint(scene_, articulation_id_, index_, "set_drive_velocity_target")
+      .desc->drive.velocity_target = v;
+  S(scene_).Invalidate();
+}
+
+double Joint::GetDriveTarget() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->drive.target;
+}
+double Joint::GetDriveVelocityTarget() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->drive.velocity_target;
+}
+double Joint::GetDriveStiffness() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->drive.stiffness;
+}
+double Joint::GetDriveDamping() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->drive.damping;
+}
+double Joint::GetDriveForceLimit() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->drive.force_limit;
+}
+
+double Joint::GetQpos() const {
+  JointRef j = DofJoint(scene_, articulation_id_, index_, "get_qpos");
+  return Articulation(scene_, articulation_id_).GetQpos()[j.compiled->dof_index];
+}
+
+double Joint::GetQvel() const {
+  JointRef j = DofJoint(scene_, articulation_id_, index_, "get_qvel");
+  return Articulation(scene_, articulation_id_).GetQvel()[j.compiled->dof_index];
+}
+
+// ---------------------------------------------------------------------------------------------
+// Articulation
+
+namespace {
+
+struct ArtRef {
+  SceneImpl& s;
+  SceneImpl::ArticulationEntry& a;
+  const CompiledArticulation& c;
+  int dof() const { return static_cast<int>(c.dof_links.size()); }
+  std::string owner() const { return "articulation '" + a.desc.name + "'"; }
+};
+
+ArtRef GetArt(Scene* scene, int id) {
+  SceneImpl& s = S(scene);
+  auto& a = s.GetArticulation(id);
+  return {s, a, s.Compiled(a)};
+}
+
+ArtRef DynamicArt(Scene* scene, int id, const char* what) {
+  ArtRef r = GetArt(scene, id);
+  if (r.a.desc.kinematic)
+    throw Error(std::string(what) + ": " + r.owner() +
+                " is kinematic; dynamics queries need a dynamic articulation");
+  return r;
+}
+
+// Gathers or scatters a per-dof quantity of MuJoCo (qvel-like arrays) for an articulation.
+Eigen::VectorXd GatherDofs(const ArtRef& r, const double* src) {
+  Eigen::VectorXd out(r.dof());
+  for (int k = 0; k < r.dof(); ++k) out[k] = src[r.c.joints[r.c.dof_links[k]].dofadr];
+  return out;
+}
+
+// Writes x into dst at the articulation's MuJoCo dofs, through the coupling matrix G.
+void ScatterDofs(const ArtRef& r, const Eigen::VectorXd& x, double* dst) {
+  Eigen::VectorXd full = r.c.G * x;
+  for (size_t i = 0; i < r.c.mj_dofs.size(); ++i) dst[r.c.mj_dofs[i]] = full[i];
+}
+
+// Rows of the articulation's MuJoCo dofs of a quantity (for G^T projections).
+Eigen::VectorXd MjDofs(const ArtRef& r, const double* src) {
+  Eigen::VectorXd out(r.c.mj_dofs.size());
+  for (size_t i = 0; i < r.c.mj_dofs.size(); ++i) out[i] = src[r.c.mj_dofs[i]];
+  return out;
+}
+
+// Mass matrix over the articulation's MuJoCo dofs.
+Eigen::MatrixXd MjMassMatrix(const ArtRef& r) {
+  int nv = r.s.m->nv;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> full(nv, nv);
+  mj_fullM(r.s.m, full.data(), r.s.d->qM);
+  int n = static_cast<int>(r.c.mj_dofs.size());
+  Eigen::MatrixXd out(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) out(i, j) = full(r.c.mj_dofs[i], r.c.mj_dofs[j]);
+  return out;
+}
+
+}  // namespace
+
+const std::string& Articulation::GetName() const { return S(scene_).GetArticulation(id_).desc.name; }
+bool Articulation::IsKinematic() const { return S(scene_).GetArticulation(id_).desc.kinematic; }
+bool Articulation::HasFixedRoot() const { return S(scene_).GetArticulation(id_).desc.fix_root; }
+const ArticulationDesc& Articulation::GetDesc() const { return S(scene_).GetArticulation(id_).desc; }
+int Articulation::Dof() const { return GetArt(scene_, id_).dof(); }
+
+std::vector<Link> Articulation::GetLinks() const {
+  std::vector<Link> out;
+  int n = static_cast<int>(S(scene_).GetArticulation(id_).desc.links.size());
+  for (int i = 0; i < n; ++i) out.emplace_back(scene_, id_, i);
+  return out;
+}
+
+std::vector<Joint> Articulation::GetJoints() const {
+  std::vector<Joint> out;
+  const auto& links = S(scene_).GetArticulation(id_).desc.links;
+  for (size_t i = 0; i < links.size(); ++i)
+    if (links[i].parent >= 0) out.emplace_back(scene_, id_, static_cast<int>(i));
+  return out;
+}
+
+std::vector<Joint> Articulation::GetActiveJoints() const {
+  ArtRef r = GetArt(scene_, id_);
+  std::vector<Joint> out;
+  for (int li : r.c.dof_links) out.emplace_back(scene_, id_, li);
+  return out;
+}
+
+Link Articulation::GetLink(int index) const {
+  LinkAt(S(scene_), id_, index);
+  return Link(scene_, id_, index);
+}
+
+Joint Articulation::GetJoint(int index) const {
+  GetJointRef(scene_, id_, index);
+  return Joint(scene_, id_, index);
+}
+
+Link Articulation::FindLinkByName(const std::string& name) const {
+  const auto& links = S(scene_).GetArticulation(id_).desc.links;
+  for (size_t i = 0; i < links.size(); ++i)
+    if (links[i].name == name) return Link(scene_, id_, static_cast<int>(i));
+  throw Error("articulation '" + GetName() + "' has no link named '" + name + "'");
+}
+
+Joint Articulation::FindJointByName(const std::string& name) const {
+  const auto& links = S(scene_).GetArticulation(id_).desc.links;
+  for (size_t i = 0; i < links.size(); ++i)
+    if (links[i].parent >= 0 && links[i].joint.name == name)
+      return Joint(scene_, id_, static_cast<int>(i));
+  throw Error("articulation '" + GetName() + "' has no joint named '" + name + "'");
+}
+
+Eigen::VectorXd Articulation::GetQpos() const {
+  ArtRef r = GetArt(scene_, id_);
+  if (r.a.desc.kinematic) return r.a.kin_qpos;
+  Eigen::VectorXd out(r.dof());
+  for (int k = 0; k < r.dof(); ++k) out[k] = r.s.d->qpos[r.c.joints[r.c.dof_links[k]].qposadr];
+  return out;
+}
+
+void Articulation::SetQpos(const Eigen::VectorXd& qpos) {
+  ArtRef r = GetArt(scene_, id_);
+  CheckVector(qpos, r.dof(), "qpos", r.owner());
+  if (r.a.desc.kinematic) {
+    r.a.kin_qpos = qpos;
+    r.s.UpdateKinematicArticulation(r.a);
+    return;
+  }
+  double* q = r.s.d->qpos;
+  for (int k = 0; k < r.dof(); ++k) {
+    const CompiledJoint& j = r.c.joints[r.c.dof_links[k]];
+    q[j.qposadr] = qpos[k];
+    if (j.screw_slide_qposadr >= 0)
+      q[j.screw_slide_qposadr] = r.a.desc.links[r.c.dof_links[k]].joint.pitch * qpos[k];
+  }
+  for (const auto& cp : r.c.couplings) {
+    q[cp.qposadr] = cp.multiplier * qpos[cp.source_dof] + cp.offset;
+    for (size_t i = 0; i < r.c.joints.size(); ++i)
+      if (r.c.joints[i].qposadr == cp.qposadr && r.c.joints[i].screw_slide_qposadr >= 0)
+        q[r.c.joints[i].screw_slide_qposadr] = r.a.desc.links[i].joint.pitch * q[cp.qposadr];
+  }
+  r.s.Invalidate();
+}
+
+Eigen::VectorXd Articulation::GetQvel() const {
+  ArtRef r = GetArt(scene_, id_);
+  if (r.a.desc.kinematic) return r.a.kin_qvel;
+  return GatherDofs(r, r.s.d->qvel);
+}
+
+void Articulation::SetQvel(const Eigen::VectorXd& qvel) {
+  ArtRef r = GetArt(scene_, id_);
+  CheckVector(qvel, r.dof(), "qvel", r.owner());
+  if (r.a.desc.kinematic) {
+    r.a.kin_qvel = qvel;
+    return;
+  }
+  ScatterDofs(r, qvel, r.s.d->qvel);
+  r.s.Invalidate();
+}
+
+Eigen::VectorXd Articulation::GetQacc() const {
+  ArtRef r = GetArt(scene_, id_);
+  if (r.a.desc.kinematic) return Eigen::VectorXd::Zero(r.dof());
+  return GatherDofs(r, r.s.d->qacc);
+}
+
+void Articulation::SetQacc(const Eigen::VectorXd& qacc) {
+  ArtRef r = DynamicArt(scene_, id_, "set_qacc");
+  CheckVector(qacc, r.dof(), "qacc", r.owner());
+  ScatterDofs(r, qacc, r.s.d->qacc);
+  ScatterDofs(r, qacc, r.s.d->qacc_warmstart);
+}
+
+Eigen::VectorXd Articulation::GetQf() const {
+  ArtRef r = GetArt(scene_, id_);
+  if (r.a.desc.kinematic) return Eigen::VectorXd::Zero(r.dof());
+  // the force on each partsim dof is G^T of the MuJoCo dof forces
+  return r.c.G.transpose() * MjDofs(r, r.s.d->qfrc_applied);
+}
+
+void Articulation::SetQf(const Eigen::VectorXd& qf) {
+  ArtRef r = DynamicArt(scene_, id_, "set_qf");
+  CheckVector(qf, r.dof(), "qf", r.owner());
+  for (int mj : r.c.mj_dofs) r.s.d->qfrc_applied[mj] = 0;
+  for (int k = 0; k < r.dof(); ++k) r.s.d->qfrc_applied[r.c.joints[r.c.dof_links[k]].dofadr] = qf[k];
+  r.s.Invalidate();
+}
+
+Eigen::MatrixX2d Articulation::GetQlimits() const {
+  ArtRef r = GetArt(scene_, id_);
+  Eigen::MatrixX2d out(r.dof(), 2);
+  for (int k = 0; k < r.dof(); ++k) {
+    const JointDesc& j = r.a.desc.links[r.c.dof_links[k]].joint;
+    bool limited = j.type != JointType::kContinuous;
+    out(k, 0) = limited ? j.lower : -kInf;
+    out(k, 1) = limited ? j.upper : kInf;
+  }
+  return out;
+}
+
+void Articulation::SetQlimits(const Eigen::MatrixX2d& limits) {
+  ArtRef r = GetArt(scene_, id_);
+  if (limits.rows() != r.dof())
+    throw Error("qlimits has " + std::to_string(limits.rows()) + " rows, " + r.owner() + " has " +
+                std::to_string(r.dof()) + " dof");
+  for (int k = 0; k < r.dof(); ++k)
+    if (std::isnan(limits(k, 0)) || std::isnan(limits(k, 1)) || limits(k, 0) > limits(k, 1))
+      throw Error("qlimits row " + std::to_string(k) + " must satisfy lower <= upper");
+  for (int k = 0; k < r.dof(); ++k) {
+    JointDesc& j = r.a.desc.links[r.c.dof_links[k]].joint;
+    if (j.type == JointType::kContinuous) continue;
+    j.lower = limits(k, 0);
+    j.upper = limits(k, 1);
+  }
+  r.s.dirty = true;
+  r.s.EnsureCompiled();
+}
+
+Pose Articulation::GetRootPose() const {
+  ArtRef r = GetArt(scene_, id_);
+  if (r.c.root_qposadr >= 0)
+    return Pose(V3(r.s.d->qpos + r.c.root_qposadr), Q4(r.s.d->qpos + r.c.root_qposadr + 3));
+  return r.a.desc.root_pose;
+}
+
+void Articulation::SetRootPose(const Pose& pose) {
+  CheckPoseArg(pose, "root pose");
+  ArtRef r = GetArt(scene_, id_);
+  Eigen::Quaterniond q = pose.q.normalized();
+  r.a.desc.root_pose = pose;
+  if (r.c.root_qposadr >= 0) {
+    double* dst = r.s.d->qpos + r.c.root_qposadr;
+    for (int k = 0; k < 3; ++k) dst[k] = pose.p[k];
+    dst[3] = q.w(), dst[4] = q.x(), dst[5] = q.y(), dst[6] = q.z();
+  } else if (r.a.desc.kinematic) {
+    r.s.UpdateKinematicArticulation(r.a);
+  } else {
+    // a fixed root is welded to the world: move the weld in the model
+    int b = r.c.link_body[0];
+    for (size_t i = 0; i < r.a.desc.links.size(); ++i)
+      if (r.a.desc.links[i].parent < 0) b = r.c.link_body[i];
+    for (int k = 0; k < 3; ++k) r.s.m->body_pos[3 * b + k] = pose.p[k];
+    double* mq = r.s.m->body_quat + 4 * b;
+    mq[0] = q.w(), mq[1] = q.x(), mq[2] = q.y(), mq[3] = q.z();
+  }
+  r.s.Invalidate();
+}
+
+Eigen::Vector3d Articulation::GetRootVelocity() const {
+  ArtRef r = GetArt(scene_, id_);
+  if (r.c.root_dofadr < 0) return Eigen::Vector3d::Zero();
+  return V3(r.s.d->qvel + r.c.root_dofadr);
+}
+
+Eigen::Vector3d Articulation::GetRootAngularVelocity() const {
+  ArtRef r = GetArt(scene_, id_);
+  if (r.c.root_dofadr < 0) return Eigen::Vector3d::Zero();
+  return Q4(r.s.d->qpos + r.c.root_qposadr + 3).normalized() * V3(r.s.d->qvel + r.c.root_dofadr + 3);
+}
+
+void Articulation::SetRootVelocity(const Eigen::Vector3d& v) {
+  CheckFinite(v, "root velocity");
+  ArtRef r = GetArt(scene_, id_);
+  if (r.c.root_dofadr < 0) throw Error(r.owner() + " has a fixed root: no root velocity to set");
+  for (int k = 0; k < 3; ++k) r.s.d->qvel[r.c.root_dofadr + k] = v[k];
+  r.s.Invalidate();
+}
+
+void Articulation::SetRootAngularVelocity(const Eigen::Vector3d& w) {
+  CheckFinite(w, "root angular velocity");
+  ArtRef r = GetArt(scene_, id_);
+  if (r.c.root_dofadr < 0) throw Error(r.owner() + " has a fixed root: no root velocity to set");
+  Eigen::Vector3d local = Q4(r.s.d->qpos + r.c.root_qposadr + 3).normalized().conjugate() * w;
+  for (int k = 0; k < 3; ++k) r.s.d->qvel[r.c.root_dofadr + 3 + k] = local[k];
+  r.s.Invalidate();
+}
+
+void Articulation::SetDriveTarget(const Eigen::VectorXd& target) {
+  ArtRef r = GetArt(scene_, id_);
+  CheckVector(target, r.dof(), "drive target", r.owner());
+  for (int k = 0; k < r.dof(); ++k) r.a.desc.links[r.c.dof_links[k]].joint.drive.target = target[k];
+  r.s.Invalidate();
+}
+
+void Articulation::SetDriveVelocityTarget(const Eigen::VectorXd& velocity) {
+  ArtRef r = GetArt(scene_, id_);
+  CheckVector(velocity, r.dof(), "drive velocity target", r.owner());
+  for (int k = 0; k < r.dof(); ++k)
+    r.a.desc.links[r.c.dof_links[k]].joint.drive.velocity_target = velocity[k];
+  r.s.Invalidate();
+}
+
+Eigen::VectorXd Articulation::GetDriveTarget() const {
+  ArtRef r = GetArt(scene_, id_);
+  Eigen::VectorXd out(r.dof());
+  for (int k = 0; k < r.dof(); ++k) out[k] = r.a.desc.links[r.c.dof_links[k]].joint.drive.target;
+  return out;
+}
+
+Eigen::VectorXd Articulation::GetDriveVelocityTarget() const {
+  ArtRef r = GetArt(scene_, id_);
+  Eigen::VectorXd out(r.dof());
+  for (int k = 0; k < r.dof(); ++k)
+    out[k] = r.a.desc.links[r.c.dof_links[k]].joint.drive.velocity_target;
+  return out;
+}
+
+void Articulation::SetDriveProperty(double stiffness, double damping, double force_limit) {
+  for (Joint& j : GetActiveJoints()) j.SetDriveProperty(stiffness, damping, force_limit);
+}
+
+Eigen::VectorXd Articulation::ComputePassiveForce(bool gravity, bool coriolis) const {
+  ArtRef r = DynamicArt(scene_, id_, "compute_passive_force");
+  r.s.EnsureForward();
+  const mjModel* m = r.s.m;
+  mjData* d = r.s.d;
+  // qfrc_bias = C(q, qdot) qdot + g(q); gravity alone is the bias at zero velocity
+  Eigen::VectorXd bias = MjDofs(r, d->qfrc_bias);
+  Eigen::VectorXd grav = Eigen::VectorXd::Zero(bias.size());
+  if (gravity != coriolis || (gravity && coriolis)) {
+    std::vector<double> saved(d->qvel, d->qvel + m->nv), g(m->nv);
+    std::fill(d->qvel, d->qvel + m->nv, 0.0);
+    mj_comVel(m, d);
+    mj_rne(m, d, 0, g.data());
+    std::copy(saved.begin(), saved.end(), d->qvel);
+    mj_comVel(m, d);
+    grav = MjDofs(r, g.data());
+  }
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(bias.size());
+  if (gravity) f += grav;
+  if (coriolis) f += bias - grav;
+  return r.c.G.transpose() * f;
+}
+
+Eigen::VectorXd Articulation::ComputeForwardDynamics(const Eigen::VectorXd& qf) const {
+  ArtRef r = DynamicArt(scene_, id_, "compute_forward_dynamics");
+  CheckVector(qf, r.dof(), "qf", r.owner());
+  r.s.EnsureForward();
+  const Eigen::MatrixXd& G = r.c.G;
+  Eigen::MatrixXd M = G.transpose() * MjMassMatrix(r) * G;
+  Eigen::VectorXd bias = G.transpose() * MjDofs(r, r.s.d->qfrc_bias);
+  return M.ldlt().solve(qf - bias);
+}
+
+Eigen::VectorXd Articulation::ComputeInverseDynamics(const Eigen::VectorXd& qacc) const {
+  ArtRef r = DynamicArt(scene_, id_, "compute_inverse_dynamics");
+  CheckVector(qacc, r.dof(), "qacc", r.owner());
+  r.s.EnsureForward();
+  const Eigen::MatrixXd& G = r.c.G;
+  return G.transpose() * (MjMassMatrix(r) * (G * qacc) + MjDofs(r, r.s.d->qfrc_bias));
+}
+
+Eigen::MatrixXd Articulation::ComputeManipulatorInertiaMatrix() const {
+  ArtRef r = DynamicArt(scene_, id_, "compute_manipulator_inertia_matrix");
+  r.s.EnsureForward();
+  return r.c.G.transpose() * MjMassMatrix(r) * r.c.G;
+}
+
+Eigen::MatrixXd Articulation::ComputeLinkJacobian(int index) const {
+  ArtRef r = DynamicArt(scene_, id_, "compute_link_jacobian");
+  int b = LinkBody(r.s, id_, index);
+  r.s.EnsureKinematics();
+  int nv = r.s.m->nv;
+  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> jp(3, nv), jr(3, nv);
+  mj_jacBody(r.s.m, r.s.d, jp.data(), jr.data(), b);
+  int n = static_cast<int>(r.c.mj_dofs.size());
+  Eigen::MatrixXd J(6, n);
+  for (int i = 0; i < n; ++i) {
+    J.block<3, 1>(0, i) = jp.col(r.c.mj_dofs[i]);
+    J.block<3, 1>(3, i) = jr.col(r.c.mj_dofs[i]);
+  }
+  return J * r.c.G;
+}
+
+Eigen::MatrixXd Articulation::ComputeWorldCartesianJacobian() const {
+  ArtRef r = DynamicArt(scene_, id_, "compute_world_cartesian_jacobian");
+  int n = static_cast<int>(r.a.desc.links.size());
+  Eigen::MatrixXd out(6 * n, r.dof());
+  for (int i = 0; i < n; ++i) out.middleRows(6 * i, 6) = ComputeLinkJacobian(i);
+  return out;
+}
+
+}  // namespace partsim

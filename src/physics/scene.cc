@@ -1,0 +1,641 @@
+// Scene: compile on change (carrying state over by name), stepping, contacts, pack/unpack.
+#include "partsim/physics/scene.h"
+
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include "physics/scene_internal.h"
+
+namespace partsim {
+
+namespace internal {
+
+SceneImpl::~SceneImpl() {
+  if (d) mj_deleteData(d);
+  if (m) mj_deleteModel(m);
+}
+
+SceneImpl::ActorEntry& SceneImpl::GetActor(int id) {
+  for (auto& a : actors)
+    if (a.id == id) return a;
+  throw Error("actor " + std::to_string(id) + " does not exist (it was removed, or the handle is "
+              "empty)");
+}
+
+SceneImpl::ArticulationEntry& SceneImpl::GetArticulation(int id) {
+  for (auto& a : articulations)
+    if (a.id == id) return a;
+  throw Error("articulation " + std::to_string(id) +
+              " does not exist (it was removed, or the handle is empty)");
+}
+
+const CompiledActor& SceneImpl::Compiled(const ActorEntry& a) {
+  EnsureCompiled();
+  return compiled_actors.at(a.id);
+}
+
+const CompiledArticulation& SceneImpl::Compiled(const ArticulationEntry& a) {
+  EnsureCompiled();
+  return compiled_articulations.at(a.id);
+}
+
+namespace {
+
+// State of named MuJoCo elements, used to carry a state across a recompile.
+struct NamedState {
+  double time = 0;
+  std::map<std::string, std::vector<double>> joint_qpos, joint_qvel, joint_warm, joint_qfrc;
+  std::map<std::string, std::vector<double>> mocap;  // pos + quat
+};
+
+NamedState SaveNamed(const mjModel* m, const mjData* d) {
+  NamedState s;
+  s.time = d->time;
+  for (int j = 0; j < m->njnt; ++j) {
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    if (!name) continue;
+    int nq = m->jnt_type[j] == mjJNT_FREE ? 7 : m->jnt_type[j] == mjJNT_BALL ? 4 : 1;
+    int nv = m->jnt_type[j] == mjJNT_FREE ? 6 : m->jnt_type[j] == mjJNT_BALL ? 3 : 1;
+    const double* q = d->qpos + m->jnt_qposadr[j];
+    int v = m->jnt_dofadr[j];
+    s.joint_qpos[name].assign(q, q + nq);
+    s.joint_qvel[name].assign(d->qvel + v, d->qvel + v + nv);
+    s.joint_warm[name].assign(d->qacc_warmstart + v, d->qacc_warmstart + v + nv);
+    s.joint_qfrc[name].assign(d->qfrc_applied + v, d->qfrc_applied + v + nv);
+  }
+  for (int b = 0; b < m->nbody; ++b) {
+    int id = m->body_mocapid[b];
+    if (id < 0) continue;
+    std::vector<double> v(d->mocap_pos + 3 * id, d->mocap_pos + 3 * id + 3);
+    v.insert(v.end(), d->mocap_quat + 4 * id, d->mocap_quat + 4 * id + 4);
+    s.mocap[mj_id2name(m, mjOBJ_BODY, b)] = v;
+  }
+  return s;
+}
+
+void RestoreNamed(const NamedState& s, const mjModel* m, mjData* d) {
+  d->time = s.time;
+  auto copy = [](const std::map<std::string, std::vector<double>>& from, const std::string& name,
+                 double* to, size_t n) {
+    auto it = from.find(name);
+    if (it != from.end() && it->second.size() == n) std::copy(it->second.begin(), it->second.end(), to);
+  };
+  for (int j = 0; j < m->njnt; ++j) {
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    if (!name) continue;
+    int nq = m->jnt_type[j] == mjJNT_FREE ? 7 : m->jnt_type[j] == mjJNT_BALL ? 4 : 1;
+    int nv = m->jnt_type[j] == mjJNT_FREE ? 6 : m->jnt_type[j] == mjJNT_BALL ? 3 : 1;
+    int v = m->jnt_dofadr[j];
+    copy(s.joint_qpos, name, d->qpos + m->jnt_qposadr[j], nq);
+    copy(s.joint_qvel, name, d->qvel + v, nv);
+    copy(s.joint_warm, name, d->qacc_warmstart + v, nv);
+    copy(s.joint_qfrc, name, d->qfrc_applied + v, nv);
+  }
+  for (int b = 0; b < m->nbody; ++b) {
+    int id = m->body_mocapid[b];
+    if (id < 0) continue;
+    auto it = s.mocap.find(mj_id2name(m, mjOBJ_BODY, b));
+    if (it == s.mocap.end()) continue;
+    std::copy(it->second.begin(), it->second.begin() + 3, d->mocap_pos + 3 * id);
+    std::copy(it->second.begin() + 3, it->second.end(), d->mocap_quat + 4 * id);
+  }
+}
+
+// Loads MJCF text through a virtual file system.
+mjModel* LoadMjcf(const std::string& xml, std::string* error) {
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  const char* name = "partsim_scene.xml";
+  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) != 0) {
+    *error = "cannot allocate the virtual MJCF file";
+    return nullptr;
+  }
+  int idx = mj_findFileVFS(vfs.get(), name);
+  std::memcpy(vfs->filedata[idx], xml.data(), xml.size());
+  char err[1024] = "";
+  mjModel* m = mj_loadXML(name, vfs.get(), err, sizeof(err));
+  mj_deleteVFS(vfs.get());
+  if (!m) *error = err;
+  return m;
+}
+
+}  // namespace
+
+void SceneImpl::EnsureCompiled() {
+  if (!dirty) return;
+  std::string xml = GenerateMjcf(*this);
+  std::string error;
+  mjModel* new_m = LoadMjcf(xml, &error);
+  if (!new_m) throw Error("MuJoCo could not compile the scene: " + error);
+  mjData* new_d = mj_makeData(new_m);
+  // carry the state of everything that existed before
+  if (m && d) RestoreNamed(SaveNamed(m, d), new_m, new_d);
+  else new_d->time = 0;
+  if (d) mj_deleteData(d);
+  if (m) mj_deleteModel(m);
+  m = new_m;
+  d = new_d;
+  mjcf = std::move(xml);
+  dirty = false;
+  BuildTables(*this);
+  for (auto& a : articulations)
+    if (a.desc.kinematic) UpdateKinematicArticulation(a);
+  Invalidate();
+}
+
+void SceneImpl::EnsureForward() {
+  EnsureCompiled();
+  if (forward_valid) return;
+  ApplyDrives();
+  mj_forward(m, d);
+  forward_valid = true;
+}
+
+void SceneImpl::EnsureKinematics() {
+  EnsureCompiled();
+  if (kinematics_valid || forward_valid) return;
+  mj_kinematics(m, d);
+  mj_comPos(m, d);
+  mj_comVel(m, d);
+  kinematics_valid = true;
+}
+
+void SceneImpl::ApplyDrives() {
+  for (const auto& a : articulations) {
+    if (a.desc.kinematic) continue;
+    const CompiledArticulation& c = compiled_articulations.at(a.id);
+    for (int li : c.dof_links) {
+      const CompiledJoint& j = c.joints[li];
+      const DriveDesc& dr = a.desc.links[li].joint.drive;
+      d->ctrl[j.actuator] = dr.stiffness * dr.target + dr.damping * dr.velocity_target;
+    }
+  }
+}
+
+void SceneImpl::UpdateKinematicArticulation(ArticulationEntry& a) {
+  const ArticulationDesc& desc = a.desc;
+  const CompiledArticulation& c = compiled_articulations.at(a.id);
+  int dof = static_cast<int>(c.dof_links.size());
+  if (a.kin_qpos.size() != dof) a.kin_qpos = Eigen::VectorXd::Zero(dof);
+  if (a.kin_qvel.size() != dof) a.kin_qvel = Eigen::VectorXd::Zero(dof);
+  // joint values, couplings included
+  std::vector<double> q(desc.links.size(), 0.0);
+  for (int k = 0; k < dof; ++k) q[c.dof_links[k]] = a.kin_qpos[k];
+  for (const JointCoupling& cp : desc.couplings) {
+    int j = -1, s = -1;
+    for (size_t i = 0; i < desc.links.size(); ++i) {
+      if (desc.links[i].parent < 0) continue;
+      if (desc.links[i].joint.name == cp.joint) j = static_cast<int>(i);
+      if (desc.links[i].joint.name == cp.source) s = static_cast<int>(i);
+    }
+    q[j] = cp.multiplier * q[s] + cp.offset;
+  }
+  // forward kinematics, parents first
+  std::vector<Pose> X_WL(desc.links.size());
+  for (size_t i = 0; i < desc.links.size(); ++i) {
+    const LinkDesc& l = desc.links[i];
+    if (l.parent < 0) {
+      X_WL[i] = desc.root_pose;
+    } else {
+      const JointDesc& jd = l.joint;
+      Pose motion;
+      if (jd.type == JointType::kPrismatic) motion.p = Eigen::Vector3d(q[i], 0, 0);
+      if (jd.type == JointType::kRevolute || jd.type == JointType::kContinuous ||
+          jd.type == JointType::kScrew)
+        motion.q = Eigen::AngleAxisd(q[i], Eigen::Vector3d::UnitX());
+      if (jd.type == JointType::kScrew) motion.p = Eigen::Vector3d(jd.pitch * q[i], 0, 0);
+      X_WL[i] = X_WL[l.parent] * jd.pose_in_parent * motion * jd.pose_in_child.Inverse();
+    }
+    int mocap = c.link_mocap[i];
+    Eigen::Quaterniond qn = X_WL[i].q.normalized();
+    for (int k = 0; k < 3; ++k) d->mocap_pos[3 * mocap + k] = X_WL[i].p[k];
+    d->mocap_quat[4 * mocap] = qn.w();
+    d->mocap_quat[4 * mocap + 1] = qn.x();
+    d->mocap_quat[4 * mocap + 2] = qn.y();
+    d->mocap_quat[4 * mocap + 3] = qn.z();
+  }
+  Invalidate();
+}
+
+void SceneImpl::Step(int n) {
+  if (n < 0) throw Error("step: n must be >= 0, got " + std::to_string(n));
+  EnsureCompiled();
+  for (int i = 0; i < n; ++i) {
+    ApplyDrives();
+    int bad_before = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
+                     d->warning[mjWARN_BADQVEL].number;
+    mj_step(m, d);
+    int bad_after = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
+                    d->warning[mjWARN_BADQVEL].number;
+    if (bad_after != bad_before)
+      warnings.push_back({d->time, "numerical instability (NaN or huge value in positions, "
+                                   "velocities or accelerations): MuJoCo reset the state to the "
+                                   "model's initial configuration"});
+    if (xfrc_dirty) {
+      std::fill(d->xfrc_applied, d->xfrc_applied + 6 * m->nbody, 0.0);
+      xfrc_dirty = false;
+    }
+  }
+  Invalidate();
+}
+
+}  // namespace internal
+
+using internal::CompiledActor;
+using internal::CompiledArticulation;
+
+// ---------------------------------------------------------------------------------------------
+// Scene
+
+Scene::Scene(const SceneConfig& config) : impl_(std::make_unique<Impl>()) {
+  if (!(config.timestep > 0) || !std::isfinite(config.timestep))
+    throw Error("SceneConfig.timestep must be finite and > 0, got " + std::to_string(config.timestep));
+  if (!config.gravity.allFinite()) throw Error("SceneConfig.gravity must be finite");
+  if (config.solver_iterations < 1)
+    throw Error("SceneConfig.solver_iterations must be >= 1, got " +
+                std::to_string(config.solver_iterations));
+  impl_->config = config;
+  impl_->EnsureCompiled();
+}
+
+Scene::~Scene() = default;
+
+std::unique_ptr<Scene> Scene::Clone() const {
+  auto copy = std::make_unique<Scene>(impl_->config);
+  Impl& c = copy->impl();
+  c.actors = impl_->actors;
+  c.articulations = impl_->articulations;
+  c.next_id = impl_->next_id;
+  c.dirty = true;
+  c.EnsureCompiled();
+  copy->Unpack(Pack());
+  c.warnings = impl_->warnings;
+  return copy;
+}
+
+const SceneConfig& Scene::GetConfig() const { return impl_->config; }
+double Scene::GetTimestep() const { return impl_->config.timestep; }
+
+void Scene::SetTimestep(double dt) {
+  if (!(dt > 0) || !std::isfinite(dt))
+    throw Error("timestep must be finite and > 0, got " + std::to_string(dt));
+  impl_->config.timestep = dt;
+  impl_->EnsureCompiled();
+  impl_->m->opt.timestep = dt;
+}
+
+Eigen::Vector3d Scene::GetGravity() const { return impl_->config.gravity; }
+
+void Scene::SetGravity(const Eigen::Vector3d& g) {
+  if (!g.allFinite()) throw Error("gravity must be finite");
+  impl_->config.gravity = g;
+  impl_->EnsureCompiled();
+  for (int k = 0; k < 3; ++k) impl_->m->opt.gravity[k] = g[k];
+  impl_->Invalidate();
+}
+
+double Scene::GetTime() const {
+  impl_->EnsureCompiled();
+  return impl_->d->time;
+}
+
+Actor Scene::AddGround(double altitude, const std::optional<PhysicalMaterial>& material,
+                       const std::string& name) {
+  if (!std::isfinite(altitude)) throw Error("add_ground: altitude must be finite");
+  ActorDesc desc;
+  desc.name = name;
+  desc.type = ActorType::kStatic;
+  desc.pose.p.z() = altitude;
+  CollisionShape plane;
+  plane.type = ShapeType::kPlane;
+  plane.material = material;
+  desc.collisions.push_back(plane);
+  VisualShape visual;
+  visual.type = ShapeType::kPlane;
+  visual.half_size = Eigen::Vector3d(10, 10, 0);
+  visual.material.base_color = Eigen::Vector4f(0.9f, 0.9f, 0.9f, 1.0f);
+  desc.visuals.push_back(visual);
+  return AddActor(desc);
+}
+
+Actor Scene::AddActor(const ActorDesc& desc) {
+  Validate(desc);
+  Impl& s = *impl_;
+  s.EnsureCompiled();
+  int id = s.next_id;
+  s.actors.push_back({id, desc});
+  s.dirty = true;
+  try {
+    s.EnsureCompiled();
+  } catch (...) {
+    // leave the scene as it was
+    s.actors.pop_back();
+    s.dirty = true;
+    s.EnsureCompiled();
+    throw;
+  }
+  ++s.next_id;
+  return Actor(this, id);
+}
+
+Articulation Scene::AddArticulation(const ArticulationDesc& desc) {
+  Validate(desc);
+  Impl& s = *impl_;
+  s.EnsureCompiled();
+  int id = s.next_id;
+  s.articulations.push_back({id, desc, {}, {}});
+  s.dirty = true;
+  try {
+    s.EnsureCompiled();
+  } catch (...) {
+    s.articulations.pop_back();
+    s.dirty = true;
+    s.EnsureCompiled();
+    throw;
+  }
+  ++s.next_id;
+  // a new articulation starts at q = 0 clamped into its limits
+  Articulation art(this, id);
+  Eigen::MatrixX2d lim = art.GetQlimits();
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(art.Dof());
+  for (int k = 0; k < art.Dof(); ++k) q[k] = std::min(std::max(0.0, lim(k, 0)), lim(k, 1));
+  art.SetQpos(q);
+  return art;
+}
+
+void Scene::RemoveActor(const Actor& actor) {
+  Impl& s = *impl_;
+  s.GetActor(actor.GetId());  // throws if absent
+  s.actors.erase(std::remove_if(s.actors.begin(), s.actors.end(),
+                                [&](const auto& a) { return a.id == actor.GetId(); }),
+                 s.actors.end());
+  s.dirty = true;
+  s.EnsureCompiled();
+}
+
+void Scene::RemoveArticulation(const Articulation& articulation) {
+  Impl& s = *impl_;
+  s.GetArticulation(articulation.GetId());
+  s.articulations.erase(
+      std::remove_if(s.articulations.begin(), s.articulations.end(),
+                     [&](const auto& a) { return a.id == articulation.GetId(); }),
+      s.articulations.end());
+  s.dirty = true;
+  s.EnsureCompiled();
+}
+
+std::vector<Actor> Scene::GetActors() const {
+  std::vector<Actor> out;
+  for (const auto& a : impl_->actors) out.emplace_back(const_cast<Scene*>(this), a.id);
+  return out;
+}
+
+std::vector<Articulation> Scene::GetArticulations() const {
+  std::vector<Articulation> out;
+  for (const auto& a : impl_->articulations) out.emplace_back(const_cast<Scene*>(this), a.id);
+  return out;
+}
+
+Actor Scene::FindActorByName(const std::string& name) const {
+  for (const auto& a : impl_->actors)
+    if (a.desc.name == name) return Actor(const_cast<Scene*>(this), a.id);
+  throw Error("no actor named '" + name + "'");
+}
+
+Articulation Scene::FindArticulationByName(const std::string& name) const {
+  for (const auto& a : impl_->articulations)
+    if (a.desc.name == name) return Articulation(const_cast<Scene*>(this), a.id);
+  throw Error("no articulation named '" + name + "'");
+}
+
+void Scene::Step(int n) { impl_->Step(n); }
+
+const std::vector<Warning>& Scene::GetWarnings() const { return impl_->warnings; }
+void Scene::ClearWarnings() { impl_->warnings.clear(); }
+
+const mjModel_* Scene::GetMjModel() const {
+  impl_->EnsureCompiled();
+  return impl_->m;
+}
+
+mjData_* Scene::GetMjData() const {
+  impl_->EnsureCompiled();
+  return impl_->d;
+}
+
+std::string Scene::GetMjcf() const {
+  impl_->EnsureCompiled();
+  return impl_->mjcf;
+}
+
+// ---------------------------------------------------------------------------------------------
+// contacts
+
+std::vector<Contact> Scene::GetContacts() const {
+  Impl& s = *impl_;
+  s.EnsureCompiled();
+  const mjModel* m = s.m;
+  const mjData* d = s.d;
+  auto body = [&](int geom) {
+    ContactBody b;
+    const internal::GeomOwner& o = s.geom_owner[geom];
+    b.shape_index = o.shape_index;
+    if (o.actor_id >= 0) {
+      b.kind = ContactBody::Kind::kActor;
+      b.actor_id = o.actor_id;
+      b.name = s.GetActor(o.actor_id).desc.name;
+    } else if (o.articulation_id >= 0) {
+      b.kind = ContactBody::Kind::kLink;
+      b.articulation_id = o.articulation_id;
+      b.link_index = o.link_index;
+      b.name = s.GetArticulation(o.articulation_id).desc.links[o.link_index].name;
+    }
+    return b;
+  };
+  std::map<std::pair<int, int>, size_t> index;
+  std::vector<Contact> out;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& c = d->contact[i];
+    if (c.exclude != 0) continue;
+    auto key = std::make_pair(c.geom1, c.geom2);
+    auto it = index.find(key);
+    if (it == index.end()) {
+      Contact contact;
+      contact.body0 = body(c.geom1);
+      contact.body1 = body(c.geom2);
+      it = index.emplace(key, out.size()).first;
+      out.push_back(contact);
+    }
+    mjtNum f[6];
+    mj_contactForce(m, d, i, f);
+    Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> frame(c.frame);
+    ContactPoint p;
+    p.position = Eigen::Vector3d(c.pos[0], c.pos[1], c.pos[2]);
+    p.normal = frame.row(0).transpose();
+    // the contact force acts on geom2 along the normal that points from geom1 to geom2
+    p.force = frame.transpose() * Eigen::Vector3d(f[0], f[1], f[2]);
+    p.impulse = p.force * m->opt.timestep;
+    p.separation = c.dist;
+    out[it->second].points.push_back(p);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// pack / unpack
+
+namespace {
+
+constexpr uint32_t kPackMagic = 0x50534d31;  // "PSM1"
+
+class Writer {
+ public:
+  template <typename T>
+  void Put(const T& v) {
+    const char* p = reinterpret_cast<const char*>(&v);
+    buf.insert(buf.end(), p, p + sizeof(T));
+  }
+  void Put(const double* v, int n) {
+    const char* p = reinterpret_cast<const char*>(v);
+    buf.insert(buf.end(), p, p + sizeof(double) * n);
+  }
+  std::vector<char> buf;
+};
+
+class Reader {
+ public:
+  explicit Reader(const std::vector<char>& b) : buf(b) {}
+  template <typename T>
+  T Get() {
+    T v;
+    Need(sizeof(T));
+    std::memcpy(&v, buf.data() + pos, sizeof(T));
+    pos += sizeof(T);
+    return v;
+  }
+  void Get(double* v, int n) {
+    Need(sizeof(double) * n);
+    std::memcpy(v, buf.data() + pos, sizeof(double) * n);
+    pos += sizeof(double) * n;
+  }
+  void Need(size_t n) {
+    if (pos + n > buf.size())
+      throw Error("unpack: state is truncated (" + std::to_string(buf.size()) + " bytes)");
+  }
+  const std::vector<char>& buf;
+  size_t pos = 0;
+};
+
+}  // namespace
+
+std::vector<char> Scene::Pack() const {
+  Impl& s = *impl_;
+  s.EnsureCompiled();
+  const mjModel* m = s.m;
+  const mjData* d = s.d;
+  Writer w;
+  w.Put(kPackMagic);
+  for (int n : {m->nq, m->nv, m->nu, m->na, m->nbody, m->nmocap}) w.Put(n);
+  w.Put(static_cast<int>(s.articulations.size()));
+  w.Put(d->time);
+  w.Put(d->qpos, m->nq);
+  w.Put(d->qvel, m->nv);
+  w.Put(d->qacc, m->nv);
+  w.Put(d->qacc_warmstart, m->nv);
+  w.Put(d->qfrc_applied, m->nv);
+  w.Put(d->xfrc_applied, 6 * m->nbody);
+  w.Put(d->act, m->na);
+  w.Put(d->mocap_pos, 3 * m->nmocap);
+  w.Put(d->mocap_quat, 4 * m->nmocap);
+  for (const auto& a : s.articulations) {
+    for (const LinkDesc& l : a.desc.links) {
+      w.Put(l.joint.drive.target);
+      w.Put(l.joint.drive.velocity_target);
+    }
+    w.Put(static_cast<int>(a.kin_qpos.size()));
+    w.Put(a.kin_qpos.data(), static_cast<int>(a.kin_qpos.size()));
+    w.Put(a.kin_qvel.data(), static_cast<int>(a.kin_qvel.size()));
+  }
+  return w.buf;
+}
+
+void Scene::Unpack(const std::vector<char>& state) {
+  Impl& s = *impl_;
+  s.EnsureCompiled();
+  mjModel* m = s.m;
+  mjData* d = s.d;
+  Reader r(state);
+  if (r.Get<uint32_t>() != kPackMagic) throw Error("unpack: not a partsim state (bad header)");
+  const char* names[] = {"nq", "nv", "nu", "na", "nbody", "nmocap"};
+  int expect[] = {m->nq, m->nv, m->nu, m->na, m->nbody, m->nmocap};
+  for (int k = 0; k < 6; ++k) {
+    int got = r.Get<int>();
+    if (got != expect[k])
+      throw Error("unpack: state has " + std::string(names[k]) + " = " + std::to_string(got) +
+                  ", this scene has " + std::to_string(expect[k]) +
+                  " (was it packed from a scene with other actors or articulations?)");
+  }
+  if (r.Get<int>() != static_cast<int>(s.articulations.size()))
+    throw Error("unpack: state has another number of articulations than this scene");
+  // read into a copy first, so that a truncated state changes nothing
+  mjData* tmp = mj_makeData(m);
+  try {
+    tmp->time = r.Get<double>();
+    r.Get(tmp->qpos, m->nq);
+    r.Get(tmp->qvel, m->nv);
+    r.Get(tmp->qacc, m->nv);
+    r.Get(tmp->qacc_warmstart, m->nv);
+    r.Get(tmp->qfrc_applied, m->nv);
+    r.Get(tmp->xfrc_applied, 6 * m->nbody);
+    r.Get(tmp->act, m->na);
+    r.Get(tmp->mocap_pos, 3 * m->nmocap);
+    r.Get(tmp->mocap_quat, 4 * m->nmocap);
+    std::vector<std::pair<double, double>> targets;
+    std::vector<Eigen::VectorXd> kin;
+    for (auto& a : s.articulations) {
+      for (size_t i = 0; i < a.desc.links.size(); ++i) {
+        double t = r.Get<double>();
+        targets.push_back({t, r.Get<double>()});
+      }
+      int n = r.Get<int>();
+      if (n != a.kin_qpos.size()) throw Error("unpack: kinematic articulation size differs");
+      Eigen::VectorXd q(n), v(n);
+      r.Get(q.data(), n);
+      r.Get(v.data(), n);
+      kin.push_back(q);
+      kin.push_back(v);
+    }
+    if (r.pos != state.size()) throw Error("unpack: state has trailing bytes");
+    // commit
+    d->time = tmp->time;
+    auto copy = [](const double* from, double* to, int n) { std::copy(from, from + n, to); };
+    copy(tmp->qpos, d->qpos, m->nq);
+    copy(tmp->qvel, d->qvel, m->nv);
+    copy(tmp->qacc, d->qacc, m->nv);
+    copy(tmp->qacc_warmstart, d->qacc_warmstart, m->nv);
+    copy(tmp->qfrc_applied, d->qfrc_applied, m->nv);
+    copy(tmp->xfrc_applied, d->xfrc_applied, 6 * m->nbody);
+    copy(tmp->act, d->act, m->na);
+    copy(tmp->mocap_pos, d->mocap_pos, 3 * m->nmocap);
+    copy(tmp->mocap_quat, d->mocap_quat, 4 * m->nmocap);
+    size_t k = 0, kk = 0;
+    for (auto& a : s.articulations) {
+      for (LinkDesc& l : a.desc.links) {
+        l.joint.drive.target = targets[k].first;
+        l.joint.drive.velocity_target = targets[k].second;
+        ++k;
+      }
+      a.kin_qpos = kin[kk++];
+      a.kin_qvel = kin[kk++];
+    }
+    s.xfrc_dirty = true;
+  } catch (...) {
+    mj_deleteData(tmp);
+    throw;
+  }
+  mj_deleteData(tmp);
+  s.Invalidate();
+}
+
+}  // namespace partsim

@@ -1,0 +1,144 @@
+// Internals of Scene: the description entries, the compiled tables that map partsim entities to
+// MuJoCo ids, and the mutable data. Not part of the public API.
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "partsim/physics/scene.h"
+
+namespace partsim {
+namespace internal {
+
+/// Where a MuJoCo geom came from.
+struct GeomOwner {
+  int actor_id = -1;         ///< owning actor, or -1
+  int articulation_id = -1;  ///< owning articulation, or -1
+  int link_index = -1;
+  int shape_index = -1;
+};
+
+/// Compiled form of an actor.
+struct CompiledActor {
+  int body = -1;
+  int mocap = -1;    ///< kinematic actors are MuJoCo mocap bodies
+  int qposadr = -1;  ///< dynamic actors have a free joint
+  int dofadr = -1;
+};
+
+/// Compiled form of one joint of an articulation (the joint above link i).
+struct CompiledJoint {
+  int mj_joint = -1;  ///< main MuJoCo joint (hinge or slide), -1 for fixed
+  int qposadr = -1;
+  int dofadr = -1;
+  int dof_index = -1;  ///< index in the articulation's qpos, -1 when fixed or coupled
+  int actuator = -1;   ///< drive actuator
+  int screw_slide_qposadr = -1;  ///< screw joints: the coupled slide joint
+  int screw_slide_dofadr = -1;
+};
+
+/// A MuJoCo dof that follows a partsim dof: q = multiplier * q[source] + offset.
+struct CompiledCoupling {
+  int qposadr = -1;
+  int dofadr = -1;
+  int source_dof = -1;  ///< partsim dof index
+  double multiplier = 1.0;
+  double offset = 0.0;
+};
+
+/// Compiled form of an articulation.
+struct CompiledArticulation {
+  std::vector<int> link_body;   ///< MuJoCo body per link
+  std::vector<int> link_mocap;  ///< kinematic articulations: mocap id per link
+  std::vector<CompiledJoint> joints;  ///< per link (entry 0 unused)
+  std::vector<int> dof_links;   ///< partsim dof -> link index
+  std::vector<CompiledCoupling> couplings;
+  int root_qposadr = -1;  ///< free root joint
+  int root_dofadr = -1;
+  /// MuJoCo dofs of the articulation's joints (free root excluded), ascending.
+  std::vector<int> mj_dofs;
+  /// Maps partsim joint velocities to the MuJoCo dofs above: qvel_mj = G qvel.
+  Eigen::MatrixXd G;
+};
+
+/// Scene::Impl: description, compiled model and data.
+struct SceneImpl {
+  SceneConfig config;
+
+  // description
+  struct ActorEntry {
+    int id;
+    ActorDesc desc;
+  };
+  struct ArticulationEntry {
+    int id;
+    ArticulationDesc desc;
+    // kinematic articulations keep their joint state here
+    Eigen::VectorXd kin_qpos;
+    Eigen::VectorXd kin_qvel;
+  };
+  std::vector<ActorEntry> actors;
+  std::vector<ArticulationEntry> articulations;
+  int next_id = 0;
+
+  // model
+  mjModel* m = nullptr;
+  std::string mjcf;
+  bool dirty = true;
+  std::map<int, CompiledActor> compiled_actors;               ///< by actor id
+  std::map<int, CompiledArticulation> compiled_articulations;  ///< by articulation id
+  std::vector<GeomOwner> geom_owner;                           ///< per MuJoCo geom
+
+  // data
+  mjData* d = nullptr;
+  bool forward_valid = false;     ///< mj_forward quantities in d match qpos/qvel
+  bool kinematics_valid = false;  ///< poses and velocities of bodies in d match qpos/qvel
+  bool xfrc_dirty = false;        ///< xfrc_applied holds forces to clear after the step
+  std::vector<Warning> warnings;
+  std::vector<double> pending_ctrl;  ///< scratch
+
+  ~SceneImpl();
+
+  // description lookups; throw partsim::Error for removed entities
+  ActorEntry& GetActor(int id);
+  ArticulationEntry& GetArticulation(int id);
+  const CompiledActor& Compiled(const ActorEntry& a);
+  const CompiledArticulation& Compiled(const ArticulationEntry& a);
+
+  /// Compiles when the description changed, carrying over the state by name.
+  void EnsureCompiled();
+  /// Runs mj_forward if the state changed since the last one.
+  void EnsureForward();
+  /// Writes drive controls into d->ctrl.
+  void ApplyDrives();
+  /// Places the links of kinematic articulations from their qpos.
+  void UpdateKinematicArticulation(ArticulationEntry& a);
+  void Step(int n);
+  /// Runs forward kinematics and body velocities if the state changed.
+  void EnsureKinematics();
+  void Invalidate() { forward_valid = kinematics_valid = false; }
+};
+
+/// Writes MJCF for the whole scene and fills the compiled tables (ids resolved after loading).
+std::string GenerateMjcf(const SceneImpl& scene);
+/// Fills compiled tables from a loaded model.
+void BuildTables(SceneImpl& scene);
+
+/// Name of MuJoCo elements generated for partsim entities.
+std::string ActorBodyName(int actor_id);
+std::string LinkBodyName(int articulation_id, int link);
+std::string JointMjName(int articulation_id, int link);
+std::string ScrewSlideMjName(int articulation_id, int link);
+std::string ActuatorMjName(int articulation_id, int link);
+
+/// Damping ratio of a contact spring-damper with the given coefficient of restitution.
+double RestitutionToDampingRatio(double restitution);
+
+}  // namespace internal
+
+struct Scene::Impl : internal::SceneImpl {};
+
+}  // namespace partsim
