@@ -324,9 +324,9 @@ def write_arm():
       <geometry><mesh filename="package://arm_description/meshes/collision/{mesh}.stl"/></geometry>
     </collision>
     <inertial>
-      <origin xyz="{com[0]:g} {com[1]:g} {com[2]:g}" rpy="0 0 0"/>
-      <mass value="{mass:g}"/>
-      <inertia ixx="{ixx:g}" ixy="{ixy:g}" ixz="{ixz:g}" iyy="{iyy:g}" iyz="{iyz:g}" izz="{izz:g}"/>
+      <origin xyz="{com[0]:.10g} {com[1]:.10g} {com[2]:.10g}" rpy="0 0 0"/>
+      <mass value="{mass:.10g}"/>
+      <inertia ixx="{ixx:.10g}" ixy="{ixy:.10g}" ixz="{ixz:.10g}" iyy="{iyy:.10g}" iyz="{iyz:.10g}" izz="{izz:.10g}"/>
     </inertial>
   </link>
 """
