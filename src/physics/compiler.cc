@@ -182,8 +182,7 @@ class MjcfWriter {
       int joint = FindJoint(art, c.joint), source = FindJoint(art, c.source);
       equality_ << "    <joint joint1=\"" << JointMjName(id, joint) << "\" joint2=\""
                 << JointMjName(id, source) << "\" polycoef=\"" << Num(c.offset) << " "
-                << Num(c.multiplier) << " 0 0 0\" solref=\"" << Num(EqualityTimeConst())
-                << " 1\"/>\n";
+                << Num(c.multiplier) << " 0 0 0\"" << EqualitySolver() << "/>\n";
       ++num_equalities_;
     }
   }
@@ -194,7 +193,12 @@ class MjcfWriter {
     return -1;  // Validate() has already rejected unknown names
   }
 
-  double EqualityTimeConst() const { return 2.0 * scene_.config.timestep; }
+  // Couplings must hold tightly even against stiff, implicitly damped drives: the shortest time
+  // constant MuJoCo accepts and the highest impedance.
+  std::string EqualitySolver() const {
+    return " solref=\"" + Num(2.0 * scene_.config.timestep) +
+           " 1\" solimp=\"0.9999 0.9999 0.001 0.5 2\"";
+  }
 
   void WriteLink(int id, const ArticulationDesc& art, int index,
                  const std::vector<std::vector<int>>& children, int depth) {
@@ -241,7 +245,7 @@ class MjcfWriter {
               << " limited=\"false\"/>\n";
       equality_ << "    <joint joint1=\"" << ScrewSlideMjName(id, index) << "\" joint2=\""
                 << JointMjName(id, index) << "\" polycoef=\"0 " << Num(j.pitch)
-                << " 0 0 0\" solref=\"" << Num(EqualityTimeConst()) << " 1\"/>\n";
+                << " 0 0 0\"" << EqualitySolver() << "/>\n";
       ++num_equalities_;
     }
     // every joint with a dof gets a PD drive actuator; gains are set at run time

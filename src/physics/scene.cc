@@ -2,6 +2,7 @@
 #include "partsim/physics/scene.h"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 
@@ -41,6 +42,21 @@ const CompiledArticulation& SceneImpl::Compiled(const ArticulationEntry& a) {
 }
 
 namespace {
+
+// MuJoCo reports warnings through a global hook; while a scene steps they go to its warning
+// list instead of MUJOCO_LOG.TXT in the working directory.
+thread_local SceneImpl* stepping_scene = nullptr;
+
+void OnMujocoWarning(const char* msg) {
+  if (stepping_scene)
+    stepping_scene->warnings.push_back({stepping_scene->d ? stepping_scene->d->time : 0.0, msg});
+  else
+    std::fprintf(stderr, "partsim: MuJoCo warning: %s\n", msg);
+}
+
+struct InstallWarningHook {
+  InstallWarningHook() { mju_user_warning = OnMujocoWarning; }
+} install_warning_hook;
 
 // State of named MuJoCo elements, used to carry a state across a recompile.
 struct NamedState {
@@ -221,6 +237,7 @@ void SceneImpl::UpdateKinematicArticulation(ArticulationEntry& a) {
 void SceneImpl::Step(int n) {
   if (n < 0) throw Error("step: n must be >= 0, got " + std::to_string(n));
   EnsureCompiled();
+  stepping_scene = this;
   for (int i = 0; i < n; ++i) {
     ApplyDrives();
     int bad_before = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
@@ -237,6 +254,7 @@ void SceneImpl::Step(int n) {
       xfrc_dirty = false;
     }
   }
+  stepping_scene = nullptr;
   Invalidate();
 }
 
