@@ -133,6 +133,18 @@ TEST(SceneTest, PdDriveReachesTarget) {
   EXPECT_NEAR(rel.x(), 0.2 + 0.01 * q[3], 1e-3);
 }
 
+TEST(SceneTest, VelocityDriveTracksVelocityTarget) {
+  Scene scene(SceneConfig{1.0 / 500, Eigen::Vector3d::Zero()});
+  Articulation arm = AddArm(scene);
+  Joint j1 = arm.FindJointByName("j1");
+  j1.SetDriveProperty(0.0, 50.0);
+  j1.SetDriveVelocityTarget(0.8);
+  scene.Step(500);
+  EXPECT_NEAR(j1.GetQvel(), 0.8, 0.01);
+  EXPECT_NEAR(j1.GetQpos(), 0.8 * 1.0, 0.1);  // about 1 s at the target speed
+  EXPECT_DOUBLE_EQ(arm.GetDriveVelocityTarget()[0], 0.8);
+}
+
 TEST(SceneTest, ForceLimitCapsDriveForce) {
   Scene scene;
   Articulation arm = AddArm(scene);
