@@ -1,0 +1,33 @@
+// Shared declarations of the partsim Python module: one Bind* function per subsystem, each in its
+// own *_py.cc file, all called from module.cc.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+#include <vector>
+
+namespace partsim::python {
+
+namespace py = pybind11;
+
+/// Pose, errors (core).
+void BindCore(py::module_& m);
+/// Scene description, Scene, builders and handles (physics).
+void BindPhysics(py::module_& m);
+/// URDF loader and mesh files (assets).
+void BindAssets(py::module_& m);
+
+/// Casts handles to a Python list whose items each keep `owner` alive (py::keep_alive cannot
+/// attach to a list, which holds no weak references).
+template <typename T>
+py::list HandleList(const std::vector<T>& handles, py::handle owner) {
+  py::list out;
+  for (const T& h : handles) {
+    py::object item = py::cast(h);
+    py::detail::keep_alive_impl(item, owner);
+    out.append(item);
+  }
+  return out;
+}
+
+}  // namespace partsim::python

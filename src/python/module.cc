@@ -1,0 +1,12 @@
+// The partsim Python extension `_partsim`; python/partsim/__init__.py re-exports it.
+#include <pybind11/pybind11.h>
+
+#include "bindings.h"
+
+PYBIND11_MODULE(_partsim, m) {
+  m.doc() = "partsim: simulation of robots interacting with articulated objects (MuJoCo 2.2.2).";
+  // core first: the other subsystems use Pose and the exception types in their signatures
+  partsim::python::BindCore(m);
+  partsim::python::BindPhysics(m);
+  partsim::python::BindAssets(m);
+}

@@ -1,0 +1,676 @@
+// Bindings of the physics subsystem: the scene description, SceneConfig, Scene, the builders and
+// the Actor / Articulation / Link / Joint handles, contacts and warnings.
+//
+// Lifetime: Python holds a Scene through a std::shared_ptr; every builder or handle returned from
+// a scene (or from another handle) keeps the object it came from alive, so a handle outlives
+// `del scene` safely.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "partsim/physics/description.h"
+#include "partsim/physics/scene.h"
+
+namespace partsim::python {
+namespace {
+
+using RowMatrixX3f = Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor>;
+using RowMatrixX3i = Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>;
+using RowMatrixX2f = Eigen::Matrix<float, Eigen::Dynamic, 2, Eigen::RowMajor>;
+
+// n x k numpy-friendly copy of a vector of fixed-size Eigen vectors, and back.
+template <typename Matrix, typename Vec>
+Matrix Stack(const std::vector<Vec>& v) {
+  Matrix out(static_cast<Eigen::Index>(v.size()), Vec::RowsAtCompileTime);
+  for (size_t i = 0; i < v.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = v[i].transpose();
+  return out;
+}
+template <typename Vec, typename Matrix>
+std::vector<Vec> Unstack(const Matrix& m) {
+  std::vector<Vec> out(static_cast<size_t>(m.rows()));
+  for (Eigen::Index i = 0; i < m.rows(); ++i) out[static_cast<size_t>(i)] = m.row(i).transpose();
+  return out;
+}
+
+// joint type from its name as JointTypeName() spells it ("revolute", "prismatic", ...)
+JointType JointTypeFromName(const std::string& name) {
+  std::string known;
+  for (JointType t : {JointType::kFixed, JointType::kRevolute, JointType::kContinuous,
+                      JointType::kPrismatic, JointType::kScrew}) {
+    if (name == JointTypeName(t)) return t;
+    known += std::string(known.empty() ? "" : ", ") + JointTypeName(t);
+  }
+  throw Error("type: unknown joint type '" + name + "' (expected one of " + known + ")");
+}
+
+constexpr const char* kColorDoc = "color: linear RGBA in [0, 1]";
+const Eigen::Vector4f kGrey(0.8f, 0.8f, 0.8f, 1.0f);
+
+// Collision and visual adders shared by ActorBuilder and LinkBuilder (same C++ signatures).
+template <typename Builder, typename PyClass>
+void BindShapeAdders(PyClass& c) {
+  using Mat = std::optional<PhysicalMaterial>;
+  const auto ri = py::return_value_policy::reference_internal;
+  c.def("add_box_collision", &Builder::AddBoxCollision, py::arg("pose") = Pose(),
+        py::arg("half_size") = Eigen::Vector3d::Ones().eval(), py::arg("material") = py::none(),
+        py::arg("density") = 1000.0, ri,
+        "Adds a box collision shape at `pose` (in the body) with half extents `half_size` (m); "
+        "material None uses the scene default; density in kg/m^3. Returns self.")
+      .def("add_sphere_collision", &Builder::AddSphereCollision, py::arg("pose") = Pose(),
+           py::arg("radius") = 1.0, py::arg("material") = py::none(), py::arg("density") = 1000.0,
+           ri, "Adds a sphere collision shape of `radius` (m). Returns self.")
+      .def("add_capsule_collision", &Builder::AddCapsuleCollision, py::arg("pose") = Pose(),
+           py::arg("radius") = 1.0, py::arg("half_length") = 1.0, py::arg("material") = py::none(),
+           py::arg("density") = 1000.0, ri,
+           "Adds a capsule along the shape's local x axis: `radius` and `half_length` (m). "
+           "Returns self.")
+      .def("add_cylinder_collision", &Builder::AddCylinderCollision, py::arg("pose") = Pose(),
+           py::arg("radius") = 1.0, py::arg("half_length") = 1.0, py::arg("material") = py::none(),
+           py::arg("density") = 1000.0, ri,
+           "Adds a cylinder along the shape's local x axis: `radius` and `half_length` (m). "
+           "Returns self.")
+      .def("add_convex_collision_from_file", &Builder::AddConvexCollisionFromFile,
+           py::arg("filename"), py::arg("pose") = Pose(),
+           py::arg("scale") = Eigen::Vector3d::Ones().eval(), py::arg("material") = py::none(),
+           py::arg("density") = 1000.0, ri,
+           "Adds the convex hull of a mesh file's vertices, multiplied by `scale`. Returns self.")
+      .def("add_box_visual", &Builder::AddBoxVisual, py::arg("pose") = Pose(),
+           py::arg("half_size") = Eigen::Vector3d::Ones().eval(), py::arg("color") = kGrey,
+           py::arg("name") = "", ri,
+           (std::string("Adds a box visual with half extents `half_size` (m); ") + kColorDoc +
+            ". Returns self.")
+               .c_str())
+      .def("add_sphere_visual", &Builder::AddSphereVisual, py::arg("pose") = Pose(),
+           py::arg("radius") = 1.0, py::arg("color") = kGrey, py::arg("name") = "", ri,
+           "Adds a sphere visual of `radius` (m); color is linear RGBA. Returns self.")
+      .def("add_capsule_visual", &Builder::AddCapsuleVisual, py::arg("pose") = Pose(),
+           py::arg("radius") = 1.0, py::arg("half_length") = 1.0, py::arg("color") = kGrey,
+           py::arg("name") = "", ri,
+           "Adds a capsule visual along local x; color is linear RGBA. Returns self.")
+      .def("add_cylinder_visual", &Builder::AddCylinderVisual, py::arg("pose") = Pose(),
+           py::arg("radius") = 1.0, py::arg("half_length") = 1.0, py::arg("color") = kGrey,
+           py::arg("name") = "", ri,
+           "Adds a cylinder visual along local x; color is linear RGBA. Returns self.")
+      .def("add_visual_from_file", &Builder::AddVisualFromFile, py::arg("filename"),
+           py::arg("pose") = Pose(), py::arg("scale") = Eigen::Vector3d::Ones().eval(),
+           py::arg("name") = "", ri,
+           "Adds every sub-mesh of a mesh file as visuals, multiplied by `scale`. Returns self.")
+      .def("set_mass_and_inertia", &Builder::SetMassAndInertia, py::arg("mass"),
+           py::arg("cmass_local_pose"), py::arg("inertia"), ri,
+           "Explicit mass (kg), centre-of-mass pose in the body and principal inertia (3,) "
+           "(kg m^2). Returns self.");
+}
+
+void BindDescription(py::module_& m) {
+  py::class_<PhysicalMaterial>(
+      m, "PhysicalMaterial",
+      "Contact material: static_friction is MuJoCo's Coulomb coefficient (the larger of two "
+      "bodies' wins), dynamic_friction is kept for reference, restitution in [0, 1].")
+      .def(py::init([](double static_friction, double dynamic_friction, double restitution) {
+             return PhysicalMaterial{static_friction, dynamic_friction, restitution};
+           }),
+           py::arg("static_friction") = 0.5, py::arg("dynamic_friction") = 0.5,
+           py::arg("restitution") = 0.0)
+      .def_readwrite("static_friction", &PhysicalMaterial::static_friction)
+      .def_readwrite("dynamic_friction", &PhysicalMaterial::dynamic_friction)
+      .def_readwrite("restitution", &PhysicalMaterial::restitution)
+      .def("__repr__", [](const PhysicalMaterial& self) {
+        return "PhysicalMaterial(" + std::to_string(self.static_friction) + ", " +
+               std::to_string(self.dynamic_friction) + ", " + std::to_string(self.restitution) +
+               ")";
+      });
+
+  py::class_<MeshData, std::shared_ptr<MeshData>>(
+      m, "MeshData", "A triangle mesh in metres, in the frame of the shape that holds it.")
+      .def(py::init<>())
+      .def_property(
+          "vertices", [](const MeshData& self) { return Stack<RowMatrixX3f>(self.vertices); },
+          [](MeshData& self, const RowMatrixX3f& v) {
+            self.vertices = Unstack<Eigen::Vector3f>(v);
+          },
+          "Vertices (n, 3) float32, metres.")
+      .def_property(
+          "faces", [](const MeshData& self) { return Stack<RowMatrixX3i>(self.faces); },
+          [](MeshData& self, const RowMatrixX3i& f) { self.faces = Unstack<Eigen::Vector3i>(f); },
+          "Triangles (m, 3) int32, counter-clockwise seen from outside.")
+      .def_property(
+          "normals", [](const MeshData& self) { return Stack<RowMatrixX3f>(self.normals); },
+          [](MeshData& self, const RowMatrixX3f& n) { self.normals = Unstack<Eigen::Vector3f>(n); },
+          "Per-vertex normals (n, 3) float32; may be empty.")
+      .def_property(
+          "uvs", [](const MeshData& self) { return Stack<RowMatrixX2f>(self.uvs); },
+          [](MeshData& self, const RowMatrixX2f& uv) { self.uvs = Unstack<Eigen::Vector2f>(uv); },
+          "Per-vertex texture coordinates (n, 2) float32; may be empty.")
+      .def_readwrite("source", &MeshData::source, "File it came from ('' when built in memory).")
+      .def_readwrite("name", &MeshData::name, "Sub-mesh or node name in its file.");
+
+  py::enum_<ShapeType>(m, "ShapeType", "Geometric primitive or mesh.")
+      .value("BOX", ShapeType::kBox)
+      .value("SPHERE", ShapeType::kSphere)
+      .value("CAPSULE", ShapeType::kCapsule)
+      .value("CYLINDER", ShapeType::kCylinder)
+      .value("CONVEX_MESH", ShapeType::kConvexMesh)
+      .value("PLANE", ShapeType::kPlane);
+
+  py::class_<CollisionShape>(m, "CollisionShape", "A collision shape of an actor or link.")
+      .def(py::init<>())
+      .def_readwrite("type", &CollisionShape::type)
+      .def_readwrite("pose", &CollisionShape::pose, "X_BS: shape S in body B.")
+      .def_readwrite("half_size", &CollisionShape::half_size, "Box half extents (3,), metres.")
+      .def_readwrite("radius", &CollisionShape::radius, "Sphere, capsule, cylinder radius (m).")
+      .def_readwrite("half_length", &CollisionShape::half_length,
+                     "Capsule, cylinder half length along local x (m).")
+      .def_property(
+          "mesh",
+          [](const CollisionShape& self) { return std::const_pointer_cast<MeshData>(self.mesh); },
+          [](CollisionShape& self, std::shared_ptr<MeshData> mesh) { self.mesh = std::move(mesh); },
+          "CONVEX_MESH: the mesh (vertices already scaled), or None.")
+      .def_readwrite("material", &CollisionShape::material, "None: the scene's default.")
+      .def_readwrite("density", &CollisionShape::density, "kg/m^3, > 0.")
+      .def_readwrite("name", &CollisionShape::name);
+
+  py::class_<RenderMaterial>(m, "RenderMaterial", "Texture and surface parameters for rendering.")
+      .def(py::init<>())
+      .def_readwrite("base_color", &RenderMaterial::base_color, "Linear RGBA (4,) in [0, 1].")
+      .def_readwrite("roughness", &RenderMaterial::roughness)
+      .def_readwrite("metallic", &RenderMaterial::metallic)
+      .def_readwrite("diffuse_texture", &RenderMaterial::diffuse_texture,
+                     "Absolute path of an image, '' for none.");
+
+  py::class_<VisualShape>(m, "VisualShape", "A visual shape: what cameras see.")
+      .def(py::init<>())
+      .def_readwrite("type", &VisualShape::type)
+      .def_readwrite("pose", &VisualShape::pose, "X_BV: visual V in body B.")
+      .def_readwrite("half_size", &VisualShape::half_size)
+      .def_readwrite("radius", &VisualShape::radius)
+      .def_readwrite("half_length", &VisualShape::half_length)
+      .def_property(
+          "mesh",
+          [](const VisualShape& self) { return std::const_pointer_cast<MeshData>(self.mesh); },
+          [](VisualShape& self, std::shared_ptr<MeshData> mesh) { self.mesh = std::move(mesh); },
+          "Mesh visuals: the mesh (vertices already scaled), or None.")
+      .def_readwrite("material", &VisualShape::material)
+      .def_readwrite("name", &VisualShape::name);
+
+  py::class_<Inertial>(m, "Inertial", "Explicit mass properties of a body.")
+      .def(py::init<>())
+      .def_readwrite("mass", &Inertial::mass, "kg, > 0.")
+      .def_readwrite("cmass_local_pose", &Inertial::cmass_local_pose,
+                     "Centre of mass and principal axes in the body frame.")
+      .def_readwrite("inertia", &Inertial::inertia, "Principal moments (3,), kg m^2.");
+
+  py::class_<BodyDesc>(m, "BodyDesc",
+                       "Shapes and mass properties shared by actors and links. List attributes "
+                       "are copies: assign a whole list to change them.")
+      .def(py::init<>())
+      .def_readwrite("name", &BodyDesc::name)
+      .def_readwrite("collisions", &BodyDesc::collisions)
+      .def_readwrite("visuals", &BodyDesc::visuals)
+      .def_readwrite("inertial", &BodyDesc::inertial, "None: from the collision shapes.");
+
+  py::enum_<ActorType>(m, "ActorType", "How an actor moves.")
+      .value("STATIC", ActorType::kStatic)
+      .value("KINEMATIC", ActorType::kKinematic)
+      .value("DYNAMIC", ActorType::kDynamic);
+
+  py::class_<ActorDesc, BodyDesc>(m, "ActorDesc", "Description of a free rigid body.")
+      .def(py::init<>())
+      .def_readwrite("type", &ActorDesc::type)
+      .def_readwrite("pose", &ActorDesc::pose, "X_WA at creation.");
+
+  py::enum_<JointType>(m, "JointType",
+                       "Joint types; revolute, continuous and screw joints rotate about the joint "
+                       "frame's x axis, prismatic joints slide along it.")
+      .value("FIXED", JointType::kFixed)
+      .value("REVOLUTE", JointType::kRevolute)
+      .value("CONTINUOUS", JointType::kContinuous)
+      .value("PRISMATIC", JointType::kPrismatic)
+      .value("SCREW", JointType::kScrew);
+
+  py::class_<DriveDesc>(m, "DriveDesc",
+                        "PD drive: force = stiffness (target - q) + damping (velocity_target - "
+                        "qdot), clamped to +-force_limit.")
+      .def(py::init<>())
+      .def_readwrite("stiffness", &DriveDesc::stiffness, "N/m or N m/rad.")
+      .def_readwrite("damping", &DriveDesc::damping, "N s/m or N m s/rad.")
+      .def_readwrite("force_limit", &DriveDesc::force_limit, "N or N m.")
+      .def_readwrite("target", &DriveDesc::target, "m or rad.")
+      .def_readwrite("velocity_target", &DriveDesc::velocity_target, "m/s or rad/s.");
+
+  py::class_<JointDesc>(m, "JointDesc", "The joint that connects a link to its parent.")
+      .def(py::init<>())
+      .def_readwrite("name", &JointDesc::name)
+      .def_readwrite("type", &JointDesc::type)
+      .def_readwrite("pose_in_parent", &JointDesc::pose_in_parent, "X_PJ.")
+      .def_readwrite("pose_in_child", &JointDesc::pose_in_child, "X_CJ.")
+      .def_readwrite("lower", &JointDesc::lower, "m or rad; -inf when unlimited.")
+      .def_readwrite("upper", &JointDesc::upper, "m or rad; +inf when unlimited.")
+      .def_readwrite("friction", &JointDesc::friction, "N or N m.")
+      .def_readwrite("damping", &JointDesc::damping, "N s/m or N m s/rad.")
+      .def_readwrite("armature", &JointDesc::armature, "kg or kg m^2.")
+      .def_readwrite("pitch", &JointDesc::pitch, "Screw joints: metres per radian.")
+      .def_readwrite("drive", &JointDesc::drive);
+
+  py::class_<LinkDesc, BodyDesc>(m, "LinkDesc", "A link: a body and the joint to its parent.")
+      .def(py::init<>())
+      .def_readwrite("parent", &LinkDesc::parent, "Index of the parent link; -1 for the root.")
+      .def_readwrite("joint", &LinkDesc::joint);
+
+  py::class_<JointCoupling>(m, "JointCoupling",
+                            "A coupled joint (URDF mimic): q[joint] = multiplier * q[source] + "
+                            "offset.")
+      .def(py::init<>())
+      .def_readwrite("joint", &JointCoupling::joint)
+      .def_readwrite("source", &JointCoupling::source)
+      .def_readwrite("multiplier", &JointCoupling::multiplier)
+      .def_readwrite("offset", &JointCoupling::offset);
+
+  py::class_<ArticulationDesc>(m, "ArticulationDesc",
+                               "A tree of links connected by joints. List attributes are copies: "
+                               "assign a whole list to change them.")
+      .def(py::init<>())
+      .def_readwrite("name", &ArticulationDesc::name)
+      .def_readwrite("links", &ArticulationDesc::links, "Parents come before their children.")
+      .def_readwrite("fix_root", &ArticulationDesc::fix_root)
+      .def_readwrite("kinematic", &ArticulationDesc::kinematic)
+      .def_readwrite("root_pose", &ArticulationDesc::root_pose, "X_WR at creation.")
+      .def_readwrite("couplings", &ArticulationDesc::couplings);
+
+  m.def("validate", py::overload_cast<const ActorDesc&, const std::string&>(&Validate),
+        py::arg("actor"), py::arg("where") = "",
+        "Checks an actor description; raises PartsimError naming the element at fault.");
+  m.def("validate", py::overload_cast<const ArticulationDesc&, const std::string&>(&Validate),
+        py::arg("art"), py::arg("where") = "",
+        "Checks an articulation description; raises PartsimError naming the element at fault.");
+}
+
+void BindHandles(py::module_& m) {
+  const auto ka = py::keep_alive<0, 1>();
+
+  py::class_<Actor>(m, "Actor", "Handle to an actor; valid until the actor is removed.")
+      .def("get_id", &Actor::GetId)
+      .def("get_name", &Actor::GetName)
+      .def_property_readonly("name", &Actor::GetName)
+      .def_property_readonly("type", &Actor::GetType, "ActorType.")
+      .def("get_pose", &Actor::GetPose, "X_WA: the actor's frame in the world.")
+      .def("set_pose", &Actor::SetPose, py::arg("pose"), "Teleports a dynamic or kinematic actor.")
+      .def("get_velocity", &Actor::GetVelocity,
+           "World-frame linear velocity (3,) of the actor's origin, m/s.")
+      .def("set_velocity", &Actor::SetVelocity, py::arg("v"))
+      .def("get_angular_velocity", &Actor::GetAngularVelocity,
+           "World-frame angular velocity (3,), rad/s.")
+      .def("set_angular_velocity", &Actor::SetAngularVelocity, py::arg("w"))
+      .def("get_mass", &Actor::GetMass, "Mass (kg) as compiled.")
+      .def("add_force_at_point", &Actor::AddForceAtPoint, py::arg("force"), py::arg("point"),
+           "Adds a world-frame force (N) at a world point (m) for the next step.")
+      .def("add_force_torque", &Actor::AddForceTorque, py::arg("force"), py::arg("torque"),
+           "Adds a world-frame force (N) at the centre of mass and a torque (N m) for the next "
+           "step.")
+      .def("get_desc", &Actor::GetDesc, "A copy of the actor's description.")
+      .def("__eq__", &Actor::operator==)
+      .def("__hash__",
+           [](const Actor& self) {
+             return py::hash(
+                 py::make_tuple(reinterpret_cast<uintptr_t>(self.GetScene()), self.GetId()));
+           })
+      .def("__repr__", [](const Actor& self) { return "<Actor '" + self.GetName() + "'>"; });
+
+  py::class_<Link>(m, "Link", "Handle to a link of an articulation.")
+      .def("get_name", &Link::GetName)
+      .def_property_readonly("name", &Link::GetName)
+      .def("get_index", &Link::GetIndex, "Index in the articulation (0 is the root).")
+      .def("get_articulation_id", &Link::GetArticulationId)
+      .def("get_parent_index", &Link::GetParentIndex, "Parent link index; -1 for the root.")
+      .def("get_pose", &Link::GetPose, "X_WL: the link frame in the world.")
+      .def("get_cmass_pose", &Link::GetCMassPose,
+           "X_WC: centre of mass frame (principal axes) in the world.")
+      .def("get_velocity", &Link::GetVelocity, "World-frame velocity (3,) at the origin, m/s.")
+      .def("get_angular_velocity", &Link::GetAngularVelocity, "World-frame (3,), rad/s.")
+      .def("get_mass", &Link::GetMass, "kg.")
+      .def("get_inertia", &Link::GetInertia, "Principal moments (3,), kg m^2.")
+      .def("add_force_at_point", &Link::AddForceAtPoint, py::arg("force"), py::arg("point"),
+           "Adds a world-frame force (N) at a world point (m) for the next step.")
+      .def("get_desc", &Link::GetDesc, "A copy of the link's description.")
+      .def("__repr__", [](const Link& self) { return "<Link '" + self.GetName() + "'>"; });
+
+  py::class_<Joint>(m, "Joint",
+                    "Handle to the joint between a link and its parent (joint index == child "
+                    "link index).")
+      .def("get_name", &Joint::GetName)
+      .def_property_readonly("name", &Joint::GetName)
+      .def_property_readonly("type", &Joint::GetType, "JointType.")
+      .def("get_index", &Joint::GetIndex)
+      .def("get_dof", &Joint::GetDof, "0 or 1 (a coupled joint has 0).")
+      .def("get_dof_index", &Joint::GetDofIndex, "Index in qpos, -1 if the joint has no dof.")
+      .def("get_parent_link", &Joint::GetParentLink, ka)
+      .def("get_child_link", &Joint::GetChildLink, ka)
+      .def("get_pose_in_parent", &Joint::GetPoseInParent, "X_PJ.")
+      .def("get_pose_in_child", &Joint::GetPoseInChild, "X_CJ.")
+      .def("get_global_pose", &Joint::GetGlobalPose, "X_WJ: the joint frame in the world.")
+      .def("get_global_axis", &Joint::GetGlobalAxis, "Joint axis (3,) in world coordinates.")
+      .def("get_limits", &Joint::GetLimits, "(lower, upper) as (2,); +-inf when unlimited.")
+      .def("set_limits", &Joint::SetLimits, py::arg("lower"), py::arg("upper"))
+      .def("get_friction", &Joint::GetFriction)
+      .def("get_damping", &Joint::GetDamping)
+      .def("get_armature", &Joint::GetArmature)
+      .def("set_friction", &Joint::SetFriction, py::arg("friction"), "N or N m.")
+      .def("set_damping", &Joint::SetDamping, py::arg("damping"), "N s/m or N m s/rad.")
+      .def("set_armature", &Joint::SetArmature, py::arg("armature"), "kg or kg m^2.")
+      .def("get_pitch", &Joint::GetPitch, "Screw pitch, metres per radian.")
+      .def("set_drive_property", &Joint::SetDriveProperty, py::arg("stiffness"), py::arg("damping"),
+           py::arg("force_limit") = kInf,
+           "PD drive: force = stiffness (target - q) + damping (velocity_target - qdot), "
+           "clamped to +-force_limit.")
+      .def("set_drive_target", &Joint::SetDriveTarget, py::arg("target"), "m or rad.")
+      .def("set_drive_velocity_target", &Joint::SetDriveVelocityTarget, py::arg("velocity"),
+           "m/s or rad/s.")
+      .def("get_drive_target", &Joint::GetDriveTarget)
+      .def("get_drive_velocity_target", &Joint::GetDriveVelocityTarget)
+      .def("get_drive_stiffness", &Joint::GetDriveStiffness)
+      .def("get_drive_damping", &Joint::GetDriveDamping)
+      .def("get_drive_force_limit", &Joint::GetDriveForceLimit)
+      .def("get_qpos", &Joint::GetQpos, "Joint position (m or rad).")
+      .def("get_qvel", &Joint::GetQvel, "Joint velocity (m/s or rad/s).")
+      .def("get_desc", &Joint::GetDesc, "A copy of the joint's description.")
+      .def("__repr__", [](const Joint& self) { return "<Joint '" + self.GetName() + "'>"; });
+
+  py::class_<Articulation>(m, "Articulation",
+                           "Handle to an articulation. Joint-space arrays have one entry per "
+                           "dof, ordered as get_active_joints(); a free root's 6 dof are not "
+                           "included.")
+      .def("get_id", &Articulation::GetId)
+      .def("get_name", &Articulation::GetName)
+      .def_property_readonly("name", &Articulation::GetName)
+      .def("is_kinematic", &Articulation::IsKinematic)
+      .def("has_fixed_root", &Articulation::HasFixedRoot)
+      .def_property_readonly("dof", &Articulation::Dof, "Degrees of freedom.")
+      .def("get_dof", &Articulation::Dof)
+      .def("get_links",
+           [](py::object self) {
+             return HandleList(self.cast<const Articulation&>().GetLinks(), self);
+           })
+      .def(
+          "get_joints",
+          [](py::object self) {
+            return HandleList(self.cast<const Articulation&>().GetJoints(), self);
+          },
+          "One joint per non-root link.")
+      .def(
+          "get_active_joints",
+          [](py::object self) {
+            return HandleList(self.cast<const Articulation&>().GetActiveJoints(), self);
+          },
+          "Joints with a dof, in qpos order.")
+      .def("get_link", &Articulation::GetLink, py::arg("index"), ka)
+      .def("get_joint", &Articulation::GetJoint, py::arg("index"), ka)
+      .def("find_link_by_name", &Articulation::FindLinkByName, py::arg("name"), ka)
+      .def("find_joint_by_name", &Articulation::FindJointByName, py::arg("name"), ka)
+      .def("get_qpos", &Articulation::GetQpos, "Joint positions (dof,), m or rad.")
+      .def("set_qpos", &Articulation::SetQpos, py::arg("qpos"))
+      .def("get_qvel", &Articulation::GetQvel, "Joint velocities (dof,), m/s or rad/s.")
+      .def("set_qvel", &Articulation::SetQvel, py::arg("qvel"))
+      .def("get_qacc", &Articulation::GetQacc, "Joint accelerations (dof,) of the last step.")
+      .def("set_qacc", &Articulation::SetQacc, py::arg("qacc"),
+           "Sets accelerations; they only seed the solver's warm start.")
+      .def("get_qf", &Articulation::GetQf, "User generalized forces (dof,), N or N m.")
+      .def("set_qf", &Articulation::SetQf, py::arg("qf"),
+           "Generalized forces (dof,); they persist until changed.")
+      .def("get_qlimits", &Articulation::GetQlimits, "(dof, 2) array of (lower, upper).")
+      .def("set_qlimits", &Articulation::SetQlimits, py::arg("limits"))
+      .def("get_root_pose", &Articulation::GetRootPose)
+      .def("set_root_pose", &Articulation::SetRootPose, py::arg("pose"))
+      .def("get_root_velocity", &Articulation::GetRootVelocity)
+      .def("get_root_angular_velocity", &Articulation::GetRootAngularVelocity)
+      .def("set_root_velocity", &Articulation::SetRootVelocity, py::arg("v"))
+      .def("set_root_angular_velocity", &Articulation::SetRootAngularVelocity, py::arg("w"))
+      .def("set_drive_target", &Articulation::SetDriveTarget, py::arg("target"),
+           "Drive targets (dof,).")
+      .def("set_drive_velocity_target", &Articulation::SetDriveVelocityTarget, py::arg("velocity"),
+           "Drive velocity targets (dof,).")
+      .def("get_drive_target", &Articulation::GetDriveTarget)
+      .def("get_drive_velocity_target", &Articulation::GetDriveVelocityTarget)
+      .def("set_drive_property", &Articulation::SetDriveProperty, py::arg("stiffness"),
+           py::arg("damping"), py::arg("force_limit") = kInf,
+           "Same drive parameters on every active joint.")
+      .def("compute_passive_force", &Articulation::ComputePassiveForce, py::arg("gravity") = true,
+           py::arg("coriolis_and_centrifugal") = true,
+           "Generalized force (dof,) that cancels gravity and/or Coriolis and centrifugal "
+           "forces at the current state.")
+      .def("compute_forward_dynamics", &Articulation::ComputeForwardDynamics, py::arg("qf"),
+           "Accelerations (dof,) from generalized forces qf, without contacts, limits or "
+           "drives.")
+      .def("compute_inverse_dynamics", &Articulation::ComputeInverseDynamics, py::arg("qacc"),
+           "Generalized forces (dof,) that produce accelerations qacc: M qacc + bias.")
+      .def("compute_manipulator_inertia_matrix", &Articulation::ComputeManipulatorInertiaMatrix,
+           "Mass matrix (dof, dof).")
+      .def("compute_link_jacobian", &Articulation::ComputeLinkJacobian, py::arg("index"),
+           "World-frame Jacobian (6, dof) of link `index` at its origin, rows (linear; "
+           "angular).")
+      .def("compute_world_cartesian_jacobian", &Articulation::ComputeWorldCartesianJacobian,
+           "Stacked link Jacobians (6 nlinks, dof).")
+      .def("get_desc", &Articulation::GetDesc, "A copy of the articulation's description.")
+      .def("__eq__", &Articulation::operator==)
+      .def("__hash__",
+           [](const Articulation& self) {
+             return py::hash(
+                 py::make_tuple(reinterpret_cast<uintptr_t>(self.GetScene()), self.GetId()));
+           })
+      .def("__repr__", [](const Articulation& self) {
+        return "<Articulation '" + self.GetName() + "' dof=" + std::to_string(self.Dof()) + ">";
+      });
+}
+
+void BindContacts(py::module_& m) {
+  py::class_<ContactPoint>(m, "ContactPoint", "One contact point between two bodies.")
+      .def_readonly("position", &ContactPoint::position, "World position (3,), m.")
+      .def_readonly("normal", &ContactPoint::normal, "World normal (3,), from body0 to body1.")
+      .def_readonly("impulse", &ContactPoint::impulse,
+                    "World impulse (3,) on body1 over the last step, N s.")
+      .def_readonly("force", &ContactPoint::force, "World force (3,) on body1, N.")
+      .def_readonly("separation", &ContactPoint::separation,
+                    "Signed distance (m), negative when penetrating.");
+
+  py::class_<ContactBody> body(m, "ContactBody",
+                               "What a contact touches: an actor or a link, and which shape.");
+  py::enum_<ContactBody::Kind>(body, "Kind")
+      .value("ACTOR", ContactBody::Kind::kActor)
+      .value("LINK", ContactBody::Kind::kLink);
+  body.def_readonly("kind", &ContactBody::kind)
+      .def_readonly("actor_id", &ContactBody::actor_id, "Kind.ACTOR: the actor's id.")
+      .def_readonly("articulation_id", &ContactBody::articulation_id, "Kind.LINK.")
+      .def_readonly("link_index", &ContactBody::link_index, "Kind.LINK.")
+      .def_readonly("shape_index", &ContactBody::shape_index, "Index in the body's collisions.")
+      .def_readonly("name", &ContactBody::name, "Actor or link name.");
+
+  py::class_<Contact>(m, "Contact", "The contact between two shapes, with its points.")
+      .def_readonly("body0", &Contact::body0)
+      .def_readonly("body1", &Contact::body1)
+      .def_readonly("points", &Contact::points)
+      .def("__repr__", [](const Contact& self) {
+        return "<Contact '" + self.body0.name + "' - '" + self.body1.name + "', " +
+               std::to_string(self.points.size()) + " points>";
+      });
+
+  py::class_<Warning>(m, "SceneWarning", "A warning recorded during stepping.")
+      .def_readonly("time", &Warning::time, "Simulated time (s).")
+      .def_readonly("message", &Warning::message)
+      .def("__repr__", [](const Warning& self) {
+        return "<Warning t=" + std::to_string(self.time) + ": " + self.message + ">";
+      });
+}
+
+void BindBuilders(py::module_& m) {
+  const auto ka = py::keep_alive<0, 1>();
+  const auto ri = py::return_value_policy::reference_internal;
+
+  py::class_<ActorBuilder> actor_builder(m, "ActorBuilder",
+                                         "Builds an actor piece by piece (SAPIEN's ActorBuilder).");
+  actor_builder.def("set_name", &ActorBuilder::SetName, py::arg("name"), ri)
+      .def("set_initial_pose", &ActorBuilder::SetInitialPose, py::arg("pose"), ri,
+           "X_WA at creation. Returns self.");
+  BindShapeAdders<ActorBuilder>(actor_builder);
+  actor_builder
+      .def("add_multiple_convex_collisions_from_file",
+           &ActorBuilder::AddMultipleConvexCollisionsFromFile, py::arg("filename"),
+           py::arg("pose") = Pose(), py::arg("scale") = Eigen::Vector3d::Ones().eval(),
+           py::arg("material") = py::none(), py::arg("density") = 1000.0, ri,
+           "One convex piece per sub-mesh (or connected component) of a mesh file. Returns "
+           "self.")
+      .def(
+          "add_convex_collision_from_mesh",
+          [](ActorBuilder& self, std::shared_ptr<MeshData> mesh, const Pose& pose,
+             const std::optional<PhysicalMaterial>& material, double density) -> ActorBuilder& {
+            return self.AddConvexCollisionFromMesh(std::move(mesh), pose, material, density);
+          },
+          py::arg("mesh"), py::arg("pose") = Pose(), py::arg("material") = py::none(),
+          py::arg("density") = 1000.0, ri,
+          "Adds the convex hull of a MeshData's vertices. Returns self.")
+      .def("build", &ActorBuilder::Build, py::arg("kinematic") = false, ka,
+           "Adds the actor to the scene (dynamic, or kinematic) and returns its handle.")
+      .def("build_kinematic", &ActorBuilder::BuildKinematic, ka)
+      .def("build_static", &ActorBuilder::BuildStatic, ka)
+      .def("get_desc", &ActorBuilder::GetDesc, "A copy of the description built so far.");
+
+  py::class_<LinkBuilder> link_builder(
+      m, "LinkBuilder", "Builds one link; owned by the ArticulationBuilder that created it.");
+  link_builder.def("get_index", &LinkBuilder::GetIndex)
+      .def("set_name", &LinkBuilder::SetName, py::arg("name"), ri)
+      .def("set_joint_name", &LinkBuilder::SetJointName, py::arg("name"), ri)
+      .def("set_joint_properties", &LinkBuilder::SetJointProperties, py::arg("type"),
+           py::arg("limits"), py::arg("pose_in_parent") = Pose(), py::arg("pose_in_child") = Pose(),
+           py::arg("friction") = 0.0, py::arg("damping") = 0.0, ri,
+           "Joint to the parent: type (JointType or its name: 'fixed', 'revolute', "
+           "'continuous', 'prismatic', 'screw'), limits (lower, upper) in m or rad, frames "
+           "X_PJ and X_CJ, friction and damping. Returns self.")
+      .def(
+          "set_joint_properties",
+          [](LinkBuilder& self, const std::string& type, const Eigen::Vector2d& limits,
+             const Pose& pose_in_parent, const Pose& pose_in_child, double friction,
+             double damping) -> LinkBuilder& {
+            return self.SetJointProperties(JointTypeFromName(type), limits, pose_in_parent,
+                                           pose_in_child, friction, damping);
+          },
+          py::arg("type"), py::arg("limits"), py::arg("pose_in_parent") = Pose(),
+          py::arg("pose_in_child") = Pose(), py::arg("friction") = 0.0, py::arg("damping") = 0.0,
+          ri)
+      .def("set_joint_armature", &LinkBuilder::SetJointArmature, py::arg("armature"), ri)
+      .def("set_screw_pitch", &LinkBuilder::SetScrewPitch, py::arg("pitch"), ri,
+           "Metres per radian. Returns self.");
+  BindShapeAdders<LinkBuilder>(link_builder);
+
+  py::class_<ArticulationBuilder>(m, "ArticulationBuilder",
+                                  "Builds an articulation link by link (SAPIEN's "
+                                  "ArticulationBuilder).")
+      .def("set_name", &ArticulationBuilder::SetName, py::arg("name"), ri)
+      .def("set_initial_pose", &ArticulationBuilder::SetInitialPose, py::arg("pose"), ri)
+      .def("create_link_builder", &ArticulationBuilder::CreateLinkBuilder,
+           py::arg("parent") = nullptr, ri,
+           "New link whose parent is `parent` (None for the root); the LinkBuilder stays "
+           "owned by this builder.")
+      .def("build", &ArticulationBuilder::Build, py::arg("fix_root_link") = false, ka)
+      .def("build_kinematic", &ArticulationBuilder::BuildKinematic, ka)
+      .def("get_desc", &ArticulationBuilder::GetDesc, "A copy of the description built so far.");
+}
+
+void BindScene(py::module_& m) {
+  const auto ka = py::keep_alive<0, 1>();
+
+  py::enum_<Integrator>(m, "Integrator", "Numerical integrator of the scene.")
+      .value("EULER", Integrator::kEuler)
+      .value("IMPLICIT", Integrator::kImplicit)
+      .value("RK4", Integrator::kRK4);
+
+  py::class_<SceneConfig>(m, "SceneConfig", "Scene-wide settings.")
+      .def(py::init<>())
+      .def_readwrite("timestep", &SceneConfig::timestep, "Seconds, > 0.")
+      .def_readwrite("gravity", &SceneConfig::gravity, "(3,) m/s^2, world frame.")
+      .def_readwrite("default_material", &SceneConfig::default_material)
+      .def_readwrite("solver_iterations", &SceneConfig::solver_iterations, ">= 1.")
+      .def_readwrite("integrator", &SceneConfig::integrator);
+
+  py::class_<Scene, std::shared_ptr<Scene>>(
+      m, "Scene", "A simulated world. Handles and builders taken from it keep it alive.")
+      .def(py::init<const SceneConfig&>(), py::arg("config") = SceneConfig())
+      .def(py::init([](double timestep, const Eigen::Vector3d& gravity) {
+             SceneConfig config;
+             config.timestep = timestep;
+             config.gravity = gravity;
+             return std::make_shared<Scene>(config);
+           }),
+           py::arg("timestep") = SceneConfig().timestep, py::arg("gravity") = SceneConfig().gravity,
+           "Scene with the default SceneConfig but `timestep` (s) and `gravity` (3,) m/s^2.")
+      .def(
+          "clone", [](const Scene& self) { return std::shared_ptr<Scene>(self.Clone()); },
+          "Independent copy with the same description and state.")
+      .def("get_config", &Scene::GetConfig, "A copy of the scene's settings.")
+      .def_property("timestep", &Scene::GetTimestep, &Scene::SetTimestep, "Seconds.")
+      .def("get_timestep", &Scene::GetTimestep)
+      .def("set_timestep", &Scene::SetTimestep, py::arg("dt"))
+      .def_property("gravity", &Scene::GetGravity, &Scene::SetGravity, "(3,) m/s^2.")
+      .def("get_gravity", &Scene::GetGravity)
+      .def("set_gravity", &Scene::SetGravity, py::arg("g"))
+      .def("get_time", &Scene::GetTime, "Simulated time (s).")
+      .def("create_actor_builder", &Scene::CreateActorBuilder, ka)
+      .def("create_articulation_builder", &Scene::CreateArticulationBuilder, ka)
+      .def_static(
+          "create_physical_material",
+          [](double static_friction, double dynamic_friction, double restitution) {
+            return PhysicalMaterial{static_friction, dynamic_friction, restitution};
+          },
+          py::arg("static_friction"), py::arg("dynamic_friction"), py::arg("restitution"),
+          "Same as PhysicalMaterial(static_friction, dynamic_friction, restitution).")
+      .def("add_ground", &Scene::AddGround, py::arg("altitude") = 0.0,
+           py::arg("material") = py::none(), py::arg("name") = "ground", ka,
+           "Adds a static ground plane at z = altitude (m).")
+      .def("add_actor", &Scene::AddActor, py::arg("desc"), ka)
+      .def("add_articulation", &Scene::AddArticulation, py::arg("desc"), ka)
+      .def("remove_actor", &Scene::RemoveActor, py::arg("actor"))
+      .def("remove_articulation", &Scene::RemoveArticulation, py::arg("articulation"))
+      .def("get_actors",
+           [](py::object self) { return HandleList(self.cast<const Scene&>().GetActors(), self); })
+      .def("get_articulations",
+           [](py::object self) {
+             return HandleList(self.cast<const Scene&>().GetArticulations(), self);
+           })
+      .def("find_actor_by_name", &Scene::FindActorByName, py::arg("name"), ka)
+      .def("find_articulation_by_name", &Scene::FindArticulationByName, py::arg("name"), ka)
+      .def("step", &Scene::Step, py::arg("n") = 1, py::call_guard<py::gil_scoped_release>(),
+           "Advances by n timesteps. The GIL is released meanwhile: other Python threads run, "
+           "but must not use this scene until step returns.")
+      .def("get_contacts", &Scene::GetContacts, "Contacts of the last step.")
+      .def("get_warnings", &Scene::GetWarnings, "Warnings recorded so far.")
+      .def("clear_warnings", &Scene::ClearWarnings)
+      .def(
+          "pack",
+          [](const Scene& self) {
+            std::vector<char> state = self.Pack();
+            return py::bytes(state.data(), state.size());
+          },
+          "Whole dynamic state as bytes, bit-exact.")
+      .def(
+          "unpack",
+          [](Scene& self, const py::bytes& state) {
+            std::string s = state;
+            self.Unpack(std::vector<char>(s.begin(), s.end()));
+          },
+          py::arg("state"), "Restores a state from pack() of this scene.")
+      .def("get_mjcf", &Scene::GetMjcf, "The MJCF text the last compile used (debugging).");
+}
+
+}  // namespace
+
+void BindPhysics(py::module_& m) {
+  // classes are registered before the signatures that mention them, so docstrings (and the
+  // stubs made from them) name Python types
+  BindDescription(m);
+  BindContacts(m);
+  BindHandles(m);
+  BindBuilders(m);
+  BindScene(m);
+}
+
+}  // namespace partsim::python
