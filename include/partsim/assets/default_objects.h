@@ -21,20 +21,21 @@ struct CabinetOptions {
   double wall_thickness = 0.018;  ///< thickness of every wall and panel (m), > 0
   /// Height of the drawer compartment as a fraction of the inner height, in (0.1, 0.9).
   double drawer_fraction = 0.3;
-  double drawer_travel = 0.4;     ///< upper limit of the drawer joint (m), <= inner depth
-  double door_limit = 1.6;        ///< upper limit of the door joint (rad), in (0, pi]
-  bool door_hinge_left = false;   ///< hinge on the +y side (left, seen from the front)
-  double handle_radius = 0.01;    ///< radius of the handle bars (m)
-  double handle_length = 0.16;    ///< length of the handle bars between post centres (m)
-  double handle_offset = 0.04;    ///< distance from the panel's front face to the bar axis (m)
-  double wood_density = 600.0;    ///< kg/m^3 for walls, drawer and door
-  double handle_density = 2700.0; ///< kg/m^3 for handles (aluminium)
-  double joint_friction = 0.1;    ///< dry friction of both joints (N or N m)
-  double joint_damping = 0.5;     ///< viscous damping of both joints (N s/m or N m s/rad)
-  /// 0 keeps the sizes above; any other value scales height, width, depth and the drawer
-  /// fraction by deterministic pseudo-random factors within about +-15%, and picks the hinge side.
+  double drawer_travel = 0.4;      ///< upper limit of the drawer joint (m), <= inner depth
+  double door_limit = 1.6;         ///< upper limit of the door joint (rad), in (0, pi]
+  bool door_hinge_left = false;    ///< hinge on the +y side (left, seen from the front)
+  double handle_radius = 0.01;     ///< radius of the handle bars (m)
+  double handle_length = 0.16;     ///< length of the handle bars between post centres (m)
+  double handle_offset = 0.04;     ///< distance from the panel's front face to the bar axis (m)
+  double wood_density = 600.0;     ///< kg/m^3 for walls, drawer and door
+  double handle_density = 2700.0;  ///< kg/m^3 for handles (aluminium)
+  double joint_friction = 0.1;     ///< dry friction of both joints (N or N m)
+  double joint_damping = 0.5;      ///< viscous damping of both joints (N s/m or N m s/rad)
+  /// 0 keeps the sizes above; any other value scales height, width, depth (and with it the
+  /// drawer travel) and the drawer fraction by deterministic pseudo-random factors within +-15%,
+  /// and picks the hinge side.
   std::uint32_t seed = 0;
-  std::string name = "cabinet";   ///< robot name in the URDF
+  std::string name = "cabinet";  ///< robot name in the URDF
 };
 
 /// Writes the cabinet described by `opts` as a URDF string with three links ("body",

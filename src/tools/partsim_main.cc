@@ -1,0 +1,490 @@
+// The `partsim` command-line program: inspect a URDF articulation (`info`) or simulate it and
+// write its joint trajectory (`simulate`). With no file, both use the built-in cabinet of
+// MakeCabinetUrdf(). Exit codes: 0 success, 1 failure while running (missing or bad file), 2 bad
+// command line.
+#include <mujoco/mujoco.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "partsim/assets/default_objects.h"
+#include "partsim/assets/urdf.h"
+#include "partsim/core/error.h"
+#include "partsim/physics/scene.h"
+
+namespace {
+
+constexpr char kVersion[] = "0.1.0";
+
+constexpr char kUsage[] = R"(partsim: simulate robots and articulated objects (doors, drawers, ...)
+
+usage:
+  partsim info [FILE.urdf] [--fix-root | --free-root] [--json]
+  partsim simulate [FILE.urdf] --steps N [options]
+  partsim --help | --version
+
+info       prints the links (name, parent, mass), the joints (name, type, parent -> child,
+           limits in rad or m), the total mass and the number of degrees of freedom.
+  --json             print the same as JSON
+  --fix-root         weld the root link to the world (default)
+  --free-root        let the root link move freely (6 more dof, not counted in DOF)
+
+simulate   steps the articulation and writes its joint trajectory: time, then the position
+           and the velocity of every joint with a dof.
+  --steps N                  number of steps (required with a file; 1000 for the demo)
+  --dt SECONDS               timestep (default 0.002)
+  --out FILE                 trajectory file; '-' writes it to standard output
+  --format csv|json          trajectory format (default: from the --out extension, else csv)
+  --drive-stiffness K        PD drive stiffness on every joint (N/m or N m/rad)
+  --drive-damping D          PD drive damping on every joint (N s/m or N m s/rad)
+  --target Q1,Q2,...         drive targets, one per dof (m or rad; needs --drive-stiffness)
+  --gravity X,Y,Z            gravity in m/s^2 (default 0,0,-9.81)
+  --fix-root | --free-root   as for info (default --fix-root)
+
+With no FILE, both commands use the built-in cabinet (a drawer and a door); `simulate` then runs
+a demo that drives the drawer and the door open and prints their final positions.
+Exit codes: 0 success, 1 runtime failure (missing or invalid file), 2 bad command line.
+)";
+
+/// A bad command line: the message names the flag or argument at fault; exit code 2.
+class UsageError : public std::runtime_error {
+ public:
+  explicit UsageError(const std::string& what) : std::runtime_error(what) {}
+};
+
+/// Parsed command line.
+struct Args {
+  std::string command;  // "info" or "simulate"
+  std::string file;     // "" for the built-in cabinet
+  bool fix_root = true;
+  bool json = false;
+  std::optional<long> steps;
+  double dt = 0.002;
+  std::string out;
+  std::string format;
+  std::optional<double> stiffness;
+  std::optional<double> damping;
+  std::optional<std::vector<double>> target;
+  Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.81);
+};
+
+// ---------------------------------------------------------------------------------------------
+// command line
+
+double ParseNumber(const std::string& flag, const std::string& text) {
+  const char* s = text.c_str();
+  char* end = nullptr;
+  errno = 0;
+  double v = std::strtod(s, &end);
+  if (text.empty() || end == s || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+    throw UsageError(flag + " expects a number, got '" + text + "'");
+  }
+  return v;
+}
+
+std::vector<double> ParseList(const std::string& flag, const std::string& text) {
+  std::vector<double> values;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, ',')) values.push_back(ParseNumber(flag, item));
+  if (values.empty() || (!text.empty() && text.back() == ',')) {
+    throw UsageError(flag + " expects comma-separated numbers, got '" + text + "'");
+  }
+  return values;
+}
+
+Args ParseArgs(const std::vector<std::string>& argv) {
+  Args args;
+  args.command = argv[0];
+  const std::string prefix = "partsim " + args.command + ": ";
+  bool simulate = args.command == "simulate";
+  for (size_t i = 1; i < argv.size(); ++i) {
+    std::string arg = argv[i];
+    // positional: the URDF file
+    if (arg.empty() || arg[0] != '-' || arg == "-") {
+      if (!args.file.empty()) {
+        throw UsageError(prefix + "unexpected extra argument '" + arg + "' (one file at most)");
+      }
+      args.file = arg;
+      continue;
+    }
+    // flags, as "--flag value" or "--flag=value"
+    std::string flag = arg, inline_value;
+    bool has_inline = false;
+    if (size_t eq = arg.find('='); eq != std::string::npos) {
+      flag = arg.substr(0, eq);
+      inline_value = arg.substr(eq + 1);
+      has_inline = true;
+    }
+    auto value = [&]() -> std::string {
+      if (has_inline) return inline_value;
+      if (i + 1 >= argv.size()) throw UsageError(prefix + flag + " needs a value");
+      return argv[++i];
+    };
+    auto no_value = [&]() {
+      if (has_inline) throw UsageError(prefix + flag + " takes no value");
+    };
+    if (flag == "--fix-root") {
+      no_value();
+      args.fix_root = true;
+    } else if (flag == "--free-root") {
+      no_value();
+      args.fix_root = false;
+    } else if (flag == "--json" && !simulate) {
+      no_value();
+      args.json = true;
+    } else if (flag == "--steps" && simulate) {
+      std::string v = value();
+      char* end = nullptr;
+      errno = 0;
+      long n = std::strtol(v.c_str(), &end, 10);
+      if (v.empty() || *end != '\0' || errno == ERANGE || n < 0) {
+        throw UsageError(prefix + "--steps expects a non-negative integer, got '" + v + "'");
+      }
+      args.steps = n;
+    } else if (flag == "--dt" && simulate) {
+      args.dt = ParseNumber(prefix + "--dt", value());
+      if (args.dt <= 0) throw UsageError(prefix + "--dt must be > 0");
+    } else if (flag == "--out" && simulate) {
+      args.out = value();
+      if (args.out.empty()) throw UsageError(prefix + "--out needs a file name");
+    } else if (flag == "--format" && simulate) {
+      args.format = value();
+      if (args.format != "csv" && args.format != "json") {
+        throw UsageError(prefix + "--format must be csv or json, got '" + args.format + "'");
+      }
+    } else if (flag == "--drive-stiffness" && simulate) {
+      args.stiffness = ParseNumber(prefix + "--drive-stiffness", value());
+      if (*args.stiffness < 0) throw UsageError(prefix + "--drive-stiffness must be >= 0");
+    } else if (flag == "--drive-damping" && simulate) {
+      args.damping = ParseNumber(prefix + "--drive-damping", value());
+      if (*args.damping < 0) throw UsageError(prefix + "--drive-damping must be >= 0");
+    } else if (flag == "--target" && simulate) {
+      args.target = ParseList(prefix + "--target", value());
+    } else if (flag == "--gravity" && simulate) {
+      std::vector<double> g = ParseList(prefix + "--gravity", value());
+      if (g.size() != 3) {
+        throw UsageError(prefix + "--gravity expects 3 numbers X,Y,Z, got " +
+                         std::to_string(g.size()));
+      }
+      args.gravity = Eigen::Vector3d(g[0], g[1], g[2]);
+    } else {
+      throw UsageError(prefix + "unknown option '" + arg + "' (see partsim --help)");
+    }
+  }
+  if (simulate && !args.file.empty() && !args.steps) {
+    throw UsageError(prefix + "--steps N is required when simulating a file");
+  }
+  if (simulate && args.target && !args.stiffness) {
+    throw UsageError(prefix +
+                     "--target needs --drive-stiffness (a drive without stiffness "
+                     "does not track positions)");
+  }
+  return args;
+}
+
+// ---------------------------------------------------------------------------------------------
+// loading
+
+/// A scene holding the one articulation that the command works on.
+struct Loaded {
+  std::unique_ptr<partsim::Scene> scene;
+  partsim::Articulation art;
+  std::string source;  // file name, or "built-in cabinet"
+};
+
+Loaded Load(const Args& args, const partsim::SceneConfig& config) {
+  Loaded out;
+  out.scene = std::make_unique<partsim::Scene>(config);
+  partsim::UrdfLoader loader = out.scene->CreateUrdfLoader();
+  loader.fix_root_link = args.fix_root;
+  if (args.file.empty()) {
+    std::cerr << "partsim: no file given, using the built-in cabinet (a drawer and a door)\n";
+    out.art = loader.LoadFromString(partsim::MakeCabinetUrdf(), ".");
+    out.source = "built-in cabinet";
+  } else {
+    // a missing file is reported with the system's reason
+    std::ifstream probe(args.file);
+    if (!probe) {
+      throw std::runtime_error("cannot open '" + args.file + "': " + std::strerror(errno));
+    }
+    out.art = loader.Load(args.file);
+    out.source = args.file;
+  }
+  return out;
+}
+
+std::string LimitText(double v) {
+  if (std::isinf(v)) return v < 0 ? "-inf" : "inf";
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.6g", v);
+  return buf;
+}
+
+nlohmann::ordered_json LimitJson(double v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(v) : nullptr;
+}
+
+const char* Unit(partsim::JointType t) {
+  return t == partsim::JointType::kPrismatic ? "m" : t == partsim::JointType::kFixed ? "" : "rad";
+}
+
+// ---------------------------------------------------------------------------------------------
+// info
+
+int RunInfo(const Args& args) {
+  Loaded l = Load(args, partsim::SceneConfig());
+  const partsim::ArticulationDesc& desc = l.art.GetDesc();
+  std::vector<partsim::Link> links = l.art.GetLinks();
+  double total = 0.0;
+  for (const partsim::Link& link : links) total += link.GetMass();
+
+  if (args.json) {
+    nlohmann::ordered_json j;
+    j["source"] = l.source;
+    j["name"] = desc.name;
+    j["fix_root"] = args.fix_root;
+    j["links"] = nlohmann::ordered_json::array();
+    for (const partsim::Link& link : links) {
+      int p = link.GetParentIndex();
+      j["links"].push_back({{"name", link.GetName()},
+                            {"parent", p < 0 ? nlohmann::ordered_json(nullptr)
+                                             : nlohmann::ordered_json(links[p].GetName())},
+                            {"mass", link.GetMass()}});
+    }
+    j["joints"] = nlohmann::ordered_json::array();
+    for (const partsim::Joint& joint : l.art.GetJoints()) {
+      Eigen::Vector2d lim = joint.GetLimits();
+      j["joints"].push_back({{"name", joint.GetName()},
+                             {"type", partsim::JointTypeName(joint.GetType())},
+                             {"parent", joint.GetParentLink().GetName()},
+                             {"child", joint.GetChildLink().GetName()},
+                             {"dof", joint.GetDof()},
+                             {"lower", LimitJson(lim[0])},
+                             {"upper", LimitJson(lim[1])},
+                             {"unit", Unit(joint.GetType())}});
+    }
+    j["total_mass"] = total;
+    j["dof"] = l.art.Dof();
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+
+  std::printf("articulation '%s' from %s (%s root)\n", desc.name.c_str(), l.source.c_str(),
+              args.fix_root ? "fixed" : "free");
+  std::printf("\nlinks (%zu):\n", links.size());
+  std::printf("  %-24s %-24s %12s\n", "name", "parent", "mass [kg]");
+  for (const partsim::Link& link : links) {
+    int p = link.GetParentIndex();
+    std::printf(
+        "  %-24s %-24s %12.4f\n", link.GetName().c_str(),
+        p < 0 ? (args.fix_root ? "(world, fixed)" : "(world, free)") : links[p].GetName().c_str(),
+        link.GetMass());
+  }
+  std::vector<partsim::Joint> joints = l.art.GetJoints();
+  std::printf("\njoints (%zu):\n", joints.size());
+  std::printf("  %-24s %-11s %-40s %s\n", "name", "type", "parent -> child", "limits");
+  for (const partsim::Joint& joint : joints) {
+    std::string link_pair =
+        joint.GetParentLink().GetName() + " -> " + joint.GetChildLink().GetName();
+    std::string limits = "-";
+    if (joint.GetDof() > 0 || joint.GetType() != partsim::JointType::kFixed) {
+      Eigen::Vector2d lim = joint.GetLimits();
+      limits = "[" + LimitText(lim[0]) + ", " + LimitText(lim[1]) + "] " + Unit(joint.GetType());
+    }
+    std::printf("  %-24s %-11s %-40s %s\n", joint.GetName().c_str(),
+                partsim::JointTypeName(joint.GetType()), link_pair.c_str(), limits.c_str());
+  }
+  std::printf("\ntotal mass: %.4f kg\n", total);
+  std::printf("DOF: %d%s\n", l.art.Dof(), args.fix_root ? "" : " (+6 of the free root)");
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// simulate
+
+/// Joint trajectory: one row per recorded instant.
+struct Trajectory {
+  std::vector<std::string> joints;
+  std::vector<double> time;
+  std::vector<Eigen::VectorXd> qpos, qvel;
+  void Record(double t, const partsim::Articulation& art) {
+    time.push_back(t);
+    qpos.push_back(art.GetQpos());
+    qvel.push_back(art.GetQvel());
+  }
+};
+
+void WriteCsv(std::ostream& out, const Trajectory& tr) {
+  out << "time";
+  for (const std::string& j : tr.joints) out << ",qpos:" << j;
+  for (const std::string& j : tr.joints) out << ",qvel:" << j;
+  out << "\n";
+  char buf[32];
+  for (size_t r = 0; r < tr.time.size(); ++r) {
+    std::snprintf(buf, sizeof(buf), "%.9g", tr.time[r]);
+    out << buf;
+    for (const Eigen::VectorXd* v : {&tr.qpos[r], &tr.qvel[r]}) {
+      for (int k = 0; k < v->size(); ++k) {
+        std::snprintf(buf, sizeof(buf), ",%.9g", (*v)[k]);
+        out << buf;
+      }
+    }
+    out << "\n";
+  }
+}
+
+void WriteJson(std::ostream& out, const Trajectory& tr, double dt) {
+  nlohmann::ordered_json j;
+  j["joints"] = tr.joints;
+  j["dt"] = dt;
+  j["time"] = tr.time;
+  j["qpos"] = nlohmann::ordered_json::array();
+  j["qvel"] = nlohmann::ordered_json::array();
+  for (size_t r = 0; r < tr.time.size(); ++r) {
+    j["qpos"].push_back(
+        std::vector<double>(tr.qpos[r].data(), tr.qpos[r].data() + tr.qpos[r].size()));
+    j["qvel"].push_back(
+        std::vector<double>(tr.qvel[r].data(), tr.qvel[r].data() + tr.qvel[r].size()));
+  }
+  out << j.dump() << "\n";
+}
+
+int RunSimulate(const Args& args) {
+  partsim::SceneConfig config;
+  config.timestep = args.dt;
+  config.gravity = args.gravity;
+  Loaded l = Load(args, config);
+  partsim::Articulation& art = l.art;
+  const bool demo = args.file.empty();
+  const long steps = args.steps.value_or(1000);
+  std::vector<partsim::Joint> active = art.GetActiveJoints();
+  const int dof = art.Dof();
+
+  // drives: the user's, else the demo's (drawer and door driven open)
+  if (args.stiffness || args.damping) {
+    art.SetDriveProperty(args.stiffness.value_or(0.0), args.damping.value_or(0.0));
+  } else if (demo) {
+    art.FindJointByName("drawer_0_joint").SetDriveProperty(200.0, 80.0);
+    art.FindJointByName("door_0_joint").SetDriveProperty(20.0, 8.0);
+  }
+  if (args.target) {
+    if (static_cast<int>(args.target->size()) != dof) {
+      throw UsageError("partsim simulate: --target has " + std::to_string(args.target->size()) +
+                       " values but the articulation has " + std::to_string(dof) + " dof");
+    }
+    art.SetDriveTarget(Eigen::Map<const Eigen::VectorXd>(args.target->data(), dof));
+  } else if (demo) {
+    art.FindJointByName("drawer_0_joint").SetDriveTarget(0.3);
+    art.FindJointByName("door_0_joint").SetDriveTarget(1.2);
+  }
+
+  // step and record
+  Trajectory tr;
+  for (const partsim::Joint& j : active) tr.joints.push_back(j.GetName());
+  const bool record = !args.out.empty();
+  if (record) tr.Record(l.scene->GetTime(), art);
+  auto start = std::chrono::steady_clock::now();
+  for (long k = 0; k < steps; ++k) {
+    l.scene->Step();
+    if (record) tr.Record(l.scene->GetTime(), art);
+  }
+  double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  // trajectory output
+  bool to_stdout = args.out == "-";
+  if (record) {
+    std::string format = args.format;
+    if (format.empty()) {
+      bool json_ext =
+          args.out.size() >= 5 && args.out.compare(args.out.size() - 5, 5, ".json") == 0;
+      format = json_ext ? "json" : "csv";
+    }
+    std::ofstream file;
+    if (!to_stdout) {
+      file.open(args.out);
+      if (!file) {
+        throw std::runtime_error("cannot write '" + args.out + "': " + std::strerror(errno));
+      }
+    }
+    std::ostream& out = to_stdout ? std::cout : file;
+    if (format == "json")
+      WriteJson(out, tr, args.dt);
+    else
+      WriteCsv(out, tr);
+    if (!to_stdout && !file) throw std::runtime_error("error while writing '" + args.out + "'");
+  }
+
+  // summary (on stderr when the trajectory went to stdout)
+  FILE* s = to_stdout ? stderr : stdout;
+  std::fprintf(s, "simulated %ld steps of %g s (%.4g s) in %.3f s: %.0f steps/s\n", steps, args.dt,
+               steps * args.dt, wall, wall > 0 ? steps / wall : 0.0);
+  if (record && !to_stdout) {
+    std::fprintf(s, "trajectory: %zu rows written to %s\n", tr.time.size(), args.out.c_str());
+  }
+  for (const partsim::Warning& w : l.scene->GetWarnings()) {
+    std::fprintf(stderr, "warning at t = %g s: %s\n", w.time, w.message.c_str());
+  }
+  Eigen::VectorXd q = art.GetQpos();
+  std::fprintf(s, "final qpos:\n");
+  for (int k = 0; k < dof; ++k) {
+    std::fprintf(s, "  %-24s %10.4f %s\n", active[k].GetName().c_str(), q[k],
+                 Unit(active[k].GetType()));
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) {
+    std::fprintf(stderr, "%s", kUsage);
+    return 2;
+  }
+  const std::string& command = args[0];
+  if (command == "--help" || command == "-h" || command == "help") {
+    std::printf("%s", kUsage);
+    return 0;
+  }
+  if (command == "--version") {
+    int v = mj_version();
+    std::printf("partsim %s (MuJoCo %d.%d.%d)\n", kVersion, v / 100, (v / 10) % 10, v % 10);
+    return 0;
+  }
+  if (command != "info" && command != "simulate") {
+    std::fprintf(stderr,
+                 "partsim: unknown %s '%s' (expected info or simulate; see partsim --help)\n",
+                 command[0] == '-' ? "option" : "command", command.c_str());
+    return 2;
+  }
+  try {
+    for (const std::string& a : args) {
+      if (a == "--help" || a == "-h") {
+        std::printf("%s", kUsage);
+        return 0;
+      }
+    }
+    Args parsed = ParseArgs(args);
+    return parsed.command == "info" ? RunInfo(parsed) : RunSimulate(parsed);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "partsim %s: %s\n", command.c_str(), e.what());
+    return 1;
+  }
+}

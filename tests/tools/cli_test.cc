@@ -1,0 +1,236 @@
+// Runs the built `partsim` program through popen and checks its output and exit codes.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "partsim/assets/default_objects.h"
+
+#ifndef PARTSIM_CLI_PATH
+#error "PARTSIM_CLI_PATH must name the partsim executable"
+#endif
+
+namespace partsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int code = -1;       // exit code
+  std::string output;  // stdout and stderr together
+};
+
+/// Runs `partsim ARGS` with stderr folded into stdout (or dropped when `stderr_too` is false).
+RunResult RunCli(const std::string& args, bool stderr_too = true) {
+  std::string cmd =
+      std::string("'") + PARTSIM_CLI_PATH + "' " + args + (stderr_too ? " 2>&1" : " 2>/dev/null");
+  RunResult r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.output.append(buf, n);
+  int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+bool Contains(const std::string& text, const std::string& what) {
+  return text.find(what) != std::string::npos;
+}
+
+/// A scratch folder, removed at the end of the test.
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("partsim_cli_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    cabinet_ = (dir_ / "cabinet.urdf").string();
+    std::ofstream(cabinet_) << MakeCabinetUrdf();
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path dir_;
+  std::string cabinet_;
+};
+
+TEST_F(CliTest, VersionAndHelp) {
+  RunResult v = RunCli("--version");
+  EXPECT_EQ(v.code, 0);
+  EXPECT_TRUE(Contains(v.output, "partsim ")) << v.output;
+  EXPECT_TRUE(Contains(v.output, "MuJoCo 2.")) << v.output;
+  RunResult h = RunCli("--help");
+  EXPECT_EQ(h.code, 0);
+  EXPECT_TRUE(Contains(h.output, "partsim info")) << h.output;
+  EXPECT_TRUE(Contains(h.output, "--drive-stiffness")) << h.output;
+  EXPECT_EQ(RunCli("simulate --help").code, 0);
+  // no arguments: usage on stderr, exit code 2
+  RunResult none = RunCli("");
+  EXPECT_EQ(none.code, 2);
+  EXPECT_TRUE(Contains(none.output, "usage")) << none.output;
+}
+
+TEST_F(CliTest, BadCommandLinesExitWithCodeTwoAndNameTheCulprit) {
+  struct Case {
+    std::string args, named;
+  };
+  const std::vector<Case> cases = {
+      {"frobnicate", "frobnicate"},
+      {"--frobnicate", "--frobnicate"},
+      {"info --bogus", "--bogus"},
+      {"info --steps 3", "--steps"},  // simulate's flag
+      {"simulate --steps abc", "--steps"},
+      {"simulate --steps -3", "--steps"},
+      {"simulate --dt 0.0.1 --steps 3", "--dt"},
+      {"simulate --dt -1 --steps 3", "--dt"},
+      {"simulate --gravity 1,2 --steps 3", "--gravity"},
+      {"simulate --gravity 0,0,x --steps 3", "--gravity"},
+      {"simulate --format xml --steps 3", "--format"},
+      {"simulate --steps", "--steps"},
+      {"simulate --target 1,2", "--target"},                               // no stiffness
+      {"simulate --drive-stiffness 10 --target 1 --steps 3", "--target"},  // 2 dof
+      {"simulate CABINET", "--steps"},                                     // a file needs --steps
+      {"info CABINET other.urdf", "other.urdf"},
+  };
+  for (const Case& c : cases) {
+    std::string args = c.args;
+    if (size_t at = args.find("CABINET"); at != std::string::npos) args.replace(at, 7, cabinet_);
+    RunResult r = RunCli(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.output;
+    EXPECT_TRUE(Contains(r.output, c.named)) << args << "\n" << r.output;
+  }
+}
+
+TEST_F(CliTest, MissingOrInvalidFileExitsWithCodeOne) {
+  std::string missing = (dir_ / "no_such_cabinet.urdf").string();
+  for (const std::string& cmd : {"info ", "simulate --steps 3 "}) {
+    RunResult r = RunCli(cmd + missing);
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_TRUE(Contains(r.output, "no_such_cabinet.urdf")) << r.output;
+  }
+  std::string broken = (dir_ / "broken.urdf").string();
+  std::ofstream(broken) << "<robot name=\"x\"><link name=\"a\"/><joint name=\"j\" "
+                           "type=\"revolute\"><parent link=\"a\"/><child link=\"zz\"/></joint>"
+                           "</robot>";
+  RunResult r = RunCli("info " + broken);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(Contains(r.output, "broken.urdf")) << r.output;
+}
+
+TEST_F(CliTest, InfoOfTheBuiltInCabinet) {
+  RunResult r = RunCli("info");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Contains(r.output, "built-in cabinet")) << r.output;
+  for (const char* name : {"body", "drawer_0", "door_0", "drawer_0_joint", "door_0_joint",
+                           "prismatic", "revolute", "[0, 0.4] m", "[0, 1.6] rad"}) {
+    EXPECT_TRUE(Contains(r.output, name)) << name << "\n" << r.output;
+  }
+  EXPECT_TRUE(Contains(r.output, "DOF: 2")) << r.output;
+}
+
+TEST_F(CliTest, InfoJsonAgreesWithItself) {
+  RunResult r = RunCli("info " + cabinet_ + " --json", /*stderr_too=*/false);
+  ASSERT_EQ(r.code, 0) << r.output;
+  nlohmann::json j = nlohmann::json::parse(r.output);
+  EXPECT_EQ(j["dof"], 2);
+  ASSERT_EQ(j["links"].size(), 3u);
+  ASSERT_EQ(j["joints"].size(), 2u);
+  double sum = 0.0;
+  for (const auto& l : j["links"]) sum += l["mass"].get<double>();
+  EXPECT_NEAR(j["total_mass"].get<double>(), sum, 1e-9);
+  EXPECT_GT(sum, 10.0);
+  EXPECT_TRUE(j["links"][0]["parent"].is_null());
+  EXPECT_EQ(j["joints"][0]["name"], "drawer_0_joint");
+  EXPECT_EQ(j["joints"][0]["parent"], "body");
+  EXPECT_EQ(j["joints"][0]["child"], "drawer_0");
+  EXPECT_DOUBLE_EQ(j["joints"][0]["upper"].get<double>(), 0.4);
+  EXPECT_EQ(j["joints"][1]["unit"], "rad");
+
+  // a free root adds no counted dof but is reported
+  RunResult f = RunCli("info " + cabinet_ + " --free-root --json", false);
+  ASSERT_EQ(f.code, 0) << f.output;
+  EXPECT_EQ(nlohmann::json::parse(f.output)["fix_root"], false);
+}
+
+TEST_F(CliTest, DemoOpensTheDrawerAndTheDoor) {
+  RunResult r = RunCli("simulate", /*stderr_too=*/false);
+  ASSERT_EQ(r.code, 0) << r.output;
+  // "  drawer_0_joint   0.2992 m"
+  double drawer = -1, door = -1;
+  std::istringstream in(r.output);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string name;
+    double value;
+    if (!(words >> name >> value)) continue;
+    if (name == "drawer_0_joint") drawer = value;
+    if (name == "door_0_joint") door = value;
+  }
+  EXPECT_GT(drawer, 0.25) << r.output;
+  EXPECT_GT(door, 1.0) << r.output;
+  EXPECT_TRUE(Contains(r.output, "steps/s")) << r.output;
+}
+
+TEST_F(CliTest, SimulateWritesCsvTrajectory) {
+  std::string out = (dir_ / "traj.csv").string();
+  RunResult r = RunCli("simulate " + cabinet_ +
+                       " --steps 50 --dt 0.004 --drive-stiffness 100 --drive-damping 20 "
+                       "--target 0.2,0.5 --out " +
+                       out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(out);
+  std::string header, line, last;
+  std::getline(in, header);
+  EXPECT_EQ(header,
+            "time,qpos:drawer_0_joint,qpos:door_0_joint,qvel:drawer_0_joint,qvel:door_0_joint");
+  int rows = 0;
+  while (std::getline(in, line)) {
+    ++rows;
+    last = line;
+  }
+  EXPECT_EQ(rows, 51);  // the initial state and one row per step
+  // the last row is at 50 steps of 4 ms, and the drawer has moved towards its target
+  std::vector<double> v;
+  std::istringstream cells(last);
+  std::string cell;
+  while (std::getline(cells, cell, ',')) v.push_back(std::stod(cell));
+  ASSERT_EQ(v.size(), 5u);
+  EXPECT_NEAR(v[0], 0.2, 1e-9);
+  EXPECT_GT(v[1], 0.01);
+  EXPECT_GT(v[3], 0.0);
+}
+
+TEST_F(CliTest, SimulateWritesJsonTrajectoryAndHonoursGravity) {
+  // the cabinet on a free root falls under gravity; with no gravity it stays
+  std::string out = (dir_ / "traj.json").string();
+  RunResult r =
+      RunCli("simulate " + cabinet_ + " --free-root --steps 20 --gravity 0,0,0 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  nlohmann::json j;
+  std::ifstream(out) >> j;
+  ASSERT_EQ(j["time"].size(), 21u);
+  ASSERT_EQ(j["qpos"].size(), 21u);
+  EXPECT_EQ(j["joints"].size(), 2u);
+  EXPECT_DOUBLE_EQ(j["dt"].get<double>(), 0.002);
+  for (const auto& row : j["qvel"])
+    for (const auto& v : row) EXPECT_NEAR(v.get<double>(), 0.0, 1e-9);
+
+  // --format overrides the extension; '-' writes to stdout, the summary then goes to stderr
+  RunResult s = RunCli("simulate " + cabinet_ + " --steps 3 --format json --out -",
+                       /*stderr_too=*/false);
+  ASSERT_EQ(s.code, 0) << s.output;
+  nlohmann::json k = nlohmann::json::parse(s.output);
+  EXPECT_EQ(k["time"].size(), 4u);
+}
+
+}  // namespace
+}  // namespace partsim
