@@ -1,12 +1,12 @@
 #include "partsim/assets/mesh.h"
 
-#include <assimp/Importer.hpp>
 #include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <assimp/Importer.hpp>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -30,7 +30,8 @@ Eigen::Matrix4d ToEigen(const aiMatrix4x4& m) {
 
 bool IsCollada(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext == ".dae";
 }
 
@@ -91,7 +92,8 @@ void CollectNode(const aiScene* scene, const aiNode* node, const Eigen::Matrix4d
       mesh->normals.reserve(am->mNumVertices);
       for (unsigned i = 0; i < am->mNumVertices; ++i) {
         const aiVector3D& a = am->mNormals[i];
-        Eigen::Vector3d n = (normal_matrix * Eigen::Vector3d(a.x, a.y, a.z)).cwiseProduct(inv_scale);
+        Eigen::Vector3d n =
+            (normal_matrix * Eigen::Vector3d(a.x, a.y, a.z)).cwiseProduct(inv_scale);
         double len = n.norm();
         mesh->normals.push_back((len > 0 ? n / len : n).cast<float>());
       }
@@ -135,10 +137,11 @@ std::vector<LoadedMesh> LoadMeshFile(const std::string& path, const Eigen::Vecto
 
   Assimp::Importer importer;
   // no points or lines: they are not surfaces
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(
-      path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_GenNormals |
-                aiProcess_SortByPType);
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                  aiProcess_GenNormals | aiProcess_SortByPType);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw Error("mesh file '" + path + "' could not be read: " + importer.GetErrorString());
   }
@@ -180,7 +183,8 @@ std::shared_ptr<MeshData> LoadMergedMesh(const std::string& path, const Eigen::V
     merged->vertices.insert(merged->vertices.end(), m.vertices.begin(), m.vertices.end());
     if (normals) merged->normals.insert(merged->normals.end(), m.normals.begin(), m.normals.end());
     if (uvs) merged->uvs.insert(merged->uvs.end(), m.uvs.begin(), m.uvs.end());
-    for (const Eigen::Vector3i& f : m.faces) merged->faces.push_back(f + Eigen::Vector3i::Constant(base));
+    for (const Eigen::Vector3i& f : m.faces)
+      merged->faces.push_back(f + Eigen::Vector3i::Constant(base));
   }
   return merged;
 }
@@ -210,9 +214,7 @@ std::vector<std::shared_ptr<MeshData>> SplitConnectedComponents(const MeshData& 
     }
     return a;
   };
-  auto valid = [nv](const Eigen::Vector3i& f) {
-    return f.minCoeff() >= 0 && f.maxCoeff() < nv;
-  };
+  auto valid = [nv](const Eigen::Vector3i& f) { return f.minCoeff() >= 0 && f.maxCoeff() < nv; };
   for (const Eigen::Vector3i& f : mesh.faces) {
     if (!valid(f)) continue;
     int a = find(weld[f[0]]);

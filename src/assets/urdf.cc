@@ -34,7 +34,8 @@ struct RawJoint {
 
 // Rotation taking the x axis onto the unit vector `a` (a = -x gives a half turn about z).
 Eigen::Quaterniond XToAxis(const Eigen::Vector3d& a) {
-  if (a.x() < -1.0 + 1e-12) return Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+  if (a.x() < -1.0 + 1e-12)
+    return Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
   return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitX(), a).normalized();
 }
 
@@ -82,14 +83,16 @@ class Parser {
   std::string ResolvePath(const std::string& uri, const std::string& where) const;
   std::vector<std::shared_ptr<MeshData>> CollisionMeshes(const std::string& path,
                                                          const Eigen::Vector3d& scale);
-  const std::vector<LoadedMesh>& VisualMeshes(const std::string& path, const Eigen::Vector3d& scale);
+  const std::vector<LoadedMesh>& VisualMeshes(const std::string& path,
+                                              const Eigen::Vector3d& scale);
 
   const UrdfLoader& loader_;
   fs::path base_dir_;
   std::string source_;
   std::map<std::string, RenderMaterial> materials_;
   // meshes read during this parse, by path and scale
-  std::map<std::pair<std::string, std::string>, std::vector<std::shared_ptr<MeshData>>> collision_cache_;
+  std::map<std::pair<std::string, std::string>, std::vector<std::shared_ptr<MeshData>>>
+      collision_cache_;
   std::map<std::pair<std::string, std::string>, std::vector<LoadedMesh>> visual_cache_;
 };
 
@@ -154,7 +157,8 @@ void Parser::ReadMaterials(const XMLElement* robot) {
   for (const XMLElement* m = robot->FirstChildElement("material"); m != nullptr;
        m = m->NextSiblingElement("material")) {
     const char* name = m->Attribute("name");
-    if (name == nullptr) Fail("<material> at line " + std::to_string(m->GetLineNum()) + " has no name");
+    if (name == nullptr)
+      Fail("<material> at line " + std::to_string(m->GetLineNum()) + " has no name");
     std::optional<RenderMaterial> mat = ReadMaterial(m, std::string("material '") + name + "'");
     materials_[name] = mat.value_or(RenderMaterial());
   }
@@ -268,12 +272,12 @@ std::optional<std::pair<std::string, Eigen::Vector3d>> Parser::ReadGeometry(
     for (int i = 0; i < 3; ++i) shape->half_size[i] = positive(s[i] * scale / 2, "size");
   } else if (kind == "sphere") {
     shape->type = ShapeType::kSphere;
-    shape->radius = positive(Numbers(attr("radius"), 1, where + " <sphere radius>")[0] * scale,
-                             "radius");
+    shape->radius =
+        positive(Numbers(attr("radius"), 1, where + " <sphere radius>")[0] * scale, "radius");
   } else if (kind == "cylinder" || kind == "capsule") {
     shape->type = kind == "cylinder" ? ShapeType::kCylinder : ShapeType::kCapsule;
-    shape->radius = positive(
-        Numbers(attr("radius"), 1, where + " <" + kind + " radius>")[0] * scale, "radius");
+    shape->radius =
+        positive(Numbers(attr("radius"), 1, where + " <" + kind + " radius>")[0] * scale, "radius");
     shape->half_length = positive(
         Numbers(attr("length"), 1, where + " <" + kind + " length>")[0] * scale / 2, "length");
     // URDF cylinders run along z, partsim's along x
@@ -286,7 +290,8 @@ std::optional<std::pair<std::string, Eigen::Vector3d>> Parser::ReadGeometry(
       s = Eigen::Vector3d(v[0], v[1], v[2]);
     }
     s *= scale;
-    if (!s.allFinite() || (s.array() == 0).any()) Fail(where + " <mesh scale> must be finite and non-zero");
+    if (!s.allFinite() || (s.array() == 0).any())
+      Fail(where + " <mesh scale> must be finite and non-zero");
     return std::make_pair(std::string(attr("filename")), s);
   } else {
     Fail(where + " <geometry> has unknown shape <" + kind + ">");
@@ -562,7 +567,7 @@ ArticulationDesc Parser::Run(const std::string& text) {
     const char* type = j->Attribute("type");
     if (type == nullptr) Fail(where + " has no type");
     raw.type = type;
-    static const std::set<std::string> kKnown = {"fixed",    "revolute", "continuous",
+    static const std::set<std::string> kKnown = {"fixed",     "revolute", "continuous",
                                                  "prismatic", "floating", "planar"};
     if (!kKnown.count(raw.type)) Fail(where + " has unknown type '" + raw.type + "'");
     if (raw.type == "planar") {
@@ -580,8 +585,8 @@ ArticulationDesc Parser::Run(const std::string& text) {
     int child = link_index[raw.child];
     if (raw.parent == raw.child) Fail(where + " joins link '" + raw.child + "' to itself");
     if (joint_of_child[child] >= 0) {
-      Fail("link '" + raw.child + "' has two parent joints, '" + joints[joint_of_child[child]].name +
-           "' and '" + raw.name + "'");
+      Fail("link '" + raw.child + "' has two parent joints, '" +
+           joints[joint_of_child[child]].name + "' and '" + raw.name + "'");
     }
     joint_of_child[child] = static_cast<int>(joints.size());
     child_joints[link_index[raw.parent]].push_back(static_cast<int>(joints.size()));
@@ -599,8 +604,8 @@ ArticulationDesc Parser::Run(const std::string& text) {
     for (size_t k = 0; k < roots.size() && k < 5; ++k) {
       list += (k ? ", '" : "'") + link_names[roots[k]] + "'";
     }
-    Fail(std::to_string(roots.size()) + " root links (" + list +
-         (roots.size() > 5 ? ", ..." : "") + "); a robot needs exactly one");
+    Fail(std::to_string(roots.size()) + " root links (" + list + (roots.size() > 5 ? ", ..." : "") +
+         "); a robot needs exactly one");
   }
   int root = roots[0];
 

@@ -100,7 +100,8 @@ TEST(MeshTest, ColladaYUpStandsUpAlongZ) {
 }
 
 TEST(MeshTest, GltfEmbeddedBufferAndBaseColour) {
-  std::vector<LoadedMesh> meshes = LoadMeshFile(kMeshDir + "box.gltf", Eigen::Vector3d::Constant(2));
+  std::vector<LoadedMesh> meshes =
+      LoadMeshFile(kMeshDir + "box.gltf", Eigen::Vector3d::Constant(2));
   ASSERT_EQ(meshes.size(), 1u);
   ExpectBounds(*meshes[0].mesh, Eigen::Vector3f(-0.2f, -0.4f, -0.6f),
                Eigen::Vector3f(0.2f, 0.4f, 0.6f));
@@ -177,15 +178,12 @@ TEST(MeshTest, BrokenFileNamesTheFile) {
     LoadMeshFile(p.string());
     FAIL() << "no exception";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("partsim_broken_mesh.stl"), std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("partsim_broken_mesh.stl"), std::string::npos) << e.what();
   }
   std::filesystem::remove(p);
 }
 
-TEST(MeshTest, DirectoryIsNotAMesh) {
-  EXPECT_THROW(LoadMeshFile(kMeshDir), Error);
-}
+TEST(MeshTest, DirectoryIsNotAMesh) { EXPECT_THROW(LoadMeshFile(kMeshDir), Error); }
 
 }  // namespace
 }  // namespace partsim

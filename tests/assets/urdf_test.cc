@@ -146,7 +146,8 @@ TEST_F(ArmTest, MimicFingerBecomesCoupling) {
   // both fingers open outwards, along +y and -y of the hand
   const JointDesc& left = FindLink(arm_, "panda_leftfinger").joint;
   const JointDesc& right = FindLink(arm_, "panda_rightfinger").joint;
-  EXPECT_TRUE((left.pose_in_parent.q * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
+  EXPECT_TRUE(
+      (left.pose_in_parent.q * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
   EXPECT_TRUE(
       (right.pose_in_parent.q * Eigen::Vector3d::UnitX()).isApprox(-Eigen::Vector3d::UnitY()));
 }
@@ -193,8 +194,8 @@ TEST_F(ArmTest, PackageMeshesVisualsAndCollisions) {
   ASSERT_EQ(link0.visuals.size(), 2u);
   EXPECT_TRUE(link0.visuals[0].material.base_color.head<3>().isApprox(
       Eigen::Vector3f(0.95f, 0.95f, 0.95f)));
-  EXPECT_TRUE(link0.visuals[1].material.base_color.head<3>().isApprox(
-      Eigen::Vector3f(0.1f, 0.1f, 0.1f)));
+  EXPECT_TRUE(
+      link0.visuals[1].material.base_color.head<3>().isApprox(Eigen::Vector3f(0.1f, 0.1f, 0.1f)));
   ASSERT_EQ(link0.collisions.size(), 1u);
   EXPECT_EQ(link0.collisions[0].type, ShapeType::kConvexMesh);
   EXPECT_NE(link0.collisions[0].mesh->source.find("collision/link0.stl"), std::string::npos);
@@ -218,7 +219,8 @@ TEST_F(ArmTest, InertialIsDiagonalisedProperly) {
   const LinkDesc& l1 = FindLink(arm_, "panda_link1");
   ASSERT_TRUE(l1.inertial.has_value());
   EXPECT_DOUBLE_EQ(l1.inertial->mass, 4.970684);
-  EXPECT_TRUE(l1.inertial->cmass_local_pose.p.isApprox(Eigen::Vector3d(0.003875, 0.002081, -0.04762)));
+  EXPECT_TRUE(
+      l1.inertial->cmass_local_pose.p.isApprox(Eigen::Vector3d(0.003875, 0.002081, -0.04762)));
   Eigen::Matrix3d tensor;
   tensor << 0.70337, -0.000139, 0.006772, -0.000139, 0.70661, 0.019169, 0.006772, 0.019169,
       0.009117;
@@ -306,7 +308,8 @@ TEST(UrdfTest, CylinderLiesAlongUrdfZ) {
   EXPECT_DOUBLE_EQ(c.half_length, 0.3);
   EXPECT_TRUE(c.pose.p.isApprox(Eigen::Vector3d(1, 2, 3)));
   Eigen::Quaterniond roll(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX()));
-  EXPECT_TRUE((c.pose.q * Eigen::Vector3d::UnitX()).isApprox(roll * Eigen::Vector3d::UnitZ(), 1e-12));
+  EXPECT_TRUE(
+      (c.pose.q * Eigen::Vector3d::UnitX()).isApprox(roll * Eigen::Vector3d::UnitZ(), 1e-12));
   const VisualShape& v = d.links[0].visuals.at(0);
   EXPECT_EQ(v.type, ShapeType::kCylinder);
   EXPECT_DOUBLE_EQ(v.half_length, 0.5);
@@ -350,11 +353,11 @@ TEST(UrdfTest, ScaleMultipliesGeometryOriginsLimitsAndMeshes) {
 }
 
 TEST(UrdfTest, WorldLinkFixedBecomesRootPose) {
-  std::string urdf = Robot("<link name=\"world\"/>" + BoxLink("base") + BoxLink("arm") +
-                           Joint("anchor", "fixed", "world", "base",
-                                 "<origin xyz=\"1 2 0.5\" rpy=\"0 0 1.5707963267948966\"/>") +
-                           Joint("j", "revolute", "base", "arm",
-                                 "<limit lower=\"-1\" upper=\"1\"/>"));
+  std::string urdf =
+      Robot("<link name=\"world\"/>" + BoxLink("base") + BoxLink("arm") +
+            Joint("anchor", "fixed", "world", "base",
+                  "<origin xyz=\"1 2 0.5\" rpy=\"0 0 1.5707963267948966\"/>") +
+            Joint("j", "revolute", "base", "arm", "<limit lower=\"-1\" upper=\"1\"/>"));
   UrdfLoader loader;
   loader.fix_root_link = false;  // the world joint decides
   ArticulationDesc d = loader.Parse(urdf, kMeshDir);
@@ -369,8 +372,7 @@ TEST(UrdfTest, WorldLinkFixedBecomesRootPose) {
 
 TEST(UrdfTest, WorldLinkFloatingFreesRoot) {
   std::string urdf = Robot("<link name=\"world\"/>" + BoxLink("base") +
-                           Joint("free", "floating", "world", "base",
-                                 "<origin xyz=\"0 0 2\"/>"));
+                           Joint("free", "floating", "world", "base", "<origin xyz=\"0 0 2\"/>"));
   ArticulationDesc d = UrdfLoader().Parse(urdf, kMeshDir);
   ASSERT_EQ(d.links.size(), 1u);
   EXPECT_EQ(d.links[0].name, "base");
@@ -445,12 +447,11 @@ TEST(UrdfTest, NoInertialLeavesItUnsetAndDensityApplies) {
 }
 
 TEST(UrdfTest, MimicWithMultiplierAndOffset) {
-  std::string urdf =
-      Robot(BoxLink("a") + BoxLink("b") + BoxLink("c") +
-            Joint("j1", "revolute", "a", "b", "<limit lower=\"-1\" upper=\"1\"/>") +
-            Joint("j2", "revolute", "a", "c",
-                  "<limit lower=\"-2\" upper=\"2\"/>"
-                  "<mimic joint=\"j1\" multiplier=\"-2\" offset=\"0.1\"/>"));
+  std::string urdf = Robot(BoxLink("a") + BoxLink("b") + BoxLink("c") +
+                           Joint("j1", "revolute", "a", "b", "<limit lower=\"-1\" upper=\"1\"/>") +
+                           Joint("j2", "revolute", "a", "c",
+                                 "<limit lower=\"-2\" upper=\"2\"/>"
+                                 "<mimic joint=\"j1\" multiplier=\"-2\" offset=\"0.1\"/>"));
   ArticulationDesc d = UrdfLoader().Parse(urdf, kMeshDir);
   ASSERT_EQ(d.couplings.size(), 1u);
   EXPECT_EQ(d.couplings[0].joint, "j2");
@@ -594,9 +595,9 @@ TEST(UrdfErrorTest, BadNumbers) {
                    {"jt", "zero", "not a number"});
   ExpectParseError(Robot(links + Joint("jc", "fixed", "a", "b", "<origin xyz=\"0 0\"/>")),
                    {"jc", "expected 3"});
-  ExpectParseError(Robot(links + Joint("jl", "revolute", "a", "b",
-                                       "<limit lower=\"-1rad\" upper=\"1\"/>")),
-                   {"jl", "lower", "-1rad"});
+  ExpectParseError(
+      Robot(links + Joint("jl", "revolute", "a", "b", "<limit lower=\"-1rad\" upper=\"1\"/>")),
+      {"jl", "lower", "-1rad"});
   ExpectParseError(Robot("<link name=\"bx\"><collision><geometry><box size=\"1 1\"/>"
                          "</geometry></collision></link>"),
                    {"bx", "box size", "expected 3"});
@@ -614,21 +615,23 @@ TEST(UrdfErrorTest, MissingMeshFile) {
 
 TEST(UrdfErrorTest, UnsupportedJointTypes) {
   std::string links = BoxLink("a") + BoxLink("b");
-  ExpectParseError(Robot(links + Joint("jw", "wobbly", "a", "b")), {"jw", "unknown type", "wobbly"});
+  ExpectParseError(Robot(links + Joint("jw", "wobbly", "a", "b")),
+                   {"jw", "unknown type", "wobbly"});
   ExpectParseError(Robot(links + Joint("j3", "planar", "a", "b")),
                    {"joint 'j3' has type 'planar', which partsim does not support"});
   ExpectParseError(Robot(links + Joint("jf", "floating", "a", "b")), {"jf", "floating"});
-  ExpectParseError(Robot(links + "<joint name=\"jt\"><parent link=\"a\"/><child link=\"b\"/></joint>"),
-                   {"jt", "no type"});
+  ExpectParseError(
+      Robot(links + "<joint name=\"jt\"><parent link=\"a\"/><child link=\"b\"/></joint>"),
+      {"jt", "no type"});
 }
 
 TEST(UrdfErrorTest, LimitsAndAxis) {
   std::string links = BoxLink("a") + BoxLink("b");
   ExpectParseError(Robot(links + Joint("jr", "revolute", "a", "b")), {"jr", "<limit>"});
   ExpectParseError(Robot(links + Joint("jp", "prismatic", "a", "b")), {"jp", "<limit>"});
-  ExpectParseError(Robot(links + Joint("jo", "revolute", "a", "b",
-                                       "<limit lower=\"1\" upper=\"-1\"/>")),
-                   {"jo", "lower"});
+  ExpectParseError(
+      Robot(links + Joint("jo", "revolute", "a", "b", "<limit lower=\"1\" upper=\"-1\"/>")),
+      {"jo", "lower"});
   ExpectParseError(Robot(links + Joint("jz", "revolute", "a", "b",
                                        "<axis xyz=\"0 0 0\"/><limit lower=\"-1\" upper=\"1\"/>")),
                    {"jz", "axis"});
@@ -667,6 +670,73 @@ TEST(UrdfErrorTest, SourceDefaultsToString) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("<string>"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace partsim
+
+namespace partsim {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// loading into a scene
+
+TEST(UrdfSceneTest, ArmLoadsWithItsDofsAndKinematics) {
+  Scene scene;
+  UrdfLoader loader = scene.CreateUrdfLoader();
+  Articulation arm = loader.Load(kArmUrdf);
+  EXPECT_EQ(arm.GetName(), "panda");
+  EXPECT_TRUE(arm.HasFixedRoot());
+  EXPECT_EQ(arm.GetLinks().size(), 12u);
+  // 7 arm joints and one finger; the mimicking finger has no dof of its own
+  ASSERT_EQ(arm.Dof(), 8);
+  Eigen::MatrixX2d lim = arm.GetQlimits();
+  EXPECT_NEAR(lim(3, 0), -3.0718, 1e-12);
+  EXPECT_NEAR(lim(3, 1), -0.0698, 1e-12);
+  EXPECT_NEAR(lim(7, 1), 0.04, 1e-12);
+  EXPECT_NEAR(arm.FindLinkByName("panda_link1").GetMass(), 4.970684, 1e-9);
+
+  // the scene's forward kinematics agree with the published DH chain
+  std::srand(11);
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(8);
+    for (int i = 0; i < 7; ++i) {
+      q[i] = lim(i, 0) + (lim(i, 1) - lim(i, 0)) * (0.5 + 0.4 * Eigen::VectorXd::Random(1)[0]);
+    }
+    q[7] = 0.02;
+    arm.SetQpos(q);
+    Pose flange = arm.FindLinkByName("panda_link8").GetPose();
+    ExpectPoseNear(flange, PandaDh(q.head<7>()), 1e-6);
+    // the mimicking finger mirrors the driven one about the hand
+    Pose hand = arm.FindLinkByName("panda_hand").GetPose();
+    Pose left = hand.Inverse() * arm.FindLinkByName("panda_leftfinger").GetPose();
+    Pose right = hand.Inverse() * arm.FindLinkByName("panda_rightfinger").GetPose();
+    EXPECT_NEAR(left.p.y(), 0.02, 1e-6);
+    EXPECT_NEAR(right.p.y(), -0.02, 1e-6);
+  }
+}
+
+TEST(UrdfSceneTest, FloatingWorldJointFallsUnderGravity) {
+  Scene scene;
+  UrdfLoader loader = scene.CreateUrdfLoader();
+  Articulation a = loader.LoadFromString(
+      Robot("<link name=\"world\"/>" + BoxLink("base") +
+            Joint("free", "floating", "world", "base", "<origin xyz=\"0 0 2\"/>")),
+      kMeshDir);
+  EXPECT_FALSE(a.HasFixedRoot());
+  EXPECT_NEAR(a.GetRootPose().p.z(), 2.0, 1e-9);
+  const double t = 0.2;
+  scene.Step(static_cast<int>(std::lround(t / scene.GetTimestep())));
+  EXPECT_NEAR(a.GetRootPose().p.z(), 2.0 - 0.5 * 9.81 * t * t, 0.01);
+}
+
+TEST(UrdfSceneTest, ErrorsLeaveTheSceneUsable) {
+  Scene scene;
+  UrdfLoader loader = scene.CreateUrdfLoader();
+  EXPECT_THROW(loader.LoadFromString(Robot(BoxLink("a") + BoxLink("a"))), Error);
+  EXPECT_TRUE(scene.GetArticulations().empty());
+  loader.LoadFromString(Robot(BoxLink("a")));
+  EXPECT_EQ(scene.GetArticulations().size(), 1u);
 }
 
 }  // namespace
