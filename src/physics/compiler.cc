@@ -230,8 +230,11 @@ class MjcfWriter {
                       "\" armature=\"" + Num(j.armature) + "\"";
     bool limited = std::isfinite(j.lower) && std::isfinite(j.upper) &&
                    j.type != JointType::kContinuous;
+    // limits hold hard: the shortest time constant MuJoCo accepts, high impedance
     std::string limits =
-        limited ? " limited=\"true\" range=\"" + Num(j.lower) + " " + Num(j.upper) + "\""
+        limited ? " limited=\"true\" range=\"" + Num(j.lower) + " " + Num(j.upper) +
+                      "\" solreflimit=\"" + Num(2.0 * scene_.config.timestep) +
+                      " 1\" solimplimit=\"0.99 0.999 0.001 0.5 2\""
                 : " limited=\"false\"";
     if (limited) ++num_limits_;
     const char* type = j.type == JointType::kPrismatic ? "slide" : "hinge";

@@ -145,6 +145,17 @@ TEST(SceneTest, VelocityDriveTracksVelocityTarget) {
   EXPECT_DOUBLE_EQ(arm.GetDriveVelocityTarget()[0], 0.8);
 }
 
+TEST(SceneTest, JointLimitStopsADrivePushingPastIt) {
+  Scene scene;
+  Articulation arm = AddArm(scene);
+  Joint j3 = arm.FindJointByName("j3");  // prismatic, limits (-0.1, 0.2)
+  j3.SetDriveProperty(5000, 100);
+  j3.SetDriveTarget(0.5);  // 0.3 m beyond the upper limit: about 1500 N against the stop
+  scene.Step(500);
+  EXPECT_LT(j3.GetQpos(), 0.2 + 1e-3);
+  EXPECT_GT(j3.GetQpos(), 0.2 - 1e-3);
+}
+
 TEST(SceneTest, ForceLimitCapsDriveForce) {
   Scene scene;
   Articulation arm = AddArm(scene);
