@@ -111,8 +111,7 @@ ActorBuilder& ActorBuilder::AddSphereCollision(const Pose& pose, double radius,
   AddSphere(desc_, pose, radius, material, density);
   return *this;
 }
-ActorBuilder& ActorBuilder::AddCapsuleCollision(const Pose& pose, double radius,
-                                                double half_length,
+ActorBuilder& ActorBuilder::AddCapsuleCollision(const Pose& pose, double radius, double half_length,
                                                 const std::optional<PhysicalMaterial>& material,
                                                 double density) {
   AddRound(desc_, ShapeType::kCapsule, pose, radius, half_length, material, density);
@@ -154,8 +153,7 @@ ActorBuilder& ActorBuilder::AddBoxVisual(const Pose& pose, const Eigen::Vector3d
   return *this;
 }
 ActorBuilder& ActorBuilder::AddSphereVisual(const Pose& pose, double radius,
-                                            const Eigen::Vector4f& color,
-                                            const std::string& name) {
+                                            const Eigen::Vector4f& color, const std::string& name) {
   VisualShape v = PrimitiveVisual(ShapeType::kSphere, pose, color, name);
   v.radius = radius;
   desc_.visuals.push_back(v);
@@ -215,9 +213,8 @@ LinkBuilder& LinkBuilder::SetJointName(const std::string& name) {
   return *this;
 }
 LinkBuilder& LinkBuilder::SetJointProperties(JointType type, const Eigen::Vector2d& limits,
-                                             const Pose& pose_in_parent,
-                                             const Pose& pose_in_child, double friction,
-                                             double damping) {
+                                             const Pose& pose_in_parent, const Pose& pose_in_child,
+                                             double friction, double damping) {
   JointDesc& j = link().joint;
   j.type = type;
   j.lower = limits[0];
@@ -254,8 +251,7 @@ LinkBuilder& LinkBuilder::AddCapsuleCollision(const Pose& pose, double radius, d
   AddRound(link(), ShapeType::kCapsule, pose, radius, half_length, material, density);
   return *this;
 }
-LinkBuilder& LinkBuilder::AddCylinderCollision(const Pose& pose, double radius,
-                                               double half_length,
+LinkBuilder& LinkBuilder::AddCylinderCollision(const Pose& pose, double radius, double half_length,
                                                const std::optional<PhysicalMaterial>& material,
                                                double density) {
   AddRound(link(), ShapeType::kCylinder, pose, radius, half_length, material, density);
@@ -283,8 +279,7 @@ LinkBuilder& LinkBuilder::AddSphereVisual(const Pose& pose, double radius,
   return *this;
 }
 LinkBuilder& LinkBuilder::AddCapsuleVisual(const Pose& pose, double radius, double half_length,
-                                           const Eigen::Vector4f& color,
-                                           const std::string& name) {
+                                           const Eigen::Vector4f& color, const std::string& name) {
   VisualShape v = PrimitiveVisual(ShapeType::kCapsule, pose, color, name);
   v.radius = radius;
   v.half_length = half_length;
@@ -292,8 +287,7 @@ LinkBuilder& LinkBuilder::AddCapsuleVisual(const Pose& pose, double radius, doub
   return *this;
 }
 LinkBuilder& LinkBuilder::AddCylinderVisual(const Pose& pose, double radius, double half_length,
-                                            const Eigen::Vector4f& color,
-                                            const std::string& name) {
+                                            const Eigen::Vector4f& color, const std::string& name) {
   VisualShape v = PrimitiveVisual(ShapeType::kCylinder, pose, color, name);
   v.radius = radius;
   v.half_length = half_length;
@@ -301,8 +295,7 @@ LinkBuilder& LinkBuilder::AddCylinderVisual(const Pose& pose, double radius, dou
   return *this;
 }
 LinkBuilder& LinkBuilder::AddVisualFromFile(const std::string& filename, const Pose& pose,
-                                            const Eigen::Vector3d& scale,
-                                            const std::string& name) {
+                                            const Eigen::Vector3d& scale, const std::string& name) {
   AddVisualFile(link(), filename, pose, scale, name);
   return *this;
 }

@@ -21,7 +21,9 @@ std::string Num(double v) {
   return buf;
 }
 
-std::string Vec(const Eigen::Vector3d& v) { return Num(v.x()) + " " + Num(v.y()) + " " + Num(v.z()); }
+std::string Vec(const Eigen::Vector3d& v) {
+  return Num(v.x()) + " " + Num(v.y()) + " " + Num(v.z());
+}
 
 std::string Quat(const Eigen::Quaterniond& q) {
   Eigen::Quaterniond n = q.normalized();
@@ -40,9 +42,9 @@ class MjcfWriter {
 
   std::string Write() {
     const SceneConfig& c = scene_.config;
-    const char* integrator = c.integrator == Integrator::kEuler     ? "Euler"
-                             : c.integrator == Integrator::kRK4     ? "RK4"
-                                                                    : "implicit";
+    const char* integrator = c.integrator == Integrator::kEuler ? "Euler"
+                             : c.integrator == Integrator::kRK4 ? "RK4"
+                                                                : "implicit";
     // bodies first: they collect mesh assets and equality constraints
     for (const auto& a : scene_.actors) WriteActor(a.id, a.desc);
     for (const auto& a : scene_.articulations) WriteArticulation(a.id, a.desc);
@@ -61,8 +63,7 @@ class MjcfWriter {
     if (!assets_.str().empty()) out << "  <asset>\n" << assets_.str() << "  </asset>\n";
     out << "  <worldbody>\n" << bodies_.str() << "  </worldbody>\n";
     if (!equality_.str().empty()) out << "  <equality>\n" << equality_.str() << "  </equality>\n";
-    if (!actuators_.str().empty())
-      out << "  <actuator>\n" << actuators_.str() << "  </actuator>\n";
+    if (!actuators_.str().empty()) out << "  <actuator>\n" << actuators_.str() << "  </actuator>\n";
     out << "</mujoco>\n";
     return out.str();
   }
@@ -174,8 +175,10 @@ class MjcfWriter {
     std::vector<std::vector<int>> children(art.links.size());
     int root = -1;
     for (size_t i = 0; i < art.links.size(); ++i) {
-      if (art.links[i].parent < 0) root = static_cast<int>(i);
-      else children[art.links[i].parent].push_back(static_cast<int>(i));
+      if (art.links[i].parent < 0)
+        root = static_cast<int>(i);
+      else
+        children[art.links[i].parent].push_back(static_cast<int>(i));
     }
     WriteLink(id, art, root, children, 0);
     for (const JointCoupling& c : art.couplings) {
@@ -215,8 +218,10 @@ class MjcfWriter {
       WriteJoint(id, index, link.joint, depth + 1);
     }
     bool moves = !(art.fix_root && link.parent < 0);
-    if (moves) WriteInertial(link.inertial, !link.collisions.empty(), depth + 1);
-    else if (link.inertial) WriteInertial(link.inertial, true, depth + 1);
+    if (moves)
+      WriteInertial(link.inertial, !link.collisions.empty(), depth + 1);
+    else if (link.inertial)
+      WriteInertial(link.inertial, true, depth + 1);
     WriteShapes(link.collisions, name, depth + 1);
     for (int c : children[index]) WriteLink(id, art, c, children, depth + 1);
     Indent(depth);
@@ -228,14 +233,14 @@ class MjcfWriter {
     std::string where = " pos=\"" + Vec(j.pose_in_child.p) + "\" axis=\"" + Vec(axis) + "\"";
     std::string dyn = " damping=\"" + Num(j.damping) + "\" frictionloss=\"" + Num(j.friction) +
                       "\" armature=\"" + Num(j.armature) + "\"";
-    bool limited = std::isfinite(j.lower) && std::isfinite(j.upper) &&
-                   j.type != JointType::kContinuous;
+    bool limited =
+        std::isfinite(j.lower) && std::isfinite(j.upper) && j.type != JointType::kContinuous;
     // limits hold hard: the shortest time constant MuJoCo accepts, high impedance
-    std::string limits =
-        limited ? " limited=\"true\" range=\"" + Num(j.lower) + " " + Num(j.upper) +
-                      "\" solreflimit=\"" + Num(2.0 * scene_.config.timestep) +
-                      " 1\" solimplimit=\"0.99 0.999 0.001 0.5 2\""
-                : " limited=\"false\"";
+    std::string limits = limited
+                             ? " limited=\"true\" range=\"" + Num(j.lower) + " " + Num(j.upper) +
+                                   "\" solreflimit=\"" + Num(2.0 * scene_.config.timestep) +
+                                   " 1\" solimplimit=\"0.99 0.999 0.001 0.5 2\""
+                             : " limited=\"false\"";
     if (limited) ++num_limits_;
     const char* type = j.type == JointType::kPrismatic ? "slide" : "hinge";
     Indent(depth);
@@ -247,8 +252,8 @@ class MjcfWriter {
       bodies_ << "<joint name=\"" << ScrewSlideMjName(id, index) << "\" type=\"slide\"" << where
               << " limited=\"false\"/>\n";
       equality_ << "    <joint joint1=\"" << ScrewSlideMjName(id, index) << "\" joint2=\""
-                << JointMjName(id, index) << "\" polycoef=\"0 " << Num(j.pitch)
-                << " 0 0 0\"" << EqualitySolver() << "/>\n";
+                << JointMjName(id, index) << "\" polycoef=\"0 " << Num(j.pitch) << " 0 0 0\""
+                << EqualitySolver() << "/>\n";
       ++num_equalities_;
     }
     // every joint with a dof gets a PD drive actuator; gains are set at run time
@@ -377,7 +382,8 @@ void BuildTables(SceneImpl& s) {
       if (coupled.count(static_cast<int>(i))) continue;
       cj.dof_index = static_cast<int>(c.dof_links.size());
       c.dof_links.push_back(static_cast<int>(i));
-      if (!desc.kinematic) cj.actuator = Id(m, mjOBJ_ACTUATOR, ActuatorMjName(a.id, static_cast<int>(i)));
+      if (!desc.kinematic)
+        cj.actuator = Id(m, mjOBJ_ACTUATOR, ActuatorMjName(a.id, static_cast<int>(i)));
     }
     for (const auto& [li, cp] : coupled) {
       CompiledCoupling cc;

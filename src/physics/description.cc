@@ -10,32 +10,46 @@ namespace partsim {
 
 const char* ShapeTypeName(ShapeType t) {
   switch (t) {
-    case ShapeType::kBox: return "box";
-    case ShapeType::kSphere: return "sphere";
-    case ShapeType::kCapsule: return "capsule";
-    case ShapeType::kCylinder: return "cylinder";
-    case ShapeType::kConvexMesh: return "convex_mesh";
-    case ShapeType::kPlane: return "plane";
+    case ShapeType::kBox:
+      return "box";
+    case ShapeType::kSphere:
+      return "sphere";
+    case ShapeType::kCapsule:
+      return "capsule";
+    case ShapeType::kCylinder:
+      return "cylinder";
+    case ShapeType::kConvexMesh:
+      return "convex_mesh";
+    case ShapeType::kPlane:
+      return "plane";
   }
   return "?";
 }
 
 const char* ActorTypeName(ActorType t) {
   switch (t) {
-    case ActorType::kStatic: return "static";
-    case ActorType::kKinematic: return "kinematic";
-    case ActorType::kDynamic: return "dynamic";
+    case ActorType::kStatic:
+      return "static";
+    case ActorType::kKinematic:
+      return "kinematic";
+    case ActorType::kDynamic:
+      return "dynamic";
   }
   return "?";
 }
 
 const char* JointTypeName(JointType t) {
   switch (t) {
-    case JointType::kFixed: return "fixed";
-    case JointType::kRevolute: return "revolute";
-    case JointType::kContinuous: return "continuous";
-    case JointType::kPrismatic: return "prismatic";
-    case JointType::kScrew: return "screw";
+    case JointType::kFixed:
+      return "fixed";
+    case JointType::kRevolute:
+      return "revolute";
+    case JointType::kContinuous:
+      return "continuous";
+    case JointType::kPrismatic:
+      return "prismatic";
+    case JointType::kScrew:
+      return "screw";
   }
   return "?";
 }
@@ -55,13 +69,13 @@ void CheckPose(const Pose& pose, const std::string& where, const std::string& wh
 }
 
 void CheckNonNegative(double v, const std::string& where, const std::string& what) {
-  Require(std::isfinite(v) && v >= 0.0, where, what + " must be finite and >= 0, got " +
-                                                   std::to_string(v));
+  Require(std::isfinite(v) && v >= 0.0, where,
+          what + " must be finite and >= 0, got " + std::to_string(v));
 }
 
 void CheckPositive(double v, const std::string& where, const std::string& what) {
-  Require(std::isfinite(v) && v > 0.0, where, what + " must be finite and > 0, got " +
-                                                  std::to_string(v));
+  Require(std::isfinite(v) && v > 0.0, where,
+          what + " must be finite and > 0, got " + std::to_string(v));
 }
 
 void CheckMaterial(const PhysicalMaterial& m, const std::string& where, const std::string& what) {
@@ -74,8 +88,8 @@ void CheckMaterial(const PhysicalMaterial& m, const std::string& where, const st
 void CheckBody(const BodyDesc& b, const std::string& where, const std::string& what) {
   for (size_t i = 0; i < b.collisions.size(); ++i) {
     const CollisionShape& s = b.collisions[i];
-    std::string w = what + " collision shape " + std::to_string(i) + " (" +
-                    ShapeTypeName(s.type) + ")";
+    std::string w =
+        what + " collision shape " + std::to_string(i) + " (" + ShapeTypeName(s.type) + ")";
     CheckPose(s.pose, where, w + " pose");
     CheckPositive(s.density, where, w + " density");
     if (s.material) CheckMaterial(*s.material, where, w + " material");
@@ -99,9 +113,9 @@ void CheckBody(const BodyDesc& b, const std::string& where, const std::string& w
       case ShapeType::kConvexMesh: {
         Require(s.mesh != nullptr, where, w + " has no mesh");
         std::string src = s.mesh->source.empty() ? "" : " from " + s.mesh->source;
-        Require(s.mesh->vertices.size() >= 4, where,
-                w + src + " needs at least 4 vertices, has " +
-                    std::to_string(s.mesh->vertices.size()));
+        Require(
+            s.mesh->vertices.size() >= 4, where,
+            w + src + " needs at least 4 vertices, has " + std::to_string(s.mesh->vertices.size()));
         Eigen::Vector3f lo = s.mesh->vertices[0], hi = lo;
         for (const auto& v : s.mesh->vertices) {
           Require(v.allFinite(), where, w + src + " has a non-finite vertex");
@@ -170,8 +184,8 @@ void Validate(const ArticulationDesc& art, const std::string& where) {
     Require(std::isfinite(j.drive.target) && std::isfinite(j.drive.velocity_target), where,
             jw + " drive target must be finite");
   }
-  Require(roots == 1, where, what + " must have exactly one root link, has " +
-                                 std::to_string(roots));
+  Require(roots == 1, where,
+          what + " must have exactly one root link, has " + std::to_string(roots));
   // couplings name existing, independent joints
   std::set<std::string> coupled;
   for (const JointCoupling& c : art.couplings) {

@@ -21,8 +21,9 @@ Eigen::Vector3d V3(const double* v) { return Eigen::Vector3d(v[0], v[1], v[2]); 
 Eigen::Quaterniond Q4(const double* q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]); }
 
 void CheckFinite(const Eigen::Vector3d& v, const std::string& what) {
-  if (!v.allFinite()) throw Error(what + " must be finite, got [" + std::to_string(v.x()) + ", " +
-                                  std::to_string(v.y()) + ", " + std::to_string(v.z()) + "]");
+  if (!v.allFinite())
+    throw Error(what + " must be finite, got [" + std::to_string(v.x()) + ", " +
+                std::to_string(v.y()) + ", " + std::to_string(v.z()) + "]");
 }
 
 void CheckPoseArg(const Pose& pose, const std::string& what) {
@@ -76,7 +77,8 @@ Pose Actor::GetPose() const {
   auto& a = s.GetActor(id_);
   const auto& c = s.Compiled(a);
   if (c.qposadr >= 0) return Pose(V3(s.d->qpos + c.qposadr), Q4(s.d->qpos + c.qposadr + 3));
-  if (c.mocap >= 0) return Pose(V3(s.d->mocap_pos + 3 * c.mocap), Q4(s.d->mocap_quat + 4 * c.mocap));
+  if (c.mocap >= 0)
+    return Pose(V3(s.d->mocap_pos + 3 * c.mocap), Q4(s.d->mocap_quat + 4 * c.mocap));
   return a.desc.pose;
 }
 
@@ -183,7 +185,9 @@ int LinkBody(SceneImpl& s, int art, int index) {
 
 }  // namespace
 
-const std::string& Link::GetName() const { return LinkAt(S(scene_), articulation_id_, index_).name; }
+const std::string& Link::GetName() const {
+  return LinkAt(S(scene_), articulation_id_, index_).name;
+}
 int Link::GetParentIndex() const { return LinkAt(S(scene_), articulation_id_, index_).parent; }
 const LinkDesc& Link::GetDesc() const { return LinkAt(S(scene_), articulation_id_, index_); }
 
@@ -243,7 +247,8 @@ JointRef GetJointRef(Scene* scene, int art, int index) {
   auto& a = s.GetArticulation(art);
   if (index < 1 || index >= static_cast<int>(a.desc.links.size()))
     throw IndexError("joint index " + std::to_string(index) + " out of range [1, " +
-                     std::to_string(a.desc.links.size()) + ") (joint i connects link i to its "
+                     std::to_string(a.desc.links.size()) +
+                     ") (joint i connects link i to its "
                      "parent; the root has none)");
   const auto& c = s.Compiled(a);
   return {&a, &a.desc.links[index].joint, &c.joints[index]};
@@ -253,8 +258,8 @@ JointRef DofJoint(Scene* scene, int art, int index, const char* what) {
   JointRef j = GetJointRef(scene, art, index);
   if (j.compiled->dof_index < 0)
     throw Error(std::string(what) + ": joint '" + j.desc->name + "' has no degree of freedom (" +
-                JointTypeName(j.desc->type) + (j.desc->type == JointType::kFixed ? "" : ", coupled") +
-                ")");
+                JointTypeName(j.desc->type) +
+                (j.desc->type == JointType::kFixed ? "" : ", coupled") + ")");
   return j;
 }
 
@@ -281,8 +286,12 @@ void SyncDrive(SceneImpl& s, const JointRef& j) {
 const std::string& Joint::GetName() const {
   return GetJointRef(scene_, articulation_id_, index_).desc->name;
 }
-JointType Joint::GetType() const { return GetJointRef(scene_, articulation_id_, index_).desc->type; }
-const JointDesc& Joint::GetDesc() const { return *GetJointRef(scene_, articulation_id_, index_).desc; }
+JointType Joint::GetType() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->type;
+}
+const JointDesc& Joint::GetDesc() const {
+  return *GetJointRef(scene_, articulation_id_, index_).desc;
+}
 int Joint::GetDof() const {
   return GetJointRef(scene_, articulation_id_, index_).compiled->dof_index >= 0 ? 1 : 0;
 }
@@ -326,9 +335,15 @@ void Joint::SetLimits(double lower, double upper) {
   s.EnsureCompiled();
 }
 
-double Joint::GetFriction() const { return GetJointRef(scene_, articulation_id_, index_).desc->friction; }
-double Joint::GetDamping() const { return GetJointRef(scene_, articulation_id_, index_).desc->damping; }
-double Joint::GetArmature() const { return GetJointRef(scene_, articulation_id_, index_).desc->armature; }
+double Joint::GetFriction() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->friction;
+}
+double Joint::GetDamping() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->damping;
+}
+double Joint::GetArmature() const {
+  return GetJointRef(scene_, articulation_id_, index_).desc->armature;
+}
 double Joint::GetPitch() const { return GetJointRef(scene_, articulation_id_, index_).desc->pitch; }
 
 void Joint::SetFriction(double v) {
@@ -465,10 +480,14 @@ Eigen::MatrixXd MjMassMatrix(const ArtRef& r) {
 
 }  // namespace
 
-const std::string& Articulation::GetName() const { return S(scene_).GetArticulation(id_).desc.name; }
+const std::string& Articulation::GetName() const {
+  return S(scene_).GetArticulation(id_).desc.name;
+}
 bool Articulation::IsKinematic() const { return S(scene_).GetArticulation(id_).desc.kinematic; }
 bool Articulation::HasFixedRoot() const { return S(scene_).GetArticulation(id_).desc.fix_root; }
-const ArticulationDesc& Articulation::GetDesc() const { return S(scene_).GetArticulation(id_).desc; }
+const ArticulationDesc& Articulation::GetDesc() const {
+  return S(scene_).GetArticulation(id_).desc;
+}
 int Articulation::Dof() const { return GetArt(scene_, id_).dof(); }
 
 std::vector<Link> Articulation::GetLinks() const {
@@ -591,7 +610,8 @@ void Articulation::SetQf(const Eigen::VectorXd& qf) {
   ArtRef r = DynamicArt(scene_, id_, "set_qf");
   CheckVector(qf, r.dof(), "qf", r.owner());
   for (int mj : r.c.mj_dofs) r.s.d->qfrc_applied[mj] = 0;
-  for (int k = 0; k < r.dof(); ++k) r.s.d->qfrc_applied[r.c.joints[r.c.dof_links[k]].dofadr] = qf[k];
+  for (int k = 0; k < r.dof(); ++k)
+    r.s.d->qfrc_applied[r.c.joints[r.c.dof_links[k]].dofadr] = qf[k];
   r.s.Invalidate();
 }
 
@@ -664,7 +684,8 @@ Eigen::Vector3d Articulation::GetRootVelocity() const {
 Eigen::Vector3d Articulation::GetRootAngularVelocity() const {
   ArtRef r = GetArt(scene_, id_);
   if (r.c.root_dofadr < 0) return Eigen::Vector3d::Zero();
-  return Q4(r.s.d->qpos + r.c.root_qposadr + 3).normalized() * V3(r.s.d->qvel + r.c.root_dofadr + 3);
+  return Q4(r.s.d->qpos + r.c.root_qposadr + 3).normalized() *
+         V3(r.s.d->qvel + r.c.root_dofadr + 3);
 }
 
 void Articulation::SetRootVelocity(const Eigen::Vector3d& v) {

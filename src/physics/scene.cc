@@ -20,7 +20,8 @@ SceneImpl::~SceneImpl() {
 SceneImpl::ActorEntry& SceneImpl::GetActor(int id) {
   for (auto& a : actors)
     if (a.id == id) return a;
-  throw Error("actor " + std::to_string(id) + " does not exist (it was removed, or the handle is "
+  throw Error("actor " + std::to_string(id) +
+              " does not exist (it was removed, or the handle is "
               "empty)");
 }
 
@@ -95,7 +96,8 @@ void RestoreNamed(const NamedState& s, const mjModel* m, mjData* d) {
   auto copy = [](const std::map<std::string, std::vector<double>>& from, const std::string& name,
                  double* to, size_t n) {
     auto it = from.find(name);
-    if (it != from.end() && it->second.size() == n) std::copy(it->second.begin(), it->second.end(), to);
+    if (it != from.end() && it->second.size() == n)
+      std::copy(it->second.begin(), it->second.end(), to);
   };
   for (int j = 0; j < m->njnt; ++j) {
     const char* name = mj_id2name(m, mjOBJ_JOINT, j);
@@ -146,8 +148,10 @@ void SceneImpl::EnsureCompiled() {
   if (!new_m) throw Error("MuJoCo could not compile the scene: " + error);
   mjData* new_d = mj_makeData(new_m);
   // carry the state of everything that existed before
-  if (m && d) RestoreNamed(SaveNamed(m, d), new_m, new_d);
-  else new_d->time = 0;
+  if (m && d)
+    RestoreNamed(SaveNamed(m, d), new_m, new_d);
+  else
+    new_d->time = 0;
   if (d) mj_deleteData(d);
   if (m) mj_deleteModel(m);
   m = new_m;
@@ -246,9 +250,10 @@ void SceneImpl::Step(int n) {
     int bad_after = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
                     d->warning[mjWARN_BADQVEL].number;
     if (bad_after != bad_before)
-      warnings.push_back({d->time, "numerical instability (NaN or huge value in positions, "
-                                   "velocities or accelerations): MuJoCo reset the state to the "
-                                   "model's initial configuration"});
+      warnings.push_back({d->time,
+                          "numerical instability (NaN or huge value in positions, "
+                          "velocities or accelerations): MuJoCo reset the state to the "
+                          "model's initial configuration"});
     if (xfrc_dirty) {
       std::fill(d->xfrc_applied, d->xfrc_applied + 6 * m->nbody, 0.0);
       xfrc_dirty = false;
@@ -268,7 +273,8 @@ using internal::CompiledArticulation;
 
 Scene::Scene(const SceneConfig& config) : impl_(std::make_unique<Impl>()) {
   if (!(config.timestep > 0) || !std::isfinite(config.timestep))
-    throw Error("SceneConfig.timestep must be finite and > 0, got " + std::to_string(config.timestep));
+    throw Error("SceneConfig.timestep must be finite and > 0, got " +
+                std::to_string(config.timestep));
   if (!config.gravity.allFinite()) throw Error("SceneConfig.gravity must be finite");
   if (config.solver_iterations < 1)
     throw Error("SceneConfig.solver_iterations must be >= 1, got " +
@@ -395,10 +401,9 @@ void Scene::RemoveActor(const Actor& actor) {
 void Scene::RemoveArticulation(const Articulation& articulation) {
   Impl& s = *impl_;
   s.GetArticulation(articulation.GetId());
-  s.articulations.erase(
-      std::remove_if(s.articulations.begin(), s.articulations.end(),
-                     [&](const auto& a) { return a.id == articulation.GetId(); }),
-      s.articulations.end());
+  s.articulations.erase(std::remove_if(s.articulations.begin(), s.articulations.end(),
+                                       [&](const auto& a) { return a.id == articulation.GetId(); }),
+                        s.articulations.end());
   s.dirty = true;
   s.EnsureCompiled();
 }

@@ -34,8 +34,8 @@ struct CompiledJoint {
   int mj_joint = -1;  ///< main MuJoCo joint (hinge or slide), -1 for fixed
   int qposadr = -1;
   int dofadr = -1;
-  int dof_index = -1;  ///< index in the articulation's qpos, -1 when fixed or coupled
-  int actuator = -1;   ///< drive actuator
+  int dof_index = -1;            ///< index in the articulation's qpos, -1 when fixed or coupled
+  int actuator = -1;             ///< drive actuator
   int screw_slide_qposadr = -1;  ///< screw joints: the coupled slide joint
   int screw_slide_dofadr = -1;
 };
@@ -51,10 +51,10 @@ struct CompiledCoupling {
 
 /// Compiled form of an articulation.
 struct CompiledArticulation {
-  std::vector<int> link_body;   ///< MuJoCo body per link
-  std::vector<int> link_mocap;  ///< kinematic articulations: mocap id per link
+  std::vector<int> link_body;         ///< MuJoCo body per link
+  std::vector<int> link_mocap;        ///< kinematic articulations: mocap id per link
   std::vector<CompiledJoint> joints;  ///< per link (entry 0 unused)
-  std::vector<int> dof_links;   ///< partsim dof -> link index
+  std::vector<int> dof_links;         ///< partsim dof -> link index
   std::vector<CompiledCoupling> couplings;
   int root_qposadr = -1;  ///< free root joint
   int root_dofadr = -1;
@@ -88,7 +88,7 @@ struct SceneImpl {
   mjModel* m = nullptr;
   std::string mjcf;
   bool dirty = true;
-  std::map<int, CompiledActor> compiled_actors;               ///< by actor id
+  std::map<int, CompiledActor> compiled_actors;                ///< by actor id
   std::map<int, CompiledArticulation> compiled_articulations;  ///< by articulation id
   std::vector<GeomOwner> geom_owner;                           ///< per MuJoCo geom
 

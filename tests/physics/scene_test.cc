@@ -21,8 +21,10 @@ double TotalNormalForceZ(const Scene& scene, int actor_id) {
   for (const Contact& c : scene.GetContacts()) {
     for (const ContactPoint& p : c.points) {
       // force is on body1; flip it when the actor is body0
-      if (c.body1.actor_id == actor_id) fz += p.force.z();
-      else if (c.body0.actor_id == actor_id) fz -= p.force.z();
+      if (c.body1.actor_id == actor_id)
+        fz += p.force.z();
+      else if (c.body0.actor_id == actor_id)
+        fz -= p.force.z();
     }
   }
   return fz;
@@ -345,7 +347,9 @@ TEST(SceneTest, FreeRootArticulationFalls) {
   LinkBuilder* root = b.CreateLinkBuilder();
   root->AddBoxCollision(Pose(), Eigen::Vector3d::Constant(0.05));
   LinkBuilder* child = b.CreateLinkBuilder(root);
-  child->SetJointProperties(JointType::kRevolute, Eigen::Vector2d(-1, 1), Pose(Eigen::Vector3d(0.1, 0, 0)), Pose())
+  child
+      ->SetJointProperties(JointType::kRevolute, Eigen::Vector2d(-1, 1),
+                           Pose(Eigen::Vector3d(0.1, 0, 0)), Pose())
       .AddSphereCollision(Pose(Eigen::Vector3d(0.05, 0, 0)), 0.03);
   b.SetInitialPose(Pose(Eigen::Vector3d(0, 0, 2)));
   Articulation art = b.Build(/*fix_root_link=*/false);
@@ -428,7 +432,8 @@ TEST(SceneTest, BadInputThrowsNamedErrorsAndSceneSurvives) {
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("actor 'bad' collision shape 0 (box) half_size"),
-              std::string::npos) << e.what();
+              std::string::npos)
+        << e.what();
   }
   EXPECT_EQ(scene.GetActors().size(), 2u);
   ActorDesc nan_actor;
@@ -462,8 +467,11 @@ TEST(SceneTest, ConvexMeshRestsAtItsExtent) {
   scene.AddGround(0.0);
   auto mesh = std::make_shared<MeshData>();
   // a tetrahedron-ish wedge: bottom face at z = -0.05 in the shape frame
-  mesh->vertices = {{-0.1f, -0.1f, -0.05f}, {0.1f, -0.1f, -0.05f}, {-0.1f, 0.1f, -0.05f},
-                    {0.1f, 0.1f, -0.05f},  {0.0f, 0.0f, 0.15f}};
+  mesh->vertices = {{-0.1f, -0.1f, -0.05f},
+                    {0.1f, -0.1f, -0.05f},
+                    {-0.1f, 0.1f, -0.05f},
+                    {0.1f, 0.1f, -0.05f},
+                    {0.0f, 0.0f, 0.15f}};
   Actor a = scene.CreateActorBuilder()
                 .AddConvexCollisionFromMesh(mesh, Pose(Eigen::Vector3d(0, 0, 0.02)))
                 .SetInitialPose(Pose(Eigen::Vector3d(0, 0, 0.5)))

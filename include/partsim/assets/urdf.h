@@ -12,7 +12,7 @@ namespace partsim {
 
 /// Per-link overrides of the loader's defaults.
 struct UrdfLinkOverride {
-  std::optional<double> density;              ///< kg/m^3 for the link's collision shapes
+  std::optional<double> density;  ///< kg/m^3 for the link's collision shapes
   std::optional<PhysicalMaterial> material;
 };
 
@@ -29,8 +29,8 @@ class UrdfLoader {
   double scale = 1.0;  ///< uniform scale on geometry, origins and prismatic limits
   /// Each mesh file (and each connected component of it) becomes its own convex piece.
   bool load_multiple_collisions_from_file = false;
-  double density = 1000.0;                       ///< kg/m^3 for links without <inertial>
-  std::optional<PhysicalMaterial> material;      ///< default material of collision shapes
+  double density = 1000.0;                                 ///< kg/m^3 for links without <inertial>
+  std::optional<PhysicalMaterial> material;                ///< default material of collision shapes
   std::map<std::string, UrdfLinkOverride> link_overrides;  ///< by link name
   std::map<std::string, std::string> package_dirs;         ///< package name -> folder
 

@@ -1,5 +1,6 @@
 // Rigid transforms. A Pose X_AB is frame B expressed in frame A: a position p (metres) and a unit
-// quaternion q, stored by Eigen as (x, y, z, w) but read and written by partsim's API as w, x, y, z.
+// quaternion q, stored by Eigen as (x, y, z, w) but read and written by partsim's API as w, x, y,
+// z.
 #pragma once
 
 #include <Eigen/Core>

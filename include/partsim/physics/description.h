@@ -29,11 +29,11 @@ struct PhysicalMaterial {
 /// A triangle mesh in metres, in the frame of the shape that holds it.
 struct MeshData {
   std::vector<Eigen::Vector3f> vertices;
-  std::vector<Eigen::Vector3i> faces;   ///< triangles, counter-clockwise seen from outside
-  std::vector<Eigen::Vector3f> normals; ///< per vertex; may be empty
-  std::vector<Eigen::Vector2f> uvs;     ///< per vertex texture coordinates; may be empty
-  std::string source;                   ///< file it came from ("" when built in memory)
-  std::string name;                     ///< sub-mesh or node name in its file ("" if none)
+  std::vector<Eigen::Vector3i> faces;    ///< triangles, counter-clockwise seen from outside
+  std::vector<Eigen::Vector3f> normals;  ///< per vertex; may be empty
+  std::vector<Eigen::Vector2f> uvs;      ///< per vertex texture coordinates; may be empty
+  std::string source;                    ///< file it came from ("" when built in memory)
+  std::string name;                      ///< sub-mesh or node name in its file ("" if none)
 };
 
 /// Geometric primitive or mesh. Sizes follow SAPIEN's conventions: a box has half-sizes; capsules
@@ -46,13 +46,13 @@ const char* ShapeTypeName(ShapeType t);
 /// vertices.
 struct CollisionShape {
   ShapeType type = ShapeType::kBox;
-  Pose pose;                                         ///< X_BS: shape S in body B
+  Pose pose;                                                   ///< X_BS: shape S in body B
   Eigen::Vector3d half_size = Eigen::Vector3d::Constant(0.5);  ///< box half extents (m)
-  double radius = 0.5;                               ///< sphere, capsule, cylinder (m)
-  double half_length = 0.5;                          ///< capsule, cylinder, along local x (m)
-  std::shared_ptr<const MeshData> mesh;              ///< kConvexMesh: vertices already scaled
-  std::optional<PhysicalMaterial> material;          ///< unset: the scene's default material
-  double density = 1000.0;                           ///< kg/m^3, > 0
+  double radius = 0.5;                                         ///< sphere, capsule, cylinder (m)
+  double half_length = 0.5;                  ///< capsule, cylinder, along local x (m)
+  std::shared_ptr<const MeshData> mesh;      ///< kConvexMesh: vertices already scaled
+  std::optional<PhysicalMaterial> material;  ///< unset: the scene's default material
+  double density = 1000.0;                   ///< kg/m^3, > 0
   std::string name;
 };
 
@@ -79,8 +79,8 @@ struct VisualShape {
 /// Explicit mass properties. When a body has none, they follow from its collision shapes'
 /// volumes and densities.
 struct Inertial {
-  double mass = 1.0;                                        ///< kg, > 0
-  Pose cmass_local_pose;                                    ///< centre of mass and principal axes in B
+  double mass = 1.0;      ///< kg, > 0
+  Pose cmass_local_pose;  ///< centre of mass and principal axes in B
   Eigen::Vector3d inertia = Eigen::Vector3d::Constant(1e-3);  ///< principal moments (kg m^2), > 0
 };
 
@@ -113,11 +113,11 @@ const char* JointTypeName(JointType t);
 /// A PD drive on a joint: force = stiffness (target - q) + damping (velocity_target - qdot),
 /// clamped to +-force_limit.
 struct DriveDesc {
-  double stiffness = 0.0;          ///< N/m or N m/rad, >= 0
-  double damping = 0.0;            ///< N s/m or N m s/rad, >= 0
-  double force_limit = kInf;       ///< N or N m, > 0
-  double target = 0.0;             ///< m or rad
-  double velocity_target = 0.0;    ///< m/s or rad/s
+  double stiffness = 0.0;        ///< N/m or N m/rad, >= 0
+  double damping = 0.0;          ///< N s/m or N m s/rad, >= 0
+  double force_limit = kInf;     ///< N or N m, > 0
+  double target = 0.0;           ///< m or rad
+  double velocity_target = 0.0;  ///< m/s or rad/s
 };
 
 /// The joint that connects a link to its parent. The joint frame J is fixed to the parent at
@@ -127,12 +127,12 @@ struct JointDesc {
   JointType type = JointType::kFixed;
   Pose pose_in_parent;
   Pose pose_in_child;
-  double lower = -kInf;      ///< lower limit (m or rad); -inf when unlimited
-  double upper = kInf;       ///< upper limit (m or rad); +inf when unlimited
-  double friction = 0.0;     ///< dry friction (N or N m), >= 0
-  double damping = 0.0;      ///< viscous damping (N s/m or N m s/rad), >= 0
-  double armature = 0.0;     ///< added rotor inertia (kg or kg m^2), >= 0
-  double pitch = 0.0;        ///< screw joints: metres of translation per radian
+  double lower = -kInf;   ///< lower limit (m or rad); -inf when unlimited
+  double upper = kInf;    ///< upper limit (m or rad); +inf when unlimited
+  double friction = 0.0;  ///< dry friction (N or N m), >= 0
+  double damping = 0.0;   ///< viscous damping (N s/m or N m s/rad), >= 0
+  double armature = 0.0;  ///< added rotor inertia (kg or kg m^2), >= 0
+  double pitch = 0.0;     ///< screw joints: metres of translation per radian
   DriveDesc drive;
 };
 
@@ -154,10 +154,10 @@ struct JointCoupling {
 /// A tree of links connected by joints, with a single root (links[0] or the one with parent -1).
 struct ArticulationDesc {
   std::string name;
-  std::vector<LinkDesc> links;       ///< parents come before their children
-  bool fix_root = true;              ///< root welded to the world, else free (6 extra dof)
-  bool kinematic = false;            ///< link poses follow qpos by forward kinematics
-  Pose root_pose;                    ///< X_WR at creation
+  std::vector<LinkDesc> links;  ///< parents come before their children
+  bool fix_root = true;         ///< root welded to the world, else free (6 extra dof)
+  bool kinematic = false;       ///< link poses follow qpos by forward kinematics
+  Pose root_pose;               ///< X_WR at creation
   std::vector<JointCoupling> couplings;
 };
 

@@ -27,11 +27,11 @@ enum class Integrator { kEuler, kImplicit, kRK4 };
 
 /// Scene-wide settings.
 struct SceneConfig {
-  double timestep = 1.0 / 500.0;                      ///< seconds, > 0
+  double timestep = 1.0 / 500.0;                           ///< seconds, > 0
   Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.81);  ///< m/s^2, world frame
   PhysicalMaterial default_material;
-  int solver_iterations = 50;                         ///< constraint solver iterations, >= 1
-  Integrator integrator = Integrator::kImplicit;      ///< implicit handles stiff PD damping
+  int solver_iterations = 50;                     ///< constraint solver iterations, >= 1
+  Integrator integrator = Integrator::kImplicit;  ///< implicit handles stiff PD damping
 };
 
 /// Handle to an actor. Cheap to copy; valid until the actor is removed.
@@ -87,8 +87,8 @@ class Link {
   Pose GetCMassPose() const;
   Eigen::Vector3d GetVelocity() const;         ///< world-frame, at the link origin (m/s)
   Eigen::Vector3d GetAngularVelocity() const;  ///< world-frame (rad/s)
-  double GetMass() const;                       ///< kg
-  Eigen::Vector3d GetInertia() const;           ///< principal moments (kg m^2)
+  double GetMass() const;                      ///< kg
+  Eigen::Vector3d GetInertia() const;          ///< principal moments (kg m^2)
   void AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point);
   const LinkDesc& GetDesc() const;
   Scene* GetScene() const { return scene_; }
@@ -232,22 +232,22 @@ class Articulation {
 
 /// One contact point between two bodies.
 struct ContactPoint {
-  Eigen::Vector3d position;   ///< world (m)
-  Eigen::Vector3d normal;     ///< world, pointing from body 0 to body 1
-  Eigen::Vector3d impulse;    ///< world, impulse on body 1 over the last step (N s)
-  Eigen::Vector3d force;      ///< world, force on body 1 (N)
-  double separation = 0.0;    ///< signed distance (m), negative when penetrating
+  Eigen::Vector3d position;  ///< world (m)
+  Eigen::Vector3d normal;    ///< world, pointing from body 0 to body 1
+  Eigen::Vector3d impulse;   ///< world, impulse on body 1 over the last step (N s)
+  Eigen::Vector3d force;     ///< world, force on body 1 (N)
+  double separation = 0.0;   ///< signed distance (m), negative when penetrating
 };
 
 /// What a contact touches: an actor or a link, and which of its collision shapes.
 struct ContactBody {
   enum class Kind { kActor, kLink };
   Kind kind = Kind::kActor;
-  int actor_id = -1;          ///< kActor
-  int articulation_id = -1;   ///< kLink
-  int link_index = -1;        ///< kLink
-  int shape_index = -1;       ///< index in the body's collisions
-  std::string name;           ///< actor or link name
+  int actor_id = -1;         ///< kActor
+  int articulation_id = -1;  ///< kLink
+  int link_index = -1;       ///< kLink
+  int shape_index = -1;      ///< index in the body's collisions
+  std::string name;          ///< actor or link name
 };
 
 /// The contact between two shapes, with its points.
