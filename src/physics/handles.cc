@@ -747,7 +747,7 @@ Eigen::VectorXd Articulation::ComputePassiveForce(bool gravity, bool coriolis) c
   // qfrc_bias = C(q, qdot) qdot + g(q); gravity alone is the bias at zero velocity
   Eigen::VectorXd bias = MjDofs(r, d->qfrc_bias);
   Eigen::VectorXd grav = Eigen::VectorXd::Zero(bias.size());
-  if (gravity != coriolis || (gravity && coriolis)) {
+  if (gravity || coriolis) {
     std::vector<double> saved(d->qvel, d->qvel + m->nv), g(m->nv);
     std::fill(d->qvel, d->qvel + m->nv, 0.0);
     mj_comVel(m, d);

@@ -305,8 +305,9 @@ void Scene::SetTimestep(double dt) {
   if (!(dt > 0) || !std::isfinite(dt))
     throw Error("timestep must be finite and > 0, got " + std::to_string(dt));
   impl_->config.timestep = dt;
+  // constraint time constants are derived from the timestep: recompile, keeping the state
+  impl_->dirty = true;
   impl_->EnsureCompiled();
-  impl_->m->opt.timestep = dt;
 }
 
 Eigen::Vector3d Scene::GetGravity() const { return impl_->config.gravity; }

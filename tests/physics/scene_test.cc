@@ -448,6 +448,20 @@ TEST(SceneTest, BadInputThrowsNamedErrorsAndSceneSurvives) {
   EXPECT_TRUE(arm.GetQpos().allFinite());
 }
 
+TEST(SceneTest, SetTimestepKeepsStateAndChangesStep) {
+  Scene scene;
+  Actor box = AddBox(scene, 0.1, 5.0);
+  scene.Step(10);
+  Eigen::Vector3d v = box.GetVelocity();
+  scene.SetTimestep(0.001);
+  EXPECT_EQ(box.GetVelocity(), v);
+  EXPECT_NE(scene.GetMjcf().find("timestep=\"0.001\""), std::string::npos);
+  scene.Step(10);
+  EXPECT_NEAR(scene.GetTime(), 10 * 0.002 + 10 * 0.001, 1e-12);
+  EXPECT_NEAR(box.GetVelocity().z(), v.z() - 9.81 * 0.01, 1e-9);
+  EXPECT_THROW(scene.SetTimestep(0.0), Error);
+}
+
 TEST(SceneTest, CloneCopiesDescriptionAndState) {
   Scene scene;
   scene.AddGround(0.0);
