@@ -543,6 +543,10 @@ class Reader {
     std::memcpy(v, buf.data() + pos, sizeof(double) * n);
     pos += sizeof(double) * n;
   }
+  void Skip(size_t n) {
+    Need(n);
+    pos += n;
+  }
   void Need(size_t n) {
     if (pos + n > buf.size())
       throw Error("unpack: state is truncated (" + std::to_string(buf.size()) + " bytes)");
@@ -602,63 +606,40 @@ void Scene::Unpack(const std::vector<char>& state) {
   }
   if (r.Get<int>() != static_cast<int>(s.articulations.size()))
     throw Error("unpack: state has another number of articulations than this scene");
-  // read into a copy first, so that a truncated state changes nothing
-  mjData* tmp = mj_makeData(m);
-  try {
-    tmp->time = r.Get<double>();
-    r.Get(tmp->qpos, m->nq);
-    r.Get(tmp->qvel, m->nv);
-    r.Get(tmp->qacc, m->nv);
-    r.Get(tmp->qacc_warmstart, m->nv);
-    r.Get(tmp->qfrc_applied, m->nv);
-    r.Get(tmp->xfrc_applied, 6 * m->nbody);
-    r.Get(tmp->act, m->na);
-    r.Get(tmp->mocap_pos, 3 * m->nmocap);
-    r.Get(tmp->mocap_quat, 4 * m->nmocap);
-    std::vector<std::pair<double, double>> targets;
-    std::vector<Eigen::VectorXd> kin;
+  // two passes over the same layout: the first only checks it, so that a truncated or foreign
+  // state changes nothing; the second writes
+  const size_t body = r.pos;
+  for (bool write : {false, true}) {
+    r.pos = body;
+    auto get = [&](double* dst, int n) {
+      if (write)
+        r.Get(dst, n);
+      else
+        r.Skip(sizeof(double) * n);
+    };
+    get(&d->time, 1);
+    get(d->qpos, m->nq);
+    get(d->qvel, m->nv);
+    get(d->qacc, m->nv);
+    get(d->qacc_warmstart, m->nv);
+    get(d->qfrc_applied, m->nv);
+    get(d->xfrc_applied, 6 * m->nbody);
+    get(d->act, m->na);
+    get(d->mocap_pos, 3 * m->nmocap);
+    get(d->mocap_quat, 4 * m->nmocap);
     for (auto& a : s.articulations) {
-      for (size_t i = 0; i < a.desc.links.size(); ++i) {
-        double t = r.Get<double>();
-        targets.push_back({t, r.Get<double>()});
+      for (LinkDesc& l : a.desc.links) {
+        get(&l.joint.drive.target, 1);
+        get(&l.joint.drive.velocity_target, 1);
       }
       int n = r.Get<int>();
       if (n != a.kin_qpos.size()) throw Error("unpack: kinematic articulation size differs");
-      Eigen::VectorXd q(n), v(n);
-      r.Get(q.data(), n);
-      r.Get(v.data(), n);
-      kin.push_back(q);
-      kin.push_back(v);
+      get(a.kin_qpos.data(), n);
+      get(a.kin_qvel.data(), n);
     }
     if (r.pos != state.size()) throw Error("unpack: state has trailing bytes");
-    // commit
-    d->time = tmp->time;
-    auto copy = [](const double* from, double* to, int n) { std::copy(from, from + n, to); };
-    copy(tmp->qpos, d->qpos, m->nq);
-    copy(tmp->qvel, d->qvel, m->nv);
-    copy(tmp->qacc, d->qacc, m->nv);
-    copy(tmp->qacc_warmstart, d->qacc_warmstart, m->nv);
-    copy(tmp->qfrc_applied, d->qfrc_applied, m->nv);
-    copy(tmp->xfrc_applied, d->xfrc_applied, 6 * m->nbody);
-    copy(tmp->act, d->act, m->na);
-    copy(tmp->mocap_pos, d->mocap_pos, 3 * m->nmocap);
-    copy(tmp->mocap_quat, d->mocap_quat, 4 * m->nmocap);
-    size_t k = 0, kk = 0;
-    for (auto& a : s.articulations) {
-      for (LinkDesc& l : a.desc.links) {
-        l.joint.drive.target = targets[k].first;
-        l.joint.drive.velocity_target = targets[k].second;
-        ++k;
-      }
-      a.kin_qpos = kin[kk++];
-      a.kin_qvel = kin[kk++];
-    }
-    s.xfrc_dirty = true;
-  } catch (...) {
-    mj_deleteData(tmp);
-    throw;
   }
-  mj_deleteData(tmp);
+  s.xfrc_dirty = true;
   s.Invalidate();
 }
 

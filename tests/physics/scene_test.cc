@@ -278,6 +278,10 @@ TEST(SceneTest, PackUnpackIsBitExact) {
   std::vector<char> truncated(state.begin(), state.begin() + state.size() / 2);
   EXPECT_THROW(scene.Unpack(truncated), Error);
   EXPECT_EQ(scene.Pack(), again);
+  std::vector<char> longer = state;
+  longer.push_back(0);
+  EXPECT_THROW(scene.Unpack(longer), Error);
+  EXPECT_EQ(scene.Pack(), again);
 }
 
 TEST(SceneTest, TwoRunsAreBitIdentical) {
