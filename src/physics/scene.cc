@@ -158,6 +158,7 @@ void SceneImpl::EnsureCompiled() {
   d = new_d;
   mjcf = std::move(xml);
   dirty = false;
+  ++description_version;
   BuildTables(*this);
   for (auto& a : articulations)
     if (a.desc.kinematic) UpdateKinematicArticulation(a);
@@ -291,6 +292,20 @@ std::unique_ptr<Scene> Scene::Clone() const {
   c.actors = impl_->actors;
   c.articulations = impl_->articulations;
   c.next_id = impl_->next_id;
+  c.next_render_id = impl_->next_render_id;
+  c.next_visual_id = impl_->next_visual_id;
+  c.lights = impl_->lights;
+  c.ambient = impl_->ambient;
+  for (const auto& cam : impl_->cameras) {
+    internal::SceneImpl::CameraEntry copy_cam{cam.id,   cam.name, cam.width,     cam.height,
+                                              cam.fx,   cam.fy,   cam.cx,        cam.cy,
+                                              cam.near, cam.far,  cam.local_pose};
+    copy_cam.mount_actor = cam.mount_actor;
+    copy_cam.mount_articulation = cam.mount_articulation;
+    copy_cam.mount_link = cam.mount_link;
+    copy_cam.X_WC = cam.X_WC;
+    c.cameras.push_back(std::move(copy_cam));
+  }
   c.dirty = true;
   c.EnsureCompiled();
   copy->Unpack(Pack());
@@ -349,7 +364,7 @@ Actor Scene::AddActor(const ActorDesc& desc) {
   Impl& s = *impl_;
   s.EnsureCompiled();
   int id = s.next_id;
-  s.actors.push_back({id, desc});
+  s.actors.push_back({id, desc, s.next_render_id, s.next_visual_id});
   s.dirty = true;
   try {
     s.EnsureCompiled();
@@ -361,6 +376,8 @@ Actor Scene::AddActor(const ActorDesc& desc) {
     throw;
   }
   ++s.next_id;
+  ++s.next_render_id;
+  s.next_visual_id += static_cast<uint32_t>(desc.visuals.size());
   return Actor(this, id);
 }
 
@@ -369,7 +386,13 @@ Articulation Scene::AddArticulation(const ArticulationDesc& desc) {
   Impl& s = *impl_;
   s.EnsureCompiled();
   int id = s.next_id;
-  s.articulations.push_back({id, desc, {}, {}});
+  internal::SceneImpl::ArticulationEntry entry{id, desc, {}, {}, s.next_render_id, {}};
+  uint32_t visual_id = s.next_visual_id;
+  for (const LinkDesc& l : desc.links) {
+    entry.visual_id_base.push_back(visual_id);
+    visual_id += static_cast<uint32_t>(l.visuals.size());
+  }
+  s.articulations.push_back(std::move(entry));
   s.dirty = true;
   try {
     s.EnsureCompiled();
@@ -380,6 +403,8 @@ Articulation Scene::AddArticulation(const ArticulationDesc& desc) {
     throw;
   }
   ++s.next_id;
+  s.next_render_id += static_cast<uint32_t>(desc.links.size());
+  s.next_visual_id = visual_id;
   // a new articulation starts at q = 0 clamped into its limits
   Articulation art(this, id);
   Eigen::MatrixX2d lim = art.GetQlimits();

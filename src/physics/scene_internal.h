@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "partsim/physics/scene.h"
+#include "partsim/render/backend.h"
 
 namespace partsim {
 namespace internal {
@@ -72,6 +73,8 @@ struct SceneImpl {
   struct ActorEntry {
     int id;
     ActorDesc desc;
+    uint32_t render_id = 0;       ///< entity id in segmentation images
+    uint32_t visual_id_base = 0;  ///< visual i has id visual_id_base + i
   };
   struct ArticulationEntry {
     int id;
@@ -79,10 +82,35 @@ struct SceneImpl {
     // kinematic articulations keep their joint state here
     Eigen::VectorXd kin_qpos;
     Eigen::VectorXd kin_qvel;
+    uint32_t render_id_base = 0;           ///< link i has entity id render_id_base + i
+    std::vector<uint32_t> visual_id_base;  ///< per link: visual j has id base + j
+  };
+  /// A camera: free (mount_actor < 0 and mount_articulation < 0) or mounted.
+  struct CameraEntry {
+    int id;
+    std::string name;
+    int width, height;
+    double fx, fy, cx, cy, near, far;
+    Pose local_pose;
+    int mount_actor = -1;
+    int mount_articulation = -1;
+    int mount_link = -1;
+    Pose X_WC;  ///< world pose at the last UpdateRender
+    std::unique_ptr<Picture> picture;
   };
   std::vector<ActorEntry> actors;
   std::vector<ArticulationEntry> articulations;
   int next_id = 0;
+  uint32_t next_render_id = 1;
+  uint32_t next_visual_id = 1;
+
+  // rendering
+  std::vector<CameraEntry> cameras;
+  std::vector<LightDesc> lights;
+  Eigen::Vector3f ambient = Eigen::Vector3f::Constant(0.1f);
+  std::unique_ptr<RenderBackend> render_backend;
+  RenderWorld render_world;
+  uint64_t description_version = 0;  ///< bumped whenever actors or articulations change
 
   // model
   mjModel* m = nullptr;

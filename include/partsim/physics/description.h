@@ -87,6 +87,7 @@ struct Inertial {
 /// Shapes and mass properties shared by actors and links.
 struct BodyDesc {
   std::string name;
+  std::string semantic_label;  ///< part label (e.g. "drawer", "handle"), "" if none
   std::vector<CollisionShape> collisions;
   std::vector<VisualShape> visuals;
   std::optional<Inertial> inertial;

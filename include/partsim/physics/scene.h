@@ -18,6 +18,12 @@ struct mjData_;
 namespace partsim {
 
 class Scene;
+class Camera;
+class RenderBackend;
+struct RenderWorld;
+struct LightDesc;
+struct RenderEntityInfo;
+struct RenderVisualInfo;
 class ActorBuilder;
 class ArticulationBuilder;
 class UrdfLoader;
@@ -313,6 +319,39 @@ class Scene {
   std::vector<char> Pack() const;
   /// Restores a state from Pack() of this scene (same actors and articulations).
   void Unpack(const std::vector<char>& state);
+
+  // --- rendering (implemented in src/render) ---
+
+  /// A camera fixed in the world: image size (pixels), vertical field of view (rad), clipping
+  /// distances (m). Place it with Camera::SetLocalPose.
+  Camera AddCamera(const std::string& name, int width, int height, double fovy, double near,
+                   double far);
+  /// A camera that moves with an actor or a link; `local_pose` is X_MC in the mount's frame.
+  Camera AddMountedCamera(const std::string& name, const Actor& mount, const Pose& local_pose,
+                          int width, int height, double fovy, double near, double far);
+  Camera AddMountedCamera(const std::string& name, const Link& mount, const Pose& local_pose,
+                          int width, int height, double fovy, double near, double far);
+  void RemoveCamera(const Camera& camera);
+  std::vector<Camera> GetCameras() const;
+  /// Lights. Directions in the world frame, colours linear RGB, angles in radians.
+  void AddDirectionalLight(const Eigen::Vector3d& direction, const Eigen::Vector3f& color,
+                           bool shadow = false);
+  void AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f& color);
+  void AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d& direction,
+                    double inner_angle, double outer_angle, const Eigen::Vector3f& color,
+                    bool shadow = false);
+  void SetAmbientLight(const Eigen::Vector3f& color);
+  const std::vector<LightDesc>& GetLights() const;
+  /// Chooses the backend: "rasterizer" (default), "pathtracer" or "null"; or a given one.
+  void SetRenderBackend(const std::string& name);
+  void SetRenderBackend(std::unique_ptr<RenderBackend> backend);
+  RenderBackend& GetRenderBackend();
+  /// Copies the current poses of everything visible into the render world.
+  void UpdateRender();
+  const RenderWorld& GetRenderWorld() const;
+  /// Render ids of actors and links, and of visual shapes (ids used by "Segmentation").
+  std::vector<RenderEntityInfo> GetRenderEntities() const;
+  std::vector<RenderVisualInfo> GetRenderVisuals() const;
 
   /// The compiled MuJoCo model and data (compiled on demand). Read freely; writing is at your
   /// own risk.

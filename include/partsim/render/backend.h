@@ -1,0 +1,123 @@
+// The renderer's backend interface. A backend turns a RenderWorld (what is visible, where, under
+// which lights) and a camera into a Picture. The rasterizer (EGL/OpenGL), the path tracer (Embree)
+// and a null backend implement it; Camera::TakePicture validates its arguments and calls one.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "partsim/physics/description.h"
+
+namespace partsim {
+
+/// Light kinds. Directions are in the world frame; spot angles in radians (half angles).
+enum class LightType { kDirectional, kPoint, kSpot };
+
+/// A light of the scene.
+struct LightDesc {
+  LightType type = LightType::kDirectional;
+  Eigen::Vector3f color = Eigen::Vector3f::Ones();     ///< linear RGB radiance scale (W-ish units)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< point and spot (m)
+  Eigen::Vector3d direction = Eigen::Vector3d(0, 0, -1);  ///< directional and spot
+  double inner_angle = 0.3;  ///< spot: full intensity inside this half angle
+  double outer_angle = 0.5;  ///< spot: no light outside this half angle
+  bool shadow = false;       ///< cast shadows (directional and spot in the rasterizer)
+  std::string name;
+};
+
+/// One mesh to draw: geometry in its own frame, where it is, what it is made of, and its ids.
+struct RenderInstance {
+  std::shared_ptr<const MeshData> mesh;  ///< triangles in the visual's frame (scaled)
+  RenderMaterial material;
+  Eigen::Matrix4d X_WV = Eigen::Matrix4d::Identity();  ///< world from visual
+  uint32_t visual_id = 0;                              ///< scene-wide id of the visual shape (>= 1)
+  uint32_t entity_id = 0;  ///< scene-wide id of the actor or link (>= 1)
+};
+
+/// What a backend renders: the snapshot taken by Scene::UpdateRender.
+struct RenderWorld {
+  std::vector<RenderInstance> instances;
+  std::vector<LightDesc> lights;
+  Eigen::Vector3f ambient = Eigen::Vector3f::Constant(0.1f);  ///< ambient light, linear RGB
+  /// Changes when the set of meshes or materials changes (not when only poses change), so that
+  /// backends know when to rebuild their buffers or acceleration structures.
+  uint64_t geometry_version = 0;
+};
+
+/// A camera as the backend sees it.
+/// Frames: the camera pose X_WC uses partsim's camera convention (x forward, y left, z up); the
+/// OpenGL camera frame G (x right, y up, z backward) is X_WC * R_CG; OpenCV's (x right, y down,
+/// z forward) is X_WC * R_CO.
+struct CameraParams {
+  int width = 0;
+  int height = 0;
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();     ///< OpenCV intrinsics (pixels)
+  double near = 0.01;                                  ///< m
+  double far = 100.0;                                  ///< m
+  Pose X_WC;                                           ///< camera pose, x forward, y left, z up
+  Eigen::Matrix4d view = Eigen::Matrix4d::Identity();  ///< world -> OpenGL camera
+  Eigen::Matrix4d projection = Eigen::Matrix4d::Identity();  ///< OpenGL camera -> clip
+};
+
+/// The outputs of one picture, row-major, row 0 at the top of the image.
+struct Picture {
+  int width = 0;
+  int height = 0;
+  std::vector<float> color;     ///< h x w x 4, lit RGBA, linear in [0, 1]
+  std::vector<float> albedo;    ///< h x w x 4, surface colour without lighting
+  std::vector<float> normal;    ///< h x w x 4, unit normal in the OpenGL camera frame, w = 0
+  std::vector<float> position;  ///< h x w x 4, xyz in the OpenGL camera frame (m), w = depth (m);
+                                ///< all 0 where no surface is seen
+  std::vector<uint32_t> segmentation;  ///< h x w x 2: visual id, entity id; 0 = background
+};
+
+/// A rendering backend.
+class RenderBackend {
+ public:
+  virtual ~RenderBackend() = default;
+  /// "rasterizer", "pathtracer" or "null".
+  virtual std::string Name() const = 0;
+  /// A line for logs: which device renders (e.g. the GL_RENDERER string).
+  virtual std::string Device() const = 0;
+  /// Fills every output of `out` (sized width x height). Arguments were validated by the caller.
+  virtual void Render(const RenderWorld& world, const CameraParams& camera, Picture* out) = 0;
+};
+
+/// Fills nothing but the background (for tests that need no pixels).
+std::unique_ptr<RenderBackend> MakeNullBackend();
+
+/// Rasterizer options.
+struct RasterOptions {
+  /// GLSL sources replacing the built-in passes; empty keeps the built-in ones. See
+  /// shaders/README.md for the inputs and outputs each pass must declare.
+  std::string gbuffer_vertex_shader;
+  std::string gbuffer_fragment_shader;
+  std::string lighting_fragment_shader;
+  int shadow_map_size = 2048;
+};
+
+/// OpenGL 4.5 core through headless EGL; on an NVIDIA GPU when there is one, else Mesa's CPU
+/// rasterizer. Throws partsim::Error when no EGL display can be created or a shader fails.
+std::unique_ptr<RenderBackend> MakeRasterBackend(const RasterOptions& options = RasterOptions());
+
+/// Path tracer options.
+struct PathTracerOptions {
+  int samples_per_pixel = 16;  ///< >= 1
+  int max_depth = 4;           ///< bounces, >= 1
+  uint64_t seed = 0;           ///< the same seed gives the same image
+  int threads = 0;             ///< 0: all cores
+};
+
+/// Physically based path tracer on Intel Embree 3.
+std::unique_ptr<RenderBackend> MakePathTracerBackend(
+    const PathTracerOptions& options = PathTracerOptions());
+
+/// A triangle mesh for a primitive visual (box, sphere, capsule, cylinder, plane) in the shape's
+/// frame, with outward normals; capsules and cylinders along x; a plane is a square of
+/// half-size `half_size.x() x half_size.y()` facing +z.
+std::shared_ptr<MeshData> MakePrimitiveMesh(const VisualShape& shape);
+
+}  // namespace partsim
