@@ -10,6 +10,7 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-pytest
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev clang-format
+  libegl-dev libegl-mesa0 libgl1-mesa-dri libopengl-dev libembree-dev libpng-dev
 )
 
 missing=()
