@@ -29,21 +29,7 @@ VisualShape PrimitiveVisual(ShapeType type, const Pose& pose, const Eigen::Vecto
   return v;
 }
 
-// Shape adders shared by actor and link builders.
-void AddBox(BodyDesc& b, const Pose& pose, const Eigen::Vector3d& half_size,
-            const std::optional<PhysicalMaterial>& material, double density) {
-  CollisionShape s = Primitive(ShapeType::kBox, pose, material, density);
-  s.half_size = half_size;
-  b.collisions.push_back(s);
-}
-
-void AddSphere(BodyDesc& b, const Pose& pose, double radius,
-               const std::optional<PhysicalMaterial>& material, double density) {
-  CollisionShape s = Primitive(ShapeType::kSphere, pose, material, density);
-  s.radius = radius;
-  b.collisions.push_back(s);
-}
-
+// Shape adders shared by the builders.
 void AddRound(BodyDesc& b, ShapeType type, const Pose& pose, double radius, double half_length,
               const std::optional<PhysicalMaterial>& material, double density) {
   CollisionShape s = Primitive(type, pose, material, density);
@@ -89,103 +75,126 @@ Inertial MakeInertial(double mass, const Pose& pose, const Eigen::Vector3d& iner
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
-// ActorBuilder
+// BodyBuilder
 
-ActorBuilder& ActorBuilder::SetName(const std::string& name) {
-  desc_.name = name;
-  return *this;
+template <typename D>
+D& BodyBuilder<D>::SetName(const std::string& name) {
+  body().name = name;
+  return self();
 }
-ActorBuilder& ActorBuilder::SetInitialPose(const Pose& pose) {
-  desc_.pose = pose;
-  return *this;
+template <typename D>
+D& BodyBuilder<D>::AddBoxCollision(const Pose& pose, const Eigen::Vector3d& half_size,
+                                   const std::optional<PhysicalMaterial>& material,
+                                   double density) {
+  CollisionShape s = Primitive(ShapeType::kBox, pose, material, density);
+  s.half_size = half_size;
+  body().collisions.push_back(s);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddBoxCollision(const Pose& pose, const Eigen::Vector3d& half_size,
-                                            const std::optional<PhysicalMaterial>& material,
-                                            double density) {
-  AddBox(desc_, pose, half_size, material, density);
-  return *this;
+template <typename D>
+D& BodyBuilder<D>::AddSphereCollision(const Pose& pose, double radius,
+                                      const std::optional<PhysicalMaterial>& material,
+                                      double density) {
+  CollisionShape s = Primitive(ShapeType::kSphere, pose, material, density);
+  s.radius = radius;
+  body().collisions.push_back(s);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddSphereCollision(const Pose& pose, double radius,
-                                               const std::optional<PhysicalMaterial>& material,
-                                               double density) {
-  AddSphere(desc_, pose, radius, material, density);
-  return *this;
+template <typename D>
+D& BodyBuilder<D>::AddCapsuleCollision(const Pose& pose, double radius, double half_length,
+                                       const std::optional<PhysicalMaterial>& material,
+                                       double density) {
+  AddRound(body(), ShapeType::kCapsule, pose, radius, half_length, material, density);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddCapsuleCollision(const Pose& pose, double radius, double half_length,
-                                                const std::optional<PhysicalMaterial>& material,
-                                                double density) {
-  AddRound(desc_, ShapeType::kCapsule, pose, radius, half_length, material, density);
-  return *this;
+template <typename D>
+D& BodyBuilder<D>::AddCylinderCollision(const Pose& pose, double radius, double half_length,
+                                        const std::optional<PhysicalMaterial>& material,
+                                        double density) {
+  AddRound(body(), ShapeType::kCylinder, pose, radius, half_length, material, density);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddCylinderCollision(const Pose& pose, double radius,
-                                                 double half_length,
-                                                 const std::optional<PhysicalMaterial>& material,
-                                                 double density) {
-  AddRound(desc_, ShapeType::kCylinder, pose, radius, half_length, material, density);
-  return *this;
-}
-ActorBuilder& ActorBuilder::AddConvexCollisionFromFile(
-    const std::string& filename, const Pose& pose, const Eigen::Vector3d& scale,
-    const std::optional<PhysicalMaterial>& material, double density) {
+template <typename D>
+D& BodyBuilder<D>::AddConvexCollisionFromFile(const std::string& filename, const Pose& pose,
+                                              const Eigen::Vector3d& scale,
+                                              const std::optional<PhysicalMaterial>& material,
+                                              double density) {
   CheckScale(scale, filename);
-  AddConvexMesh(desc_, LoadMergedMesh(filename, scale), pose, material, density);
-  return *this;
+  AddConvexMesh(body(), LoadMergedMesh(filename, scale), pose, material, density);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddMultipleConvexCollisionsFromFile(
+template <typename D>
+D& BodyBuilder<D>::AddMultipleConvexCollisionsFromFile(
     const std::string& filename, const Pose& pose, const Eigen::Vector3d& scale,
     const std::optional<PhysicalMaterial>& material, double density) {
   CheckScale(scale, filename);
   for (auto& piece : LoadConvexPieces(filename, scale))
-    AddConvexMesh(desc_, piece, pose, material, density);
-  return *this;
+    AddConvexMesh(body(), piece, pose, material, density);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddConvexCollisionFromMesh(
-    std::shared_ptr<const MeshData> mesh, const Pose& pose,
-    const std::optional<PhysicalMaterial>& material, double density) {
-  AddConvexMesh(desc_, std::move(mesh), pose, material, density);
-  return *this;
+template <typename D>
+D& BodyBuilder<D>::AddConvexCollisionFromMesh(std::shared_ptr<const MeshData> mesh,
+                                              const Pose& pose,
+                                              const std::optional<PhysicalMaterial>& material,
+                                              double density) {
+  AddConvexMesh(body(), std::move(mesh), pose, material, density);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddBoxVisual(const Pose& pose, const Eigen::Vector3d& half_size,
-                                         const Eigen::Vector4f& color, const std::string& name) {
+template <typename D>
+D& BodyBuilder<D>::AddBoxVisual(const Pose& pose, const Eigen::Vector3d& half_size,
+                                const Eigen::Vector4f& color, const std::string& name) {
   VisualShape v = PrimitiveVisual(ShapeType::kBox, pose, color, name);
   v.half_size = half_size;
-  desc_.visuals.push_back(v);
-  return *this;
+  body().visuals.push_back(v);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddSphereVisual(const Pose& pose, double radius,
-                                            const Eigen::Vector4f& color, const std::string& name) {
+template <typename D>
+D& BodyBuilder<D>::AddSphereVisual(const Pose& pose, double radius, const Eigen::Vector4f& color,
+                                   const std::string& name) {
   VisualShape v = PrimitiveVisual(ShapeType::kSphere, pose, color, name);
   v.radius = radius;
-  desc_.visuals.push_back(v);
-  return *this;
+  body().visuals.push_back(v);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddCapsuleVisual(const Pose& pose, double radius, double half_length,
-                                             const Eigen::Vector4f& color,
-                                             const std::string& name) {
+template <typename D>
+D& BodyBuilder<D>::AddCapsuleVisual(const Pose& pose, double radius, double half_length,
+                                    const Eigen::Vector4f& color, const std::string& name) {
   VisualShape v = PrimitiveVisual(ShapeType::kCapsule, pose, color, name);
   v.radius = radius;
   v.half_length = half_length;
-  desc_.visuals.push_back(v);
-  return *this;
+  body().visuals.push_back(v);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddCylinderVisual(const Pose& pose, double radius, double half_length,
-                                              const Eigen::Vector4f& color,
-                                              const std::string& name) {
+template <typename D>
+D& BodyBuilder<D>::AddCylinderVisual(const Pose& pose, double radius, double half_length,
+                                     const Eigen::Vector4f& color, const std::string& name) {
   VisualShape v = PrimitiveVisual(ShapeType::kCylinder, pose, color, name);
   v.radius = radius;
   v.half_length = half_length;
-  desc_.visuals.push_back(v);
-  return *this;
+  body().visuals.push_back(v);
+  return self();
 }
-ActorBuilder& ActorBuilder::AddVisualFromFile(const std::string& filename, const Pose& pose,
-                                              const Eigen::Vector3d& scale,
-                                              const std::string& name) {
-  AddVisualFile(desc_, filename, pose, scale, name);
-  return *this;
+template <typename D>
+D& BodyBuilder<D>::AddVisualFromFile(const std::string& filename, const Pose& pose,
+                                     const Eigen::Vector3d& scale, const std::string& name) {
+  AddVisualFile(body(), filename, pose, scale, name);
+  return self();
 }
-ActorBuilder& ActorBuilder::SetMassAndInertia(double mass, const Pose& cmass_local_pose,
-                                              const Eigen::Vector3d& inertia) {
-  desc_.inertial = MakeInertial(mass, cmass_local_pose, inertia);
+template <typename D>
+D& BodyBuilder<D>::SetMassAndInertia(double mass, const Pose& cmass_local_pose,
+                                     const Eigen::Vector3d& inertia) {
+  body().inertial = MakeInertial(mass, cmass_local_pose, inertia);
+  return self();
+}
+
+template class BodyBuilder<ActorBuilder>;
+template class BodyBuilder<LinkBuilder>;
+
+// ---------------------------------------------------------------------------------------------
+// ActorBuilder
+
+ActorBuilder& ActorBuilder::SetInitialPose(const Pose& pose) {
+  desc_.pose = pose;
   return *this;
 }
 
@@ -203,11 +212,8 @@ Actor ActorBuilder::BuildStatic() {
 // LinkBuilder
 
 LinkDesc& LinkBuilder::link() { return owner_->desc_.links[index_]; }
+BodyDesc& LinkBuilder::Body() { return link(); }
 
-LinkBuilder& LinkBuilder::SetName(const std::string& name) {
-  link().name = name;
-  return *this;
-}
 LinkBuilder& LinkBuilder::SetJointName(const std::string& name) {
   link().joint.name = name;
   return *this;
@@ -231,77 +237,6 @@ LinkBuilder& LinkBuilder::SetJointArmature(double armature) {
 }
 LinkBuilder& LinkBuilder::SetScrewPitch(double pitch) {
   link().joint.pitch = pitch;
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddBoxCollision(const Pose& pose, const Eigen::Vector3d& half_size,
-                                          const std::optional<PhysicalMaterial>& material,
-                                          double density) {
-  AddBox(link(), pose, half_size, material, density);
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddSphereCollision(const Pose& pose, double radius,
-                                             const std::optional<PhysicalMaterial>& material,
-                                             double density) {
-  AddSphere(link(), pose, radius, material, density);
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddCapsuleCollision(const Pose& pose, double radius, double half_length,
-                                              const std::optional<PhysicalMaterial>& material,
-                                              double density) {
-  AddRound(link(), ShapeType::kCapsule, pose, radius, half_length, material, density);
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddCylinderCollision(const Pose& pose, double radius, double half_length,
-                                               const std::optional<PhysicalMaterial>& material,
-                                               double density) {
-  AddRound(link(), ShapeType::kCylinder, pose, radius, half_length, material, density);
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddConvexCollisionFromFile(
-    const std::string& filename, const Pose& pose, const Eigen::Vector3d& scale,
-    const std::optional<PhysicalMaterial>& material, double density) {
-  CheckScale(scale, filename);
-  AddConvexMesh(link(), LoadMergedMesh(filename, scale), pose, material, density);
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddBoxVisual(const Pose& pose, const Eigen::Vector3d& half_size,
-                                       const Eigen::Vector4f& color, const std::string& name) {
-  VisualShape v = PrimitiveVisual(ShapeType::kBox, pose, color, name);
-  v.half_size = half_size;
-  link().visuals.push_back(v);
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddSphereVisual(const Pose& pose, double radius,
-                                          const Eigen::Vector4f& color, const std::string& name) {
-  VisualShape v = PrimitiveVisual(ShapeType::kSphere, pose, color, name);
-  v.radius = radius;
-  link().visuals.push_back(v);
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddCapsuleVisual(const Pose& pose, double radius, double half_length,
-                                           const Eigen::Vector4f& color, const std::string& name) {
-  VisualShape v = PrimitiveVisual(ShapeType::kCapsule, pose, color, name);
-  v.radius = radius;
-  v.half_length = half_length;
-  link().visuals.push_back(v);
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddCylinderVisual(const Pose& pose, double radius, double half_length,
-                                            const Eigen::Vector4f& color, const std::string& name) {
-  VisualShape v = PrimitiveVisual(ShapeType::kCylinder, pose, color, name);
-  v.radius = radius;
-  v.half_length = half_length;
-  link().visuals.push_back(v);
-  return *this;
-}
-LinkBuilder& LinkBuilder::AddVisualFromFile(const std::string& filename, const Pose& pose,
-                                            const Eigen::Vector3d& scale, const std::string& name) {
-  AddVisualFile(link(), filename, pose, scale, name);
-  return *this;
-}
-LinkBuilder& LinkBuilder::SetMassAndInertia(double mass, const Pose& cmass_local_pose,
-                                            const Eigen::Vector3d& inertia) {
-  link().inertial = MakeInertial(mass, cmass_local_pose, inertia);
   return *this;
 }
 

@@ -359,22 +359,32 @@ Actor Scene::AddGround(double altitude, const std::optional<PhysicalMaterial>& m
   return AddActor(desc);
 }
 
+namespace {
+
+// Compiles a changed description; if MuJoCo refuses it, undoes the change and recompiles, so that
+// the scene stays as it was, then rethrows.
+template <typename Undo>
+void CompileOrUndo(internal::SceneImpl& s, Undo undo) {
+  s.dirty = true;
+  try {
+    s.EnsureCompiled();
+  } catch (...) {
+    undo();
+    s.dirty = true;
+    s.EnsureCompiled();
+    throw;
+  }
+}
+
+}  // namespace
+
 Actor Scene::AddActor(const ActorDesc& desc) {
   Validate(desc);
   Impl& s = *impl_;
   s.EnsureCompiled();
   int id = s.next_id;
   s.actors.push_back({id, desc, s.next_render_id, s.next_visual_id});
-  s.dirty = true;
-  try {
-    s.EnsureCompiled();
-  } catch (...) {
-    // leave the scene as it was
-    s.actors.pop_back();
-    s.dirty = true;
-    s.EnsureCompiled();
-    throw;
-  }
+  CompileOrUndo(s, [&] { s.actors.pop_back(); });
   ++s.next_id;
   ++s.next_render_id;
   s.next_visual_id += static_cast<uint32_t>(desc.visuals.size());
@@ -393,15 +403,7 @@ Articulation Scene::AddArticulation(const ArticulationDesc& desc) {
     visual_id += static_cast<uint32_t>(l.visuals.size());
   }
   s.articulations.push_back(std::move(entry));
-  s.dirty = true;
-  try {
-    s.EnsureCompiled();
-  } catch (...) {
-    s.articulations.pop_back();
-    s.dirty = true;
-    s.EnsureCompiled();
-    throw;
-  }
+  CompileOrUndo(s, [&] { s.articulations.pop_back(); });
   ++s.next_id;
   s.next_render_id += static_cast<uint32_t>(desc.links.size());
   s.next_visual_id = visual_id;

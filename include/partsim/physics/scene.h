@@ -368,75 +368,89 @@ class Scene {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Builds an actor piece by piece (SAPIEN's ActorBuilder).
-class ActorBuilder {
+/// Shape, visual and mass methods shared by actor and link builders (CRTP: each returns the
+/// derived builder so that calls chain).
+template <typename Derived>
+class BodyBuilder {
  public:
-  explicit ActorBuilder(Scene* scene) : scene_(scene) {}
-
-  ActorBuilder& SetName(const std::string& name);
-  ActorBuilder& SetInitialPose(const Pose& pose);
-  ActorBuilder& AddBoxCollision(const Pose& pose, const Eigen::Vector3d& half_size,
+  Derived& SetName(const std::string& name);
+  /// Box collision with half sizes (m), material (default: the scene's) and density (kg/m^3).
+  Derived& AddBoxCollision(const Pose& pose, const Eigen::Vector3d& half_size,
+                           const std::optional<PhysicalMaterial>& material = {},
+                           double density = 1000.0);
+  Derived& AddSphereCollision(const Pose& pose, double radius,
+                              const std::optional<PhysicalMaterial>& material = {},
+                              double density = 1000.0);
+  /// Capsule along the shape's x axis.
+  Derived& AddCapsuleCollision(const Pose& pose, double radius, double half_length,
+                               const std::optional<PhysicalMaterial>& material = {},
+                               double density = 1000.0);
+  /// Cylinder along the shape's x axis.
+  Derived& AddCylinderCollision(const Pose& pose, double radius, double half_length,
                                 const std::optional<PhysicalMaterial>& material = {},
                                 double density = 1000.0);
-  ActorBuilder& AddSphereCollision(const Pose& pose, double radius,
-                                   const std::optional<PhysicalMaterial>& material = {},
-                                   double density = 1000.0);
-  ActorBuilder& AddCapsuleCollision(const Pose& pose, double radius, double half_length,
-                                    const std::optional<PhysicalMaterial>& material = {},
-                                    double density = 1000.0);
-  ActorBuilder& AddCylinderCollision(const Pose& pose, double radius, double half_length,
-                                     const std::optional<PhysicalMaterial>& material = {},
-                                     double density = 1000.0);
   /// Convex hull of a mesh file's vertices (scaled).
-  ActorBuilder& AddConvexCollisionFromFile(const std::string& filename, const Pose& pose = Pose(),
-                                           const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
-                                           const std::optional<PhysicalMaterial>& material = {},
-                                           double density = 1000.0);
-  /// One convex piece per sub-mesh (or connected component) of a mesh file.
-  ActorBuilder& AddMultipleConvexCollisionsFromFile(
+  Derived& AddConvexCollisionFromFile(const std::string& filename, const Pose& pose = Pose(),
+                                      const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
+                                      const std::optional<PhysicalMaterial>& material = {},
+                                      double density = 1000.0);
+  /// One convex piece per sub-mesh (and connected component) of a mesh file.
+  Derived& AddMultipleConvexCollisionsFromFile(
       const std::string& filename, const Pose& pose = Pose(),
       const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
       const std::optional<PhysicalMaterial>& material = {}, double density = 1000.0);
-  ActorBuilder& AddConvexCollisionFromMesh(std::shared_ptr<const MeshData> mesh,
-                                           const Pose& pose = Pose(),
-                                           const std::optional<PhysicalMaterial>& material = {},
-                                           double density = 1000.0);
-  ActorBuilder& AddBoxVisual(const Pose& pose, const Eigen::Vector3d& half_size,
+  Derived& AddConvexCollisionFromMesh(std::shared_ptr<const MeshData> mesh,
+                                      const Pose& pose = Pose(),
+                                      const std::optional<PhysicalMaterial>& material = {},
+                                      double density = 1000.0);
+  /// Visuals with a linear RGBA colour and an optional name (e.g. a part name).
+  Derived& AddBoxVisual(const Pose& pose, const Eigen::Vector3d& half_size,
+                        const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                        const std::string& name = "");
+  Derived& AddSphereVisual(const Pose& pose, double radius,
+                           const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                           const std::string& name = "");
+  Derived& AddCapsuleVisual(const Pose& pose, double radius, double half_length,
+                            const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
+                            const std::string& name = "");
+  Derived& AddCylinderVisual(const Pose& pose, double radius, double half_length,
                              const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
                              const std::string& name = "");
-  ActorBuilder& AddSphereVisual(const Pose& pose, double radius,
-                                const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
-                                const std::string& name = "");
-  ActorBuilder& AddCapsuleVisual(const Pose& pose, double radius, double half_length,
-                                 const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
-                                 const std::string& name = "");
-  ActorBuilder& AddCylinderVisual(const Pose& pose, double radius, double half_length,
-                                  const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
-                                  const std::string& name = "");
-  ActorBuilder& AddVisualFromFile(const std::string& filename, const Pose& pose = Pose(),
-                                  const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
-                                  const std::string& name = "");
+  /// Every sub-mesh of a file as a visual, with the file's materials.
+  Derived& AddVisualFromFile(const std::string& filename, const Pose& pose = Pose(),
+                             const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
+                             const std::string& name = "");
   /// Explicit mass (kg), centre-of-mass pose in the body and principal inertia (kg m^2).
-  ActorBuilder& SetMassAndInertia(double mass, const Pose& cmass_local_pose,
-                                  const Eigen::Vector3d& inertia);
+  Derived& SetMassAndInertia(double mass, const Pose& cmass_local_pose,
+                             const Eigen::Vector3d& inertia);
 
+ private:
+  BodyDesc& body() { return static_cast<Derived*>(this)->Body(); }
+  Derived& self() { return *static_cast<Derived*>(this); }
+};
+
+/// Builds an actor piece by piece (SAPIEN's ActorBuilder).
+class ActorBuilder : public BodyBuilder<ActorBuilder> {
+ public:
+  explicit ActorBuilder(Scene* scene) : scene_(scene) {}
+
+  ActorBuilder& SetInitialPose(const Pose& pose);
   Actor Build(bool kinematic = false);
   Actor BuildKinematic() { return Build(true); }
   Actor BuildStatic();
   const ActorDesc& GetDesc() const { return desc_; }
+  BodyDesc& Body() { return desc_; }
 
- protected:
-  BodyDesc& body() { return desc_; }
+ private:
   Scene* scene_;
   ActorDesc desc_;
 };
 
 /// Builds one link of an articulation; obtained from ArticulationBuilder::CreateLinkBuilder.
-class LinkBuilder {
+class LinkBuilder : public BodyBuilder<LinkBuilder> {
  public:
   LinkBuilder(ArticulationBuilder* owner, int index) : owner_(owner), index_(index) {}
   int GetIndex() const { return index_; }
-  LinkBuilder& SetName(const std::string& name);
   LinkBuilder& SetJointName(const std::string& name);
   /// Joint to the parent: type, limits (lower, upper), frames, friction and damping.
   LinkBuilder& SetJointProperties(JointType type, const Eigen::Vector2d& limits,
@@ -444,45 +458,16 @@ class LinkBuilder {
                                   double friction = 0.0, double damping = 0.0);
   LinkBuilder& SetJointArmature(double armature);
   LinkBuilder& SetScrewPitch(double pitch);
-  LinkBuilder& AddBoxCollision(const Pose& pose, const Eigen::Vector3d& half_size,
-                               const std::optional<PhysicalMaterial>& material = {},
-                               double density = 1000.0);
-  LinkBuilder& AddSphereCollision(const Pose& pose, double radius,
-                                  const std::optional<PhysicalMaterial>& material = {},
-                                  double density = 1000.0);
-  LinkBuilder& AddCapsuleCollision(const Pose& pose, double radius, double half_length,
-                                   const std::optional<PhysicalMaterial>& material = {},
-                                   double density = 1000.0);
-  LinkBuilder& AddCylinderCollision(const Pose& pose, double radius, double half_length,
-                                    const std::optional<PhysicalMaterial>& material = {},
-                                    double density = 1000.0);
-  LinkBuilder& AddConvexCollisionFromFile(const std::string& filename, const Pose& pose = Pose(),
-                                          const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
-                                          const std::optional<PhysicalMaterial>& material = {},
-                                          double density = 1000.0);
-  LinkBuilder& AddBoxVisual(const Pose& pose, const Eigen::Vector3d& half_size,
-                            const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
-                            const std::string& name = "");
-  LinkBuilder& AddSphereVisual(const Pose& pose, double radius,
-                               const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
-                               const std::string& name = "");
-  LinkBuilder& AddCapsuleVisual(const Pose& pose, double radius, double half_length,
-                                const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
-                                const std::string& name = "");
-  LinkBuilder& AddCylinderVisual(const Pose& pose, double radius, double half_length,
-                                 const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
-                                 const std::string& name = "");
-  LinkBuilder& AddVisualFromFile(const std::string& filename, const Pose& pose = Pose(),
-                                 const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
-                                 const std::string& name = "");
-  LinkBuilder& SetMassAndInertia(double mass, const Pose& cmass_local_pose,
-                                 const Eigen::Vector3d& inertia);
+  BodyDesc& Body();
 
  private:
   LinkDesc& link();
   ArticulationBuilder* owner_;
   int index_;
 };
+
+extern template class BodyBuilder<ActorBuilder>;
+extern template class BodyBuilder<LinkBuilder>;
 
 /// Builds an articulation link by link (SAPIEN's ArticulationBuilder).
 class ArticulationBuilder {
