@@ -1,0 +1,233 @@
+// A hand-written PartNet-Mobility folder (y-up file frame, a hinge with a negative limit, a
+// slider, a body), read, cross-checked and loaded; and each kind of bad folder.
+#include "partsim/assets/partnet_mobility.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace partsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// An axis-aligned box OBJ (outward faces) centred at c with half sizes h.
+std::string BoxObj(Eigen::Vector3d c, Eigen::Vector3d h) {
+  std::string s = "mtllib original.mtl\nusemtl wood\n";
+  for (int i = 0; i < 8; ++i) {
+    Eigen::Vector3d v = c + Eigen::Vector3d((i & 1 ? 1 : -1) * h.x(), (i & 2 ? 1 : -1) * h.y(),
+                                            (i & 4 ? 1 : -1) * h.z());
+    s += "v " + std::to_string(v.x()) + " " + std::to_string(v.y()) + " " + std::to_string(v.z()) +
+         "\n";
+  }
+  s += "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+  return s;
+}
+
+void Write(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p) << text;
+}
+
+// The object, in the file's y-up frame: a body 0.6 wide (x), 0.8 tall (y), 0.4 deep (z, front
+// at +z); a door hinged about the vertical (y) axis at its left edge, opening to negative
+// angles; a drawer sliding out along +z.
+struct Folder {
+  fs::path dir;
+  std::string urdf, json, semantics;
+
+  explicit Folder(const std::string& name) : dir(fs::temp_directory_path() / "partsim_pm" / name) {
+    fs::remove_all(dir);
+    urdf = R"(<?xml version="1.0"?>
+<robot name="cabinet">
+  <link name="base"/>
+  <link name="link_2">
+    <visual name="body-1"><geometry><mesh filename="textured_objs/original-1.obj"/></geometry></visual>
+    <collision><geometry><mesh filename="textured_objs/original-1.obj"/></geometry></collision>
+  </link>
+  <joint name="joint_2" type="fixed"><parent link="base"/><child link="link_2"/></joint>
+  <link name="link_0">
+    <visual name="door-2"><geometry><mesh filename="textured_objs/original-2.obj"/></geometry></visual>
+    <visual name="handle-3"><geometry><mesh filename="textured_objs/original-3.obj"/></geometry></visual>
+    <collision><geometry><mesh filename="textured_objs/original-2.obj"/></geometry></collision>
+  </link>
+  <joint name="joint_0" type="revolute">
+    <origin xyz="-0.3 0.2 0.21"/><axis xyz="0 1 0"/>
+    <parent link="link_2"/><child link="link_0"/>
+    <limit lower="-1.5707963267948966" upper="0" effort="10" velocity="1"/>
+  </joint>
+  <link name="link_1">
+    <visual name="drawer-4"><geometry><mesh filename="textured_objs/original-4.obj"/></geometry></visual>
+    <collision><geometry><mesh filename="textured_objs/original-4.obj"/></geometry></collision>
+  </link>
+  <joint name="joint_1" type="prismatic">
+    <origin xyz="0 -0.2 0"/><axis xyz="0 0 1"/>
+    <parent link="link_2"/><child link="link_1"/>
+    <limit lower="0" upper="0.3" effort="10" velocity="1"/>
+  </joint>
+</robot>
+)";
+    json = R"([
+ {"id": 0, "parent": 2, "joint": "hinge", "name": "rotation_door",
+  "parts": [{"id": 2, "name": "door", "children": []}, {"id": 3, "name": "handle", "children": []}],
+  "jointData": {"axis": {"origin": [-0.3, 0.5, 0.21], "direction": [0, 1, 0]},
+                "limit": {"a": -90, "b": 0, "noLimit": false}}},
+ {"id": 1, "parent": 2, "joint": "slider", "name": "drawer",
+  "parts": [{"id": 4, "name": "drawer", "children": []}],
+  "jointData": {"axis": {"origin": [0, 0, 0], "direction": [0, 0, 1]},
+                "limit": {"a": 0, "b": 0.3, "noLimit": false, "rotates": false}}},
+ {"id": 2, "parent": -1, "joint": "heavy", "name": "cabinet_body",
+  "parts": [{"id": 1, "name": "body", "children": []}], "jointData": {}}
+])";
+    semantics = "link_0 hinge rotation_door\nlink_1 slider drawer\nlink_2 heavy cabinet_body\n";
+    WriteAll();
+  }
+
+  void WriteAll() const {
+    Write(dir / "mobility.urdf", urdf);
+    Write(dir / "mobility_v2.json", json);
+    Write(dir / "semantics.txt", semantics);
+    Write(dir / "meta.json",
+          R"({"model_cat": "StorageFurniture", "model_id": "9001", "anno_id": "a1"})");
+    Write(dir / "bounding_box.json", R"({"min": [-0.3, -0.4, -0.2], "max": [0.3, 0.4, 0.22]})");
+    Write(dir / "textured_objs/original.mtl", "newmtl wood\nKd 0.6 0.4 0.2\n");
+    // body is a shell behind the door (three boxes would be more real; one thin back is enough)
+    Write(dir / "textured_objs/original-1.obj", BoxObj({0, 0, -0.19}, {0.3, 0.4, 0.01}));
+    Write(dir / "textured_objs/original-2.obj", BoxObj({0.15, 0.2, 0.0}, {0.14, 0.19, 0.005}));
+    Write(dir / "textured_objs/original-3.obj", BoxObj({0.25, 0.2, 0.02}, {0.01, 0.05, 0.01}));
+    Write(dir / "textured_objs/original-4.obj", BoxObj({0, -0.0, 0.0}, {0.25, 0.1, 0.15}));
+  }
+  std::string Path() const { return dir.string(); }
+};
+
+void ExpectErrorMentions(const std::string& folder, std::vector<std::string> words) {
+  try {
+    PartNetMobilityLoader().Parse(folder);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    for (const std::string& w : words)
+      EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << e.what() << " lacks " << w;
+  }
+}
+
+TEST(PartNetMobilityTest, ReadsLabelsJointsLimitsAndParts) {
+  Folder f("good");
+  PartNetMobilityObject obj = PartNetMobilityLoader().Parse(f.Path());
+  EXPECT_EQ(obj.category, "StorageFurniture");
+  EXPECT_EQ(obj.model_id, "9001");
+  EXPECT_EQ(obj.articulation.name, "StorageFurniture_9001");
+  ASSERT_EQ(obj.links.size(), 3u);
+  const LinkDesc& door = obj.articulation.links[obj.LinkIndex(0)];
+  EXPECT_EQ(door.semantic_label, "rotation_door");
+  EXPECT_EQ(door.joint.type, JointType::kRevolute);
+  EXPECT_NEAR(door.joint.lower, -M_PI / 2, 1e-9);
+  EXPECT_NEAR(door.joint.upper, 0.0, 1e-12);
+  EXPECT_EQ(obj.articulation.links[obj.LinkIndex(1)].joint.type, JointType::kPrismatic);
+  EXPECT_EQ(obj.articulation.links[obj.LinkIndex(2)].semantic_label, "cabinet_body");
+  EXPECT_EQ(obj.Link(2).joint, "heavy");
+  EXPECT_EQ(PartNetMobilityObject::MotionJointType(obj.Link(0)), JointType::kRevolute);
+  // the handle of the door on link_0
+  std::vector<int> handle = obj.PartVisuals(0, "handle");
+  ASSERT_EQ(handle.size(), 1u);
+  EXPECT_EQ(door.visuals[handle[0]].name, "handle-3");
+  EXPECT_NEAR(obj.bbox_max.z(), 0.22, 1e-12);
+}
+
+TEST(PartNetMobilityTest, LoadsZUpWithTheFilesAxes) {
+  Folder f("zup");
+  Scene scene(SceneConfig{1.0 / 500, Eigen::Vector3d::Zero()});
+  PartNetMobilityLoader loader(&scene);
+  Articulation art = loader.Load(f.Path());
+  EXPECT_EQ(art.Dof(), 2);
+  // the file's vertical y axis is the world's z; its front (+z) is the world's -y
+  Joint door = art.FindJointByName("joint_0");
+  Joint drawer = art.FindJointByName("joint_1");
+  EXPECT_LT((door.GetGlobalAxis() - Eigen::Vector3d::UnitZ()).norm(), 1e-9);
+  EXPECT_LT((drawer.GetGlobalAxis() - Eigen::Vector3d(0, -1, 0)).norm(), 1e-9);
+  // the hinge sits at file (-0.3, *, 0.21) -> world x = -0.3, y = -0.21
+  Pose hinge = door.GetGlobalPose();
+  EXPECT_NEAR(hinge.p.x(), -0.3, 1e-9);
+  EXPECT_NEAR(hinge.p.y(), -0.21, 1e-9);
+  // the door opens to negative angles: driven to -1 it swings its free edge towards +y... and
+  // stays within its limits
+  door.SetDriveProperty(200, 20);
+  door.SetDriveTarget(-1.0);
+  drawer.SetDriveProperty(500, 50);
+  drawer.SetDriveTarget(0.2);
+  scene.Step(1000);
+  EXPECT_NEAR(door.GetQpos(), -1.0, 0.02);
+  EXPECT_NEAR(drawer.GetQpos(), 0.2, 0.01);
+  Pose drawer_pose = art.GetLink(art.FindLinkByName("link_1").GetIndex()).GetPose();
+  EXPECT_NEAR(drawer_pose.p.y(), -0.2, 0.01);  // slid out to the front (world -y)
+}
+
+TEST(PartNetMobilityTest, MissingFileIsNamed) {
+  Folder f("missing");
+  fs::remove(f.dir / "semantics.txt");
+  ExpectErrorMentions(f.Path(), {"semantics.txt", "missing"});
+}
+
+TEST(PartNetMobilityTest, JsonThatDisagreesWithTheUrdfIsNamed) {
+  Folder f("limits");
+  f.json.replace(f.json.find("\"a\": -90"), 8, "\"a\": -60");
+  f.WriteAll();
+  ExpectErrorMentions(f.Path(), {"mobility.urdf", "link_0", "limits"});
+
+  Folder g("type");
+  g.json.replace(g.json.find("\"joint\": \"slider\""), 17, "\"joint\": \"hinge\" ");
+  g.semantics = "link_0 hinge rotation_door\nlink_1 hinge drawer\nlink_2 heavy cabinet_body\n";
+  g.WriteAll();
+  ExpectErrorMentions(g.Path(), {"link_1", "prismatic"});
+
+  Folder h("axis");
+  h.json.replace(h.json.find("[0, 1, 0]"), 9, "[1, 0, 0]");
+  h.WriteAll();
+  ExpectErrorMentions(h.Path(), {"link_0", "axis"});
+
+  Folder s("semantics");
+  s.semantics = "link_0 hinge door\nlink_1 slider drawer\nlink_2 heavy cabinet_body\n";
+  s.WriteAll();
+  ExpectErrorMentions(s.Path(), {"semantics.txt", "link_0", "rotation_door"});
+}
+
+TEST(PartNetMobilityTest, UnknownJointTypeIsNamed) {
+  Folder f("unknown");
+  f.json.replace(f.json.find("\"joint\": \"heavy\""), 16, "\"joint\": \"bolted\"");
+  f.WriteAll();
+  ExpectErrorMentions(f.Path(), {"mobility_v2.json", "link_2", "bolted"});
+}
+
+TEST(PartNetMobilityTest, BrokenObjIsNamedAndTheBatchGoesOn) {
+  Folder good("batch/a_good");
+  Folder bad("batch/b_broken");
+  Write(bad.dir / "textured_objs/original-2.obj", "v 0 0 0\nf 1 2 3\nthis is not an obj\n");
+  ExpectErrorMentions(bad.Path(), {"original-2.obj"});
+  Folder malformed("batch/c_malformed");
+  Write(malformed.dir / "mobility_v2.json", "[{\"id\": 0,");
+  std::vector<PartNetBatchEntry> batch = ParsePartNetMobilityBatch(
+      (fs::temp_directory_path() / "partsim_pm/batch").string(), PartNetMobilityLoader());
+  ASSERT_EQ(batch.size(), 3u);
+  EXPECT_TRUE(batch[0].ok) << batch[0].error;
+  EXPECT_FALSE(batch[1].ok);
+  EXPECT_NE(batch[1].error.find("original-2.obj"), std::string::npos) << batch[1].error;
+  EXPECT_FALSE(batch[2].ok);
+  EXPECT_NE(batch[2].error.find("malformed JSON"), std::string::npos) << batch[2].error;
+}
+
+TEST(PartNetMobilityTest, MultipleCollisionsGiveOnePiecePerFile) {
+  Folder f("pieces");
+  // the door link gets a second collision file
+  f.urdf.replace(f.urdf.find("</link>\n  <joint name=\"joint_0\""), 7,
+                 "<collision><geometry><mesh filename=\"textured_objs/original-3.obj\"/>"
+                 "</geometry></collision></link>");
+  f.WriteAll();
+  PartNetMobilityLoader loader;
+  loader.urdf.load_multiple_collisions_from_file = true;
+  PartNetMobilityObject obj = loader.Parse(f.Path());
+  EXPECT_EQ(obj.articulation.links[obj.LinkIndex(0)].collisions.size(), 2u);
+}
+
+}  // namespace
+}  // namespace partsim
