@@ -1,0 +1,298 @@
+// Quality checks of PartNet-Mobility objects (load, labels, rest, range, visibility) and the
+// statistics table of a dataset.
+#include "partsim/assets/quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <set>
+#include <sstream>
+
+#include "partsim/assets/partnet_mobility.h"
+#include "partsim/physics/scene.h"
+#include "partsim/render/camera.h"
+
+namespace partsim {
+namespace {
+
+// Drive gains for the range check: stiff enough to overcome friction and gravity of household
+// parts, with force limits so that a jammed part cannot force its way through.
+constexpr double kRevoluteStiffness = 200.0, kRevoluteDamping = 20.0, kRevoluteForce = 50.0;
+constexpr double kPrismaticStiffness = 2000.0, kPrismaticDamping = 100.0, kPrismaticForce = 200.0;
+
+QualityCheck Check(const std::string& name, bool passed, const std::string& detail) {
+  return {name, passed, detail};
+}
+
+std::string Fmt(double v) {
+  std::ostringstream s;
+  s << std::setprecision(4) << v;
+  return s.str();
+}
+
+// Undriven, fixed base: how far does each joint move, and does anything blow up?
+QualityCheck RestCheck(Scene& scene, Articulation& art, const QualityOptions& o) {
+  Eigen::VectorXd q0 = art.GetQpos();
+  int steps = static_cast<int>(std::lround(o.rest_seconds / scene.GetTimestep()));
+  scene.Step(steps);
+  Eigen::VectorXd dq = (art.GetQpos() - q0).cwiseAbs();
+  if (!scene.GetWarnings().empty())
+    return Check("rest", false, "numerical trouble: " + scene.GetWarnings()[0].message);
+  if (!dq.allFinite()) return Check("rest", false, "joint positions became non-finite");
+  if (dq.size() == 0) return Check("rest", true, "no movable joint");
+  Eigen::Index worst;
+  double max = dq.maxCoeff(&worst);
+  std::string joint = art.GetActiveJoints()[worst].GetName();
+  return Check(
+      "rest", max <= o.rest_tolerance,
+      "largest motion " + Fmt(max) + " at joint '" + joint + "' in " + Fmt(o.rest_seconds) + " s");
+}
+
+// Each movable dof, driven alone, must cover its range both ways.
+QualityCheck RangeCheck(Scene& scene, Articulation& art, const QualityOptions& o) {
+  std::vector<Joint> joints = art.GetActiveJoints();
+  Eigen::MatrixX2d limits = art.GetQlimits();
+  std::vector<char> state = scene.Pack();
+  int steps = static_cast<int>(std::lround(o.range_seconds / scene.GetTimestep()));
+  std::vector<std::string> jammed;
+  for (size_t k = 0; k < joints.size(); ++k) {
+    scene.Unpack(state);
+    Eigen::VectorXd hold = art.GetQpos();
+    // every other joint holds its rest position; this one goes to each end
+    for (size_t j = 0; j < joints.size(); ++j) {
+      bool rev = joints[j].GetType() != JointType::kPrismatic;
+      joints[j].SetDriveProperty(rev ? kRevoluteStiffness : kPrismaticStiffness,
+                                 rev ? kRevoluteDamping : kPrismaticDamping,
+                                 rev ? kRevoluteForce : kPrismaticForce);
+    }
+    art.SetDriveTarget(hold);
+    double lo = limits(k, 0), hi = limits(k, 1);
+    if (!std::isfinite(lo)) lo = -M_PI;
+    if (!std::isfinite(hi)) hi = M_PI;
+    double span = hi - lo;
+    for (double end : {hi, lo}) {
+      joints[k].SetDriveTarget(end);
+      scene.Step(steps);
+      double q = art.GetQpos()[k];
+      if (std::abs(q - end) > (1.0 - o.range_fraction) * span) {
+        jammed.push_back("'" + joints[k].GetName() + "' stopped at " + Fmt(q) + " on its way to " +
+                         Fmt(end));
+        break;
+      }
+    }
+  }
+  scene.Unpack(state);
+  for (Joint& j : joints) j.SetDriveProperty(0, 0);
+  if (jammed.empty())
+    return Check("range", true, std::to_string(joints.size()) + " parts cover their ranges");
+  std::string detail = std::to_string(jammed.size()) + " jammed: " + jammed[0];
+  for (size_t i = 1; i < std::min<size_t>(jammed.size(), 3); ++i) detail += "; " + jammed[i];
+  return Check("range", false, detail);
+}
+
+// Six views around the object, from slightly above: each movable link's render id must show.
+QualityCheck VisibilityCheck(Scene& scene, Articulation& art, const QualityOptions& o) {
+  // the object's extent from its links' rest positions and shapes' offsets
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+  for (const Link& l : art.GetLinks()) {
+    Pose X = l.GetPose();
+    for (const VisualShape& v : l.GetDesc().visuals) {
+      if (!v.mesh) continue;
+      for (const auto& p : v.mesh->vertices) {
+        Eigen::Vector3d w = X.Transform(v.pose.Transform(p.cast<double>()));
+        lo = lo.cwiseMin(w);
+        hi = hi.cwiseMax(w);
+      }
+    }
+  }
+  if (lo.x() > hi.x()) return Check("visible", false, "the object has no mesh visuals");
+  Eigen::Vector3d centre = 0.5 * (lo + hi);
+  double radius = std::max(0.5 * (hi - lo).norm(), 0.02);
+  const double fovy = 0.8;
+  double distance = radius / std::sin(0.5 * fovy) * 1.05;
+  scene.SetRenderBackend(o.render_backend);
+  scene.AddDirectionalLight(Eigen::Vector3d(-0.3, 0.4, -1), Eigen::Vector3f(1, 1, 1));
+  std::vector<Camera> cams;
+  const double pitch = 0.45;
+  for (int i = 0; i < 6; ++i) {
+    // five around (front first: the object's front faces world -y) and one from above
+    double yaw = -M_PI / 2 + i * 2 * M_PI / 5;
+    Eigen::Vector3d dir = i < 5 ? Eigen::Vector3d(std::cos(yaw) * std::cos(pitch),
+                                                  std::sin(yaw) * std::cos(pitch), std::sin(pitch))
+                                : Eigen::Vector3d(0.01, -0.3, 1.0).normalized();
+    Eigen::Vector3d eye = centre + distance * dir;
+    // camera x forward (towards the centre), z up
+    Eigen::Vector3d fwd = (centre - eye).normalized();
+    Eigen::Vector3d left = Eigen::Vector3d::UnitZ().cross(fwd).normalized();
+    Eigen::Vector3d up = fwd.cross(left);
+    Eigen::Matrix3d R;
+    R << fwd, left, up;
+    Camera cam = scene.AddCamera("quality_" + std::to_string(i), o.image_size, o.image_size, fovy,
+                                 0.01, 10 * distance + 1);
+    cam.SetLocalPose(Pose(eye, Eigen::Quaterniond(R)));
+    cams.push_back(cam);
+  }
+  scene.UpdateRender();
+  std::set<uint32_t> seen;
+  for (Camera& cam : cams) {
+    cam.TakePicture();
+    const std::vector<uint32_t>& seg = cam.GetUintPicture("Segmentation");
+    for (size_t p = 1; p < seg.size(); p += 2) seen.insert(seg[p]);
+  }
+  for (Camera& cam : cams) scene.RemoveCamera(cam);
+  // map entity ids to links of this articulation
+  std::vector<std::string> hidden;
+  std::vector<RenderEntityInfo> entities = scene.GetRenderEntities();
+  for (const Joint& j : art.GetActiveJoints()) {
+    int link = j.GetChildLink().GetIndex();
+    for (const RenderEntityInfo& e : entities) {
+      if (!e.is_link || e.articulation_id != art.GetId() || e.link_index != link) continue;
+      if (!seen.count(e.id) && !art.GetLink(link).GetDesc().visuals.empty())
+        hidden.push_back(e.name);
+    }
+  }
+  if (hidden.empty()) return Check("visible", true, "every movable part shows in some view");
+  return Check("visible", false,
+               std::to_string(hidden.size()) + " parts never show, e.g. '" + hidden[0] + "'");
+}
+
+}  // namespace
+
+bool ObjectQualityReport::Passed() const {
+  return !checks.empty() &&
+         std::all_of(checks.begin(), checks.end(), [](const QualityCheck& c) { return c.passed; });
+}
+
+std::string ObjectQualityReport::ToString() const {
+  std::ostringstream s;
+  s << (Passed() ? "PASS " : "FAIL ") << folder << " (" << category << ", " << movable_parts
+    << " movable parts)\n";
+  for (const QualityCheck& c : checks)
+    s << "  " << (c.passed ? "ok   " : "FAIL ") << c.name << ": " << c.detail << "\n";
+  return s.str();
+}
+
+ObjectQualityReport CheckPartNetObject(const std::string& folder, const QualityOptions& o) {
+  ObjectQualityReport report;
+  report.folder = folder;
+  PartNetMobilityObject obj;
+  try {
+    obj = PartNetMobilityLoader().Parse(folder);
+  } catch (const Error& e) {
+    report.checks.push_back(Check("load", false, e.what()));
+    return report;
+  }
+  report.category = obj.category;
+  report.model_id = obj.model_id;
+  for (const PartNetLink& l : obj.links)
+    report.movable_parts += l.joint == "hinge" || l.joint == "slider";
+  // the reader has cross-checked URDF, mobility_v2.json and semantics.txt
+  report.checks.push_back(Check("labels", true,
+                                "URDF, mobility_v2.json and semantics.txt agree on " +
+                                    std::to_string(obj.links.size()) + " links"));
+  try {
+    Scene scene;
+    Articulation art = scene.AddArticulation(obj.articulation);
+    report.checks.push_back(Check("load", true, std::to_string(art.Dof()) + " dof"));
+    report.checks.push_back(RestCheck(scene, art, o));
+    report.checks.push_back(RangeCheck(scene, art, o));
+    if (o.check_visibility) report.checks.push_back(VisibilityCheck(scene, art, o));
+  } catch (const Error& e) {
+    report.checks.push_back(Check("load", false, e.what()));
+  }
+  return report;
+}
+
+void DatasetStatistics::Add(const std::string& category, int movable_parts) {
+  auto& entry = per_category[category];
+  entry.first += 1;
+  entry.second += movable_parts;
+  models += 1;
+  parts += movable_parts;
+}
+
+std::string DatasetStatistics::ToTable(bool with_paper) const {
+  std::set<std::string> cats;
+  for (const auto& [c, v] : per_category) cats.insert(c);
+  if (with_paper)
+    for (const auto& [c, v] : PaperStatistics()) cats.insert(c);
+  std::ostringstream s;
+  s << std::left << std::setw(16) << "category" << std::right << std::setw(8) << "#M"
+    << std::setw(8) << "#P";
+  if (with_paper) s << std::setw(12) << "paper #M" << std::setw(10) << "paper #P";
+  s << "\n";
+  auto row = [&](const std::string& name, int m, int p, int pm, int pp) {
+    s << std::left << std::setw(16) << name << std::right << std::setw(8) << m << std::setw(8) << p;
+    if (with_paper) s << std::setw(12) << pm << std::setw(10) << pp;
+    s << "\n";
+  };
+  int paper_m = 0, paper_p = 0;
+  for (const std::string& c : cats) {
+    auto it = per_category.find(c);
+    auto pit = PaperStatistics().find(c);
+    int pm = pit == PaperStatistics().end() ? 0 : pit->second.first;
+    int pp = pit == PaperStatistics().end() ? 0 : pit->second.second;
+    paper_m += pm;
+    paper_p += pp;
+    row(c, it == per_category.end() ? 0 : it->second.first,
+        it == per_category.end() ? 0 : it->second.second, pm, pp);
+  }
+  row("All", models, parts, paper_m, paper_p);
+  return s.str();
+}
+
+const std::map<std::string, std::pair<int, int>>& PaperStatistics() {
+  // Table 1 of the SAPIEN paper (its "Cabinet" is StorageFurniture, "Monitor" Display,
+  // the second "Chair" FoldingChair)
+  static const std::map<std::string, std::pair<int, int>> table = {
+      {"Bottle", {57, 114}},
+      {"Box", {28, 94}},
+      {"Bucket", {36, 74}},
+      {"StorageFurniture", {345, 1174}},
+      {"Camera", {37, 341}},
+      {"Cart", {61, 232}},
+      {"Chair", {80, 1235}},
+      {"Clock", {31, 106}},
+      {"CoffeeMachine", {55, 374}},
+      {"Dishwasher", {48, 112}},
+      {"Dispenser", {57, 162}},
+      {"Door", {36, 103}},
+      {"Eyeglasses", {65, 195}},
+      {"Fan", {81, 172}},
+      {"Faucet", {84, 228}},
+      {"FoldingChair", {26, 58}},
+      {"Refrigerator", {44, 118}},
+      {"Globe", {61, 130}},
+      {"Kettle", {29, 66}},
+      {"Keyboard", {37, 3593}},
+      {"Knife", {44, 149}},
+      {"Lamp", {45, 165}},
+      {"Laptop", {56, 112}},
+      {"Lighter", {28, 86}},
+      {"Microwave", {16, 85}},
+      {"Display", {37, 93}},
+      {"Mouse", {14, 61}},
+      {"Oven", {30, 214}},
+      {"Pen", {48, 97}},
+      {"Phone", {17, 271}},
+      {"Pliers", {25, 59}},
+      {"KitchenPot", {25, 53}},
+      {"Printer", {29, 376}},
+      {"Remote", {49, 1490}},
+      {"Safe", {30, 202}},
+      {"Scissors", {47, 94}},
+      {"Stapler", {23, 69}},
+      {"Suitcase", {24, 101}},
+      {"Switch", {70, 195}},
+      {"Table", {101, 420}},
+      {"Toaster", {25, 116}},
+      {"Toilet", {69, 229}},
+      {"TrashCan", {70, 208}},
+      {"USB", {51, 103}},
+      {"WashingMachine", {17, 144}},
+      {"Window", {58, 195}},
+  };
+  return table;
+}
+
+}  // namespace partsim
