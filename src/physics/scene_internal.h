@@ -5,6 +5,7 @@
 #include <mujoco/mujoco.h>
 
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -96,7 +97,10 @@ struct SceneImpl {
     int mount_articulation = -1;
     int mount_link = -1;
     Pose X_WC;  ///< world pose at the last UpdateRender
-    std::unique_ptr<Picture> picture;
+    /// The last picture; shared with the numpy views Python holds, so that TakePicture renders
+    /// into a new one while an older one is still viewed.
+    std::shared_ptr<Picture> picture;
+    Pose picture_X_WC;  ///< the camera pose the picture was taken from
   };
   std::vector<ActorEntry> actors;
   std::vector<ArticulationEntry> articulations;
@@ -111,6 +115,20 @@ struct SceneImpl {
   std::unique_ptr<RenderBackend> render_backend;
   RenderWorld render_world;
   uint64_t description_version = 0;  ///< bumped whenever actors or articulations change
+  /// Where each render_world instance comes from (src/render/scene_render.cc): an actor, or a
+  /// link of an articulation, and the visual's pose in that body.
+  struct RenderSource {
+    int actor_id = -1;
+    int articulation_id = -1;
+    int link_index = -1;
+    Pose X_BV;
+  };
+  std::vector<RenderSource> render_sources;  ///< one per render_world.instances entry
+  bool render_world_built = false;           ///< UpdateRender has run at least once
+  uint64_t render_world_description = 0;     ///< description_version the instances follow
+  /// Meshes of primitive visuals by their parameters, kept across rebuilds so that the same
+  /// primitive keeps the same pointer (backends cache their buffers by pointer).
+  std::map<std::string, std::shared_ptr<const MeshData>> primitive_meshes;
 
   // model
   mjModel* m = nullptr;

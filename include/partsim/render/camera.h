@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,9 @@ class Camera {
   void TakePicture();
   /// All outputs of the last picture; throws if none was taken.
   const Picture& GetPictureData() const;
+  /// The last picture, shared: it stays valid (and unchanged) after later TakePicture calls,
+  /// which then render into a new Picture. Python's numpy views hold this. Throws if none.
+  std::shared_ptr<const Picture> GetSharedPicture() const;
   /// One float output by name ("Color", "Albedo", "Normal", "Position"): h x w x 4 values.
   const std::vector<float>& GetFloatPicture(const std::string& name) const;
   /// "Segmentation": h x w x 2 (visual id, entity id).

@@ -1,0 +1,83 @@
+// Pictures to files and point clouds: depth images in metres, point clouds in the camera or the
+// world frame with colours and segmentation ids, PNG (8-bit colour, 16-bit depth, indexed
+// segmentation colours), PLY and NPY. Every writer throws partsim::Error naming the path when the
+// file cannot be written.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "partsim/core/pose.h"
+#include "partsim/render/backend.h"
+
+namespace partsim {
+
+class Camera;
+
+/// Depth image (h x w, row-major, metres along the view axis), 0 where no surface is seen.
+std::vector<float> DepthImage(const Picture& picture);
+
+/// Frame of point cloud positions: the OpenGL camera frame (x right, y up, z backward) of the
+/// picture, or the world.
+enum class PointCloudFrame { kCamera, kWorld };
+
+/// Points seen by a camera: one per pixel that sees a surface, in row-major pixel order.
+struct PointCloud {
+  std::vector<float> positions;      ///< N x 3 (m)
+  std::vector<uint8_t> colors;       ///< N x 4 RGBA, sRGB-encoded colour; empty for none
+  std::vector<uint32_t> visual_ids;  ///< N visual ids (segmentation channel 0); empty for none
+  std::vector<uint32_t> entity_ids;  ///< N actor or link ids (channel 1); empty for none
+  /// Number of points.
+  size_t Size() const { return positions.size() / 3; }
+};
+
+/// Point cloud of a picture. With kWorld, `X_WC` (partsim camera convention: x forward, y left,
+/// z up) places the camera in the world; it is ignored with kCamera.
+PointCloud MakePointCloud(const Picture& picture, PointCloudFrame frame = PointCloudFrame::kCamera,
+                          const Pose& X_WC = Pose());
+/// Point cloud of a camera's last picture, placed with the pose the picture was taken from.
+PointCloud MakePointCloud(const Camera& camera, PointCloudFrame frame = PointCloudFrame::kCamera);
+
+/// sRGB 8-bit encoding of linear RGBA floats (clamped to [0, 1]; alpha stays linear).
+std::vector<uint8_t> ToRgba8(const std::vector<float>& rgba);
+
+/// Colour of a segmentation id: black for 0 (background), else a fixed bright colour that
+/// depends only on the id (so images of several views and runs agree).
+std::array<uint8_t, 3> SegmentationColor(uint32_t id);
+
+/// 8-bit PNG with `channels` 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA): row-major pixels,
+/// top row first, width x height x channels bytes.
+void WritePng(const std::string& path, int width, int height, int channels, const uint8_t* pixels);
+/// 16-bit greyscale PNG (width x height values).
+void WritePng16(const std::string& path, int width, int height, const uint16_t* pixels);
+
+/// The picture's colour as an 8-bit sRGB RGBA PNG.
+void WriteColorPng(const std::string& path, const Picture& picture);
+/// Depth (width x height, metres, 0 = nothing) as a 16-bit PNG in millimetres, rounded and
+/// clamped to 65535; 0 stays 0.
+void WriteDepthPng(const std::string& path, int width, int height, const float* depth);
+void WriteDepthPng(const std::string& path, const Picture& picture);
+/// The picture's camera-frame normals as an RGB PNG: (n + 1) / 2 per channel; black where
+/// nothing is seen.
+void WriteNormalPng(const std::string& path, const Picture& picture);
+/// Segmentation ids (width x height values, `stride` apart) in the colours of
+/// SegmentationColor; background black.
+void WriteSegmentationPng(const std::string& path, int width, int height, const uint32_t* ids,
+                          int stride = 1);
+/// One channel of the picture's segmentation: 0 visual ids, 1 actor / link ids.
+void WriteSegmentationPng(const std::string& path, const Picture& picture, int channel = 1);
+
+/// PLY with vertex properties x y z (float), red green blue alpha (uchar), visual_id and
+/// entity_id (uint); binary little-endian or ASCII. Missing colours are written white, missing
+/// ids 0. Throws if the arrays of `cloud` disagree in length.
+void WritePly(const std::string& path, const PointCloud& cloud, bool binary = true);
+
+/// NumPy .npy (format 1.0, C order) of float32 or uint32 values with the given shape; the
+/// product of `shape` must equal the number of values.
+void WriteNpy(const std::string& path, const float* data, const std::vector<size_t>& shape);
+void WriteNpy(const std::string& path, const uint32_t* data, const std::vector<size_t>& shape);
+
+}  // namespace partsim

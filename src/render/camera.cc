@@ -1,0 +1,219 @@
+// Camera handles: intrinsics, poses and matrices, and pictures taken with the scene's backend.
+#include "partsim/render/camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "partsim/render/camera_math.h"
+#include "partsim/render/image_io.h"
+#include "physics/scene_internal.h"
+
+namespace partsim {
+
+using internal::SceneImpl;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+SceneImpl::CameraEntry& Entry(Scene* scene, int id) {
+  if (!scene) throw Error("empty camera handle: it does not belong to a scene");
+  for (auto& c : scene->impl().cameras)
+    if (c.id == id) return c;
+  throw Error("camera " + std::to_string(id) + " does not exist (it was removed)");
+}
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
+const Picture& PictureOf(const SceneImpl::CameraEntry& c) {
+  if (!c.picture)
+    throw Error("camera '" + c.name + "': no picture yet (call take_picture() first)");
+  return *c.picture;
+}
+
+}  // namespace
+
+bool IsFloatPictureName(const std::string& name) {
+  return name == "Color" || name == "Albedo" || name == "Normal" || name == "Position";
+}
+
+const std::string& Camera::GetName() const { return Entry(scene_, id_).name; }
+int Camera::GetWidth() const { return Entry(scene_, id_).width; }
+int Camera::GetHeight() const { return Entry(scene_, id_).height; }
+double Camera::GetNear() const { return Entry(scene_, id_).near; }
+double Camera::GetFar() const { return Entry(scene_, id_).far; }
+
+void Camera::SetNearFar(double near, double far) {
+  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  if (!std::isfinite(near) || near <= 0)
+    throw Error("camera '" + c.name + "': near must be finite and > 0, got " + Num(near));
+  if (!std::isfinite(far) || far <= near)
+    throw Error("camera '" + c.name + "': far must be finite and > near (" + Num(near) + "), got " +
+                Num(far));
+  c.near = near;
+  c.far = far;
+}
+
+void Camera::SetFovy(double fovy) {
+  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  if (!std::isfinite(fovy) || fovy <= 0 || fovy >= kPi)
+    throw Error("camera '" + c.name + "': fovy must be in (0, pi) radians, got " + Num(fovy));
+  Eigen::Matrix3d K = IntrinsicsFromFovy(c.width, c.height, fovy);
+  c.fx = K(0, 0);
+  c.fy = K(1, 1);
+  c.cx = K(0, 2);
+  c.cy = K(1, 2);
+}
+
+double Camera::GetFovy() const {
+  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  return 2 * std::atan(0.5 * c.height / c.fy);
+}
+
+double Camera::GetFovx() const {
+  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  return 2 * std::atan(0.5 * c.width / c.fx);
+}
+
+void Camera::SetIntrinsics(double fx, double fy, double cx, double cy) {
+  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  std::string what = "camera '" + c.name + "': ";
+  if (!std::isfinite(fx) || fx <= 0)
+    throw Error(what + "fx must be finite and > 0, got " + Num(fx));
+  if (!std::isfinite(fy) || fy <= 0)
+    throw Error(what + "fy must be finite and > 0, got " + Num(fy));
+  if (!std::isfinite(cx)) throw Error(what + "cx must be finite, got " + Num(cx));
+  if (!std::isfinite(cy)) throw Error(what + "cy must be finite, got " + Num(cy));
+  c.fx = fx;
+  c.fy = fy;
+  c.cx = cx;
+  c.cy = cy;
+}
+
+Eigen::Matrix3d Camera::GetIntrinsicMatrix() const {
+  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  Eigen::Matrix3d K;
+  K << c.fx, 0, c.cx,  //
+      0, c.fy, c.cy,   //
+      0, 0, 1;
+  return K;
+}
+
+Eigen::Matrix<double, 3, 4> Camera::GetExtrinsicMatrix() const {
+  // X_OW = (X_WC R_CO)^-1
+  Eigen::Matrix4d X_WO = GetPose().ToMatrix();
+  X_WO.topLeftCorner<3, 3>() = X_WO.topLeftCorner<3, 3>() * RotationCameraToCv();
+  Eigen::Matrix3d R_OW = X_WO.topLeftCorner<3, 3>().transpose();
+  Eigen::Matrix<double, 3, 4> Rt;
+  Rt.leftCols<3>() = R_OW;
+  Rt.col(3) = -R_OW * X_WO.topRightCorner<3, 1>();
+  return Rt;
+}
+
+Eigen::Matrix4d Camera::GetModelMatrix() const {
+  Eigen::Matrix4d X_WG = GetPose().ToMatrix();
+  X_WG.topLeftCorner<3, 3>() = X_WG.topLeftCorner<3, 3>() * RotationCameraToGl();
+  return X_WG;
+}
+
+Eigen::Matrix4d Camera::GetProjectionMatrix() const {
+  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  return ProjectionFromIntrinsics(GetIntrinsicMatrix(), c.width, c.height, c.near, c.far);
+}
+
+Pose Camera::GetPose() const { return Entry(scene_, id_).X_WC; }
+
+void Camera::SetLocalPose(const Pose& pose) {
+  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  if (!pose.IsValid())
+    throw Error("camera '" + c.name +
+                "': pose must hold finite numbers and a unit quaternion, got " + pose.ToString());
+  if (c.mount_actor >= 0 || c.mount_articulation >= 0) {
+    // keep the mount where it was at the last UpdateRender: X_WM = X_WC X_MC^-1
+    c.X_WC = c.X_WC * c.local_pose.Inverse() * pose;
+  } else {
+    c.X_WC = pose;
+  }
+  c.local_pose = pose;
+}
+
+Pose Camera::GetLocalPose() const { return Entry(scene_, id_).local_pose; }
+
+void Camera::TakePicture() {
+  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  SceneImpl& s = scene_->impl();
+  // the first picture of a scene needs a render world: build it now
+  if (!s.render_world_built) scene_->UpdateRender();
+  RenderBackend& backend = scene_->GetRenderBackend();
+  CameraParams params = GetParams();
+  // render into a fresh picture while an older one is still viewed (from Python)
+  std::shared_ptr<Picture> picture =
+      c.picture && c.picture.use_count() == 1 ? c.picture : std::make_shared<Picture>();
+  picture->width = c.width;
+  picture->height = c.height;
+  try {
+    backend.Render(s.render_world, params, picture.get());
+  } catch (...) {
+    // a half-written picture is not the last picture
+    if (picture == c.picture) c.picture.reset();
+    throw;
+  }
+  // a backend that fills the wrong sizes is a bug: refuse its picture
+  size_t n = static_cast<size_t>(c.width) * static_cast<size_t>(c.height);
+  if (picture->width != c.width || picture->height != c.height || picture->color.size() != 4 * n ||
+      picture->albedo.size() != 4 * n || picture->normal.size() != 4 * n ||
+      picture->position.size() != 4 * n || picture->segmentation.size() != 2 * n) {
+    if (picture == c.picture) c.picture.reset();
+    throw Error("camera '" + c.name + "': backend '" + backend.Name() +
+                "' returned a picture of the wrong size");
+  }
+  c.picture = std::move(picture);
+  c.picture_X_WC = params.X_WC;
+}
+
+const Picture& Camera::GetPictureData() const { return PictureOf(Entry(scene_, id_)); }
+
+std::shared_ptr<const Picture> Camera::GetSharedPicture() const {
+  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  PictureOf(c);
+  return c.picture;
+}
+
+const std::vector<float>& Camera::GetFloatPicture(const std::string& name) const {
+  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  if (!IsFloatPictureName(name))
+    throw Error("camera '" + c.name + "': unknown picture name '" + name +
+                "' (float pictures: Color, Albedo, Normal, Position; uint32: Segmentation)");
+  const Picture& p = PictureOf(c);
+  if (name == "Color") return p.color;
+  if (name == "Albedo") return p.albedo;
+  if (name == "Normal") return p.normal;
+  return p.position;
+}
+
+const std::vector<uint32_t>& Camera::GetUintPicture(const std::string& name) const {
+  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  if (name != "Segmentation")
+    throw Error("camera '" + c.name + "': unknown picture name '" + name +
+                "' (uint32 pictures: Segmentation; float: Color, Albedo, Normal, Position)");
+  return PictureOf(c).segmentation;
+}
+
+std::vector<uint8_t> Camera::GetColorRGBA8() const { return ToRgba8(GetPictureData().color); }
+
+std::vector<float> Camera::GetDepth() const { return DepthImage(GetPictureData()); }
+
+CameraParams Camera::GetParams() const {
+  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  return MakeCameraParams(c.width, c.height, GetIntrinsicMatrix(), c.near, c.far, c.X_WC);
+}
+
+}  // namespace partsim

@@ -1,0 +1,367 @@
+// PNG (libpng), PLY and NPY writers, depth images and point clouds.
+#include "partsim/render/image_io.h"
+
+#include <png.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "partsim/core/error.h"
+#include "partsim/render/camera.h"
+#include "partsim/render/camera_math.h"
+#include "physics/scene_internal.h"
+
+namespace partsim {
+namespace {
+
+// a file opened for writing, closed on scope exit; throws naming the path
+struct File {
+  File(const std::string& path, const char* what) : path_(path) {
+    f_ = std::fopen(path.c_str(), "wb");
+    if (!f_)
+      throw Error(std::string(what) + ": cannot write '" + path + "': " + std::strerror(errno));
+  }
+  ~File() {
+    if (f_) std::fclose(f_);
+  }
+  // flushes and closes, reporting a failed write (a full disk) by the path
+  void Close(const char* what) {
+    bool bad = std::ferror(f_) != 0;
+    bad = (std::fclose(f_) != 0) || bad;
+    f_ = nullptr;
+    if (bad) throw Error(std::string(what) + ": writing '" + path_ + "' failed");
+  }
+  FILE* get() { return f_; }
+
+ private:
+  std::string path_;
+  FILE* f_ = nullptr;
+};
+
+void CheckSize(const char* what, int width, int height) {
+  if (width < 1 || height < 1)
+    throw Error(std::string(what) + ": image size must be at least 1 x 1, got " +
+                std::to_string(width) + " x " + std::to_string(height));
+}
+
+void CheckPicture(const char* what, const Picture& p) {
+  CheckSize(what, p.width, p.height);
+  size_t n = static_cast<size_t>(p.width) * static_cast<size_t>(p.height);
+  if (p.color.size() != 4 * n || p.normal.size() != 4 * n || p.position.size() != 4 * n ||
+      p.segmentation.size() != 2 * n)
+    throw Error(std::string(what) + ": picture buffers do not match its size " +
+                std::to_string(p.width) + " x " + std::to_string(p.height));
+}
+
+// writes rows of `bit_depth`-bit samples; 16-bit rows hold native uint16 values
+void WritePngRows(const std::string& path, int width, int height, int color_type, int bit_depth,
+                  int bytes_per_pixel, const uint8_t* data, const char* what) {
+  File file(path, what);
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info) {
+    png_destroy_write_struct(&png, &info);
+    throw Error(std::string(what) + ": libpng could not start writing '" + path + "'");
+  }
+  std::vector<png_bytep> rows(static_cast<size_t>(height));
+  size_t stride = static_cast<size_t>(width) * bytes_per_pixel;
+  for (int r = 0; r < height; ++r)
+    rows[r] = const_cast<png_bytep>(data + static_cast<size_t>(r) * stride);
+  // libpng reports errors by longjmp; nothing with a destructor is created after this point
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    throw Error(std::string(what) + ": libpng failed writing '" + path + "'");
+  }
+  png_init_io(png, file.get());
+  png_set_IHDR(png, info, width, height, bit_depth, color_type, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  // PNG stores 16-bit samples big-endian
+  if (bit_depth == 16) png_set_swap(png);
+  png_write_image(png, rows.data());
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  file.Close(what);
+}
+
+// little-endian helpers for binary PLY and NPY (the machines partsim runs on are little-endian;
+// checked once here)
+bool LittleEndian() {
+  uint16_t x = 1;
+  uint8_t b;
+  std::memcpy(&b, &x, 1);
+  return b == 1;
+}
+
+template <typename T>
+void WriteNpyImpl(const std::string& path, const T* data, const std::vector<size_t>& shape,
+                  const char* descr) {
+  const char* what = "write_npy";
+  size_t count = 1;
+  for (size_t s : shape) count *= s;
+  if (!data && count > 0) throw Error(std::string(what) + ": no data for '" + path + "'");
+  if (!LittleEndian()) throw Error(std::string(what) + ": needs a little-endian machine");
+  // header: dict, padded with spaces and a newline to a multiple of 64 bytes
+  std::string dims;
+  for (size_t i = 0; i < shape.size(); ++i) dims += std::to_string(shape[i]) + ", ";
+  if (shape.size() > 1) dims.resize(dims.size() - 2);
+  if (shape.size() == 1) dims.resize(dims.size() - 1);
+  std::string header =
+      std::string("{'descr': '") + descr + "', 'fortran_order': False, 'shape': (" + dims + "), }";
+  size_t total = 10 + header.size() + 1;
+  header.append((64 - total % 64) % 64, ' ');
+  header += '\n';
+  File file(path, what);
+  const char magic[] = "\x93NUMPY\x01\x00";
+  std::fwrite(magic, 1, 8, file.get());
+  uint16_t len = static_cast<uint16_t>(header.size());
+  uint8_t len_le[2] = {static_cast<uint8_t>(len & 0xff), static_cast<uint8_t>(len >> 8)};
+  std::fwrite(len_le, 1, 2, file.get());
+  std::fwrite(header.data(), 1, header.size(), file.get());
+  if (count > 0) std::fwrite(data, sizeof(T), count, file.get());
+  file.Close(what);
+}
+
+}  // namespace
+
+std::vector<float> DepthImage(const Picture& picture) {
+  std::vector<float> depth(picture.position.size() / 4);
+  for (size_t i = 0; i < depth.size(); ++i) depth[i] = picture.position[4 * i + 3];
+  return depth;
+}
+
+PointCloud MakePointCloud(const Picture& picture, PointCloudFrame frame, const Pose& X_WC) {
+  CheckPicture("point_cloud", picture);
+  // world from OpenGL camera frame
+  Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f t = Eigen::Vector3f::Zero();
+  if (frame == PointCloudFrame::kWorld) {
+    if (!X_WC.IsValid()) throw Error("point_cloud: camera pose is not valid: " + X_WC.ToString());
+    R = (X_WC.q.toRotationMatrix() * RotationCameraToGl()).cast<float>();
+    t = X_WC.p.cast<float>();
+  }
+  size_t n = static_cast<size_t>(picture.width) * static_cast<size_t>(picture.height);
+  std::vector<uint8_t> rgba = ToRgba8(picture.color);
+  PointCloud cloud;
+  // pixels that see a surface have a depth > 0
+  for (size_t i = 0; i < n; ++i) {
+    if (!(picture.position[4 * i + 3] > 0)) continue;
+    Eigen::Vector3f p(picture.position[4 * i], picture.position[4 * i + 1],
+                      picture.position[4 * i + 2]);
+    p = R * p + t;
+    cloud.positions.insert(cloud.positions.end(), {p.x(), p.y(), p.z()});
+    cloud.colors.insert(cloud.colors.end(), rgba.begin() + 4 * i, rgba.begin() + 4 * i + 4);
+    cloud.visual_ids.push_back(picture.segmentation[2 * i]);
+    cloud.entity_ids.push_back(picture.segmentation[2 * i + 1]);
+  }
+  return cloud;
+}
+
+PointCloud MakePointCloud(const Camera& camera, PointCloudFrame frame) {
+  const Picture& picture = camera.GetPictureData();
+  Pose X_WC;
+  for (const auto& c : camera.GetScene()->impl().cameras)
+    if (c.id == camera.GetId()) X_WC = c.picture_X_WC;
+  return MakePointCloud(picture, frame, X_WC);
+}
+
+std::vector<uint8_t> ToRgba8(const std::vector<float>& rgba) {
+  std::vector<uint8_t> out(rgba.size());
+  auto byte = [](float x) {
+    x = std::min(std::max(x, 0.0f), 1.0f);
+    return static_cast<uint8_t>(std::lround(x * 255.0f));
+  };
+  for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
+    for (size_t k = 0; k < 3; ++k) {
+      float x = std::min(std::max(rgba[i + k], 0.0f), 1.0f);
+      float s = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
+      out[i + k] = byte(s);
+    }
+    // alpha is coverage, not colour: no transfer curve
+    out[i + 3] = byte(rgba[i + 3]);
+  }
+  return out;
+}
+
+std::array<uint8_t, 3> SegmentationColor(uint32_t id) {
+  if (id == 0) return {0, 0, 0};
+  // hash the id (murmur3 finaliser), then take a hue from it at full saturation and a value in
+  // [0.6, 1] so that every id is clearly brighter than the background
+  uint32_t h = id;
+  h ^= h >> 16;
+  h *= 0x85ebca6bu;
+  h ^= h >> 13;
+  h *= 0xc2b2ae35u;
+  h ^= h >> 16;
+  double hue = (h & 0xffff) / 65536.0 * 6.0;
+  double sat = 0.55 + 0.45 * ((h >> 16) & 0xff) / 255.0;
+  double val = 0.6 + 0.4 * ((h >> 24) & 0xff) / 255.0;
+  int sector = static_cast<int>(hue);
+  double f = hue - sector;
+  double p = val * (1 - sat), q = val * (1 - sat * f), t = val * (1 - sat * (1 - f));
+  double rgb[6][3] = {{val, t, p}, {q, val, p}, {p, val, t}, {p, q, val}, {t, p, val}, {val, p, q}};
+  const double* c = rgb[sector % 6];
+  return {static_cast<uint8_t>(std::lround(c[0] * 255)),
+          static_cast<uint8_t>(std::lround(c[1] * 255)),
+          static_cast<uint8_t>(std::lround(c[2] * 255))};
+}
+
+void WritePng(const std::string& path, int width, int height, int channels, const uint8_t* pixels) {
+  const char* what = "write_png";
+  CheckSize(what, width, height);
+  int type;
+  switch (channels) {
+    case 1:
+      type = PNG_COLOR_TYPE_GRAY;
+      break;
+    case 2:
+      type = PNG_COLOR_TYPE_GRAY_ALPHA;
+      break;
+    case 3:
+      type = PNG_COLOR_TYPE_RGB;
+      break;
+    case 4:
+      type = PNG_COLOR_TYPE_RGBA;
+      break;
+    default:
+      throw Error(std::string(what) + ": channels must be 1, 2, 3 or 4, got " +
+                  std::to_string(channels) + " (writing '" + path + "')");
+  }
+  WritePngRows(path, width, height, type, 8, channels, pixels, what);
+}
+
+void WritePng16(const std::string& path, int width, int height, const uint16_t* pixels) {
+  const char* what = "write_png16";
+  CheckSize(what, width, height);
+  WritePngRows(path, width, height, PNG_COLOR_TYPE_GRAY, 16, 2,
+               reinterpret_cast<const uint8_t*>(pixels), what);
+}
+
+void WriteColorPng(const std::string& path, const Picture& picture) {
+  CheckPicture("write_color_png", picture);
+  std::vector<uint8_t> rgba = ToRgba8(picture.color);
+  WritePng(path, picture.width, picture.height, 4, rgba.data());
+}
+
+void WriteDepthPng(const std::string& path, int width, int height, const float* depth) {
+  CheckSize("write_depth_png", width, height);
+  size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  std::vector<uint16_t> mm(n);
+  for (size_t i = 0; i < n; ++i) {
+    // millimetres, rounded; NaN and negative depths mean nothing was seen
+    double v = depth[i] > 0 ? std::round(1000.0 * depth[i]) : 0.0;
+    mm[i] = static_cast<uint16_t>(std::min(v, 65535.0));
+  }
+  WritePng16(path, width, height, mm.data());
+}
+
+void WriteDepthPng(const std::string& path, const Picture& picture) {
+  CheckPicture("write_depth_png", picture);
+  std::vector<float> depth = DepthImage(picture);
+  WriteDepthPng(path, picture.width, picture.height, depth.data());
+}
+
+void WriteNormalPng(const std::string& path, const Picture& picture) {
+  CheckPicture("write_normal_png", picture);
+  size_t n = static_cast<size_t>(picture.width) * static_cast<size_t>(picture.height);
+  std::vector<uint8_t> rgb(3 * n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    if (!(picture.position[4 * i + 3] > 0)) continue;
+    for (size_t k = 0; k < 3; ++k) {
+      float x = std::min(std::max(0.5f * (picture.normal[4 * i + k] + 1.0f), 0.0f), 1.0f);
+      rgb[3 * i + k] = static_cast<uint8_t>(std::lround(x * 255.0f));
+    }
+  }
+  WritePng(path, picture.width, picture.height, 3, rgb.data());
+}
+
+void WriteSegmentationPng(const std::string& path, int width, int height, const uint32_t* ids,
+                          int stride) {
+  CheckSize("write_segmentation_png", width, height);
+  if (stride < 1)
+    throw Error("write_segmentation_png: stride must be >= 1, got " + std::to_string(stride));
+  size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  std::vector<uint8_t> rgb(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    std::array<uint8_t, 3> c = SegmentationColor(ids[i * stride]);
+    std::copy(c.begin(), c.end(), rgb.begin() + 3 * i);
+  }
+  WritePng(path, width, height, 3, rgb.data());
+}
+
+void WriteSegmentationPng(const std::string& path, const Picture& picture, int channel) {
+  CheckPicture("write_segmentation_png", picture);
+  if (channel != 0 && channel != 1)
+    throw Error(
+        "write_segmentation_png: channel must be 0 (visual ids) or 1 (actor/link ids), "
+        "got " +
+        std::to_string(channel));
+  WriteSegmentationPng(path, picture.width, picture.height, picture.segmentation.data() + channel,
+                       2);
+}
+
+void WritePly(const std::string& path, const PointCloud& cloud, bool binary) {
+  const char* what = "write_ply";
+  size_t n = cloud.Size();
+  if (cloud.positions.size() != 3 * n)
+    throw Error(std::string(what) + ": positions must hold 3 values per point, got " +
+                std::to_string(cloud.positions.size()) + " (writing '" + path + "')");
+  if (!cloud.colors.empty() && cloud.colors.size() != 4 * n)
+    throw Error(std::string(what) + ": colors must hold 4 values per point (" + std::to_string(n) +
+                " points), got " + std::to_string(cloud.colors.size()) + " (writing '" + path +
+                "')");
+  if (!cloud.visual_ids.empty() && cloud.visual_ids.size() != n)
+    throw Error(std::string(what) + ": visual_ids must hold one id per point (" +
+                std::to_string(n) + " points), got " + std::to_string(cloud.visual_ids.size()) +
+                " (writing '" + path + "')");
+  if (!cloud.entity_ids.empty() && cloud.entity_ids.size() != n)
+    throw Error(std::string(what) + ": entity_ids must hold one id per point (" +
+                std::to_string(n) + " points), got " + std::to_string(cloud.entity_ids.size()) +
+                " (writing '" + path + "')");
+  if (binary && !LittleEndian())
+    throw Error(std::string(what) + ": binary PLY needs a little-endian machine");
+
+  File file(path, what);
+  std::string header = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
+                       " 1.0\ncomment partsim point cloud\nelement vertex " + std::to_string(n) +
+                       "\nproperty float x\nproperty float y\nproperty float z\n"
+                       "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                       "property uchar alpha\nproperty uint visual_id\nproperty uint entity_id\n"
+                       "end_header\n";
+  std::fwrite(header.data(), 1, header.size(), file.get());
+  // one record per point: 12 bytes of position, 4 of colour, 8 of ids
+  std::vector<uint8_t> record(24);
+  for (size_t i = 0; i < n; ++i) {
+    const float* p = cloud.positions.data() + 3 * i;
+    uint8_t c[4] = {255, 255, 255, 255};
+    if (!cloud.colors.empty()) std::memcpy(c, cloud.colors.data() + 4 * i, 4);
+    uint32_t ids[2] = {cloud.visual_ids.empty() ? 0u : cloud.visual_ids[i],
+                       cloud.entity_ids.empty() ? 0u : cloud.entity_ids[i]};
+    if (binary) {
+      std::memcpy(record.data(), p, 12);
+      std::memcpy(record.data() + 12, c, 4);
+      std::memcpy(record.data() + 16, ids, 8);
+      std::fwrite(record.data(), 1, record.size(), file.get());
+    } else {
+      std::fprintf(file.get(), "%.9g %.9g %.9g %u %u %u %u %u %u\n", p[0], p[1], p[2], c[0], c[1],
+                   c[2], c[3], ids[0], ids[1]);
+    }
+  }
+  file.Close(what);
+}
+
+void WriteNpy(const std::string& path, const float* data, const std::vector<size_t>& shape) {
+  WriteNpyImpl(path, data, shape, "<f4");
+}
+
+void WriteNpy(const std::string& path, const uint32_t* data, const std::vector<size_t>& shape) {
+  WriteNpyImpl(path, data, shape, "<u4");
+}
+
+}  // namespace partsim

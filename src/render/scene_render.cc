@@ -1,0 +1,410 @@
+// The scene's rendering methods: cameras, lights, the render world that backends draw, and the
+// tables that name segmentation ids.
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "partsim/physics/scene.h"
+#include "partsim/render/backend.h"
+#include "partsim/render/camera.h"
+#include "physics/scene_internal.h"
+
+namespace partsim {
+
+using internal::SceneImpl;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kMaxImageSize = 16384;
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
+std::string Vec(const Eigen::Vector3d& v) {
+  return "[" + Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z()) + "]";
+}
+
+// checks what every camera needs; `what` names the call for the message
+void CheckCameraArgs(const std::string& what, int width, int height, double fovy, double near,
+                     double far) {
+  if (width < 1 || width > kMaxImageSize)
+    throw Error(what + ": width must be in [1, " + std::to_string(kMaxImageSize) + "], got " +
+                std::to_string(width));
+  if (height < 1 || height > kMaxImageSize)
+    throw Error(what + ": height must be in [1, " + std::to_string(kMaxImageSize) + "], got " +
+                std::to_string(height));
+  if (!std::isfinite(fovy) || fovy <= 0 || fovy >= kPi)
+    throw Error(what + ": fovy must be in (0, pi) radians, got " + Num(fovy));
+  if (!std::isfinite(near) || near <= 0)
+    throw Error(what + ": near must be finite and > 0, got " + Num(near));
+  if (!std::isfinite(far) || far <= near)
+    throw Error(what + ": far must be finite and > near (" + Num(near) + "), got " + Num(far));
+}
+
+void CheckPose(const std::string& what, const Pose& pose) {
+  if (!pose.IsValid())
+    throw Error(what + " must hold finite numbers and a unit quaternion, got " + pose.ToString());
+}
+
+void CheckColor(const std::string& what, const Eigen::Vector3f& c) {
+  if (!c.allFinite() || (c.array() < 0).any())
+    throw Error(what + ": color must be finite and >= 0, got " + Vec(c.cast<double>()));
+}
+
+Eigen::Vector3d CheckDirection(const std::string& what, const Eigen::Vector3d& d) {
+  if (!d.allFinite() || d.norm() < 1e-12)
+    throw Error(what + ": direction must be finite and non-zero, got " + Vec(d));
+  return d.normalized();
+}
+
+SceneImpl::CameraEntry MakeEntry(int id, const std::string& name, int width, int height,
+                                 double fovy, double near, double far) {
+  double f = 0.5 * height / std::tan(0.5 * fovy);
+  SceneImpl::CameraEntry c{};
+  c.id = id;
+  c.name = name;
+  c.width = width;
+  c.height = height;
+  c.fx = c.fy = f;
+  c.cx = 0.5 * (width - 1);
+  c.cy = 0.5 * (height - 1);
+  c.near = near;
+  c.far = far;
+  return c;
+}
+
+// key of a primitive visual in the mesh cache: its type and exact sizes
+std::string PrimitiveKey(const VisualShape& v) {
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "%d %.17g %.17g %.17g %.17g %.17g", static_cast<int>(v.type),
+                v.half_size.x(), v.half_size.y(), v.half_size.z(), v.radius, v.half_length);
+  return buf;
+}
+
+bool SameMaterial(const RenderMaterial& a, const RenderMaterial& b) {
+  return a.base_color == b.base_color && a.roughness == b.roughness && a.metallic == b.metallic &&
+         a.diffuse_texture == b.diffuse_texture;
+}
+
+// true when two instance lists draw the same meshes with the same materials and ids
+bool SameGeometry(const std::vector<RenderInstance>& a, const std::vector<RenderInstance>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i].mesh != b[i].mesh || a[i].visual_id != b[i].visual_id ||
+        a[i].entity_id != b[i].entity_id || !SameMaterial(a[i].material, b[i].material))
+      return false;
+  }
+  return true;
+}
+
+// World pose of a camera's mount; false when the mount no longer exists.
+bool MountPose(Scene* scene, const SceneImpl::CameraEntry& c, Pose* X_WM) {
+  SceneImpl& s = scene->impl();
+  if (c.mount_actor >= 0) {
+    for (const auto& a : s.actors)
+      if (a.id == c.mount_actor) {
+        *X_WM = Actor(scene, a.id).GetPose();
+        return true;
+      }
+    return false;
+  }
+  for (const auto& a : s.articulations)
+    if (a.id == c.mount_articulation) {
+      if (c.mount_link >= static_cast<int>(a.desc.links.size())) return false;
+      *X_WM = Link(scene, a.id, c.mount_link).GetPose();
+      return true;
+    }
+  return false;
+}
+
+bool IsMounted(const SceneImpl::CameraEntry& c) {
+  return c.mount_actor >= 0 || c.mount_articulation >= 0;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// cameras
+
+Camera Scene::AddCamera(const std::string& name, int width, int height, double fovy, double near,
+                        double far) {
+  CheckCameraArgs("add_camera '" + name + "'", width, height, fovy, near, far);
+  Impl& s = *impl_;
+  int id = s.next_id++;
+  s.cameras.push_back(MakeEntry(id, name, width, height, fovy, near, far));
+  return Camera(this, id);
+}
+
+Camera Scene::AddMountedCamera(const std::string& name, const Actor& mount, const Pose& local_pose,
+                               int width, int height, double fovy, double near, double far) {
+  std::string what = "add_mounted_camera '" + name + "'";
+  CheckCameraArgs(what, width, height, fovy, near, far);
+  CheckPose(what + ": local_pose", local_pose);
+  if (mount.GetScene() != this) throw Error(what + ": the mount actor belongs to another scene");
+  Impl& s = *impl_;
+  s.GetActor(mount.GetId());  // throws when removed
+  // the pose is known at once, before the first UpdateRender
+  Pose X_WC = mount.GetPose() * local_pose;
+  int id = s.next_id++;
+  SceneImpl::CameraEntry c = MakeEntry(id, name, width, height, fovy, near, far);
+  c.local_pose = local_pose;
+  c.mount_actor = mount.GetId();
+  c.X_WC = X_WC;
+  s.cameras.push_back(std::move(c));
+  return Camera(this, id);
+}
+
+Camera Scene::AddMountedCamera(const std::string& name, const Link& mount, const Pose& local_pose,
+                               int width, int height, double fovy, double near, double far) {
+  std::string what = "add_mounted_camera '" + name + "'";
+  CheckCameraArgs(what, width, height, fovy, near, far);
+  CheckPose(what + ": local_pose", local_pose);
+  if (mount.GetScene() != this) throw Error(what + ": the mount link belongs to another scene");
+  Impl& s = *impl_;
+  const auto& art = s.GetArticulation(mount.GetArticulationId());
+  if (mount.GetIndex() < 0 || mount.GetIndex() >= static_cast<int>(art.desc.links.size()))
+    throw Error(what + ": link index " + std::to_string(mount.GetIndex()) + " out of range");
+  Pose X_WC = mount.GetPose() * local_pose;
+  int id = s.next_id++;
+  SceneImpl::CameraEntry c = MakeEntry(id, name, width, height, fovy, near, far);
+  c.local_pose = local_pose;
+  c.mount_articulation = mount.GetArticulationId();
+  c.mount_link = mount.GetIndex();
+  c.X_WC = X_WC;
+  s.cameras.push_back(std::move(c));
+  return Camera(this, id);
+}
+
+void Scene::RemoveCamera(const Camera& camera) {
+  Impl& s = *impl_;
+  for (auto it = s.cameras.begin(); it != s.cameras.end(); ++it)
+    if (it->id == camera.GetId() && camera.GetScene() == this) {
+      s.cameras.erase(it);
+      return;
+    }
+  throw Error("remove_camera: camera " + std::to_string(camera.GetId()) +
+              " does not exist (it was removed, or belongs to another scene)");
+}
+
+std::vector<Camera> Scene::GetCameras() const {
+  std::vector<Camera> out;
+  for (const auto& c : impl_->cameras) out.emplace_back(const_cast<Scene*>(this), c.id);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// lights
+
+void Scene::AddDirectionalLight(const Eigen::Vector3d& direction, const Eigen::Vector3f& color,
+                                bool shadow) {
+  LightDesc l;
+  l.type = LightType::kDirectional;
+  l.direction = CheckDirection("add_directional_light", direction);
+  CheckColor("add_directional_light", color);
+  l.color = color;
+  l.shadow = shadow;
+  l.name = "directional_" + std::to_string(impl_->lights.size());
+  impl_->lights.push_back(l);
+}
+
+void Scene::AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f& color) {
+  if (!position.allFinite())
+    throw Error("add_point_light: position must be finite, got " + Vec(position));
+  CheckColor("add_point_light", color);
+  LightDesc l;
+  l.type = LightType::kPoint;
+  l.position = position;
+  l.color = color;
+  l.name = "point_" + std::to_string(impl_->lights.size());
+  impl_->lights.push_back(l);
+}
+
+void Scene::AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d& direction,
+                         double inner_angle, double outer_angle, const Eigen::Vector3f& color,
+                         bool shadow) {
+  if (!position.allFinite())
+    throw Error("add_spot_light: position must be finite, got " + Vec(position));
+  LightDesc l;
+  l.type = LightType::kSpot;
+  l.direction = CheckDirection("add_spot_light", direction);
+  if (!std::isfinite(outer_angle) || outer_angle <= 0 || outer_angle > 0.5 * kPi)
+    throw Error("add_spot_light: outer_angle must be in (0, pi/2] radians, got " +
+                Num(outer_angle));
+  if (!std::isfinite(inner_angle) || inner_angle < 0 || inner_angle > outer_angle)
+    throw Error("add_spot_light: inner_angle must be in [0, outer_angle] radians, got " +
+                Num(inner_angle));
+  CheckColor("add_spot_light", color);
+  l.position = position;
+  l.inner_angle = inner_angle;
+  l.outer_angle = outer_angle;
+  l.color = color;
+  l.shadow = shadow;
+  l.name = "spot_" + std::to_string(impl_->lights.size());
+  impl_->lights.push_back(l);
+}
+
+void Scene::SetAmbientLight(const Eigen::Vector3f& color) {
+  CheckColor("set_ambient_light", color);
+  impl_->ambient = color;
+}
+
+const std::vector<LightDesc>& Scene::GetLights() const { return impl_->lights; }
+
+// ---------------------------------------------------------------------------------------------
+// backend (by name: backend_registry.cc)
+
+void Scene::SetRenderBackend(std::unique_ptr<RenderBackend> backend) {
+  if (!backend) throw Error("set_render_backend: backend is null");
+  impl_->render_backend = std::move(backend);
+}
+
+// ---------------------------------------------------------------------------------------------
+// render world
+
+void Scene::UpdateRender() {
+  Impl& s = *impl_;
+  s.EnsureCompiled();
+  RenderWorld& world = s.render_world;
+
+  // rebuild the instances when actors or articulations changed
+  if (!s.render_world_built || s.render_world_description != s.description_version) {
+    std::map<std::string, std::shared_ptr<const MeshData>> cache;
+    std::vector<RenderInstance> instances;
+    std::vector<SceneImpl::RenderSource> sources;
+    auto add = [&](const VisualShape& v, uint32_t visual_id, uint32_t entity_id,
+                   SceneImpl::RenderSource src) {
+      RenderInstance inst;
+      if (v.type == ShapeType::kConvexMesh) {
+        if (!v.mesh) return;
+        inst.mesh = v.mesh;
+      } else {
+        // primitives share one mesh per size, stable across rebuilds
+        std::string key = PrimitiveKey(v);
+        auto it = s.primitive_meshes.find(key);
+        std::shared_ptr<const MeshData> mesh =
+            it != s.primitive_meshes.end() ? it->second : MakePrimitiveMesh(v);
+        cache[key] = mesh;
+        inst.mesh = mesh;
+      }
+      inst.material = v.material;
+      inst.visual_id = visual_id;
+      inst.entity_id = entity_id;
+      src.X_BV = v.pose;
+      instances.push_back(std::move(inst));
+      sources.push_back(src);
+    };
+    for (const auto& a : s.actors) {
+      for (size_t j = 0; j < a.desc.visuals.size(); ++j) {
+        SceneImpl::RenderSource src;
+        src.actor_id = a.id;
+        add(a.desc.visuals[j], a.visual_id_base + static_cast<uint32_t>(j), a.render_id, src);
+      }
+    }
+    for (const auto& a : s.articulations) {
+      for (size_t i = 0; i < a.desc.links.size(); ++i) {
+        const LinkDesc& l = a.desc.links[i];
+        for (size_t j = 0; j < l.visuals.size(); ++j) {
+          SceneImpl::RenderSource src;
+          src.articulation_id = a.id;
+          src.link_index = static_cast<int>(i);
+          add(l.visuals[j], a.visual_id_base[i] + static_cast<uint32_t>(j),
+              a.render_id_base + static_cast<uint32_t>(i), src);
+        }
+      }
+    }
+    // the version changes exactly when meshes, materials or ids change
+    if (!s.render_world_built || !SameGeometry(instances, world.instances))
+      ++world.geometry_version;
+    world.instances = std::move(instances);
+    s.render_sources = std::move(sources);
+    s.primitive_meshes = std::move(cache);
+    s.render_world_description = s.description_version;
+    s.render_world_built = true;
+  }
+
+  // poses of every instance from its body (consecutive instances of one body share its pose)
+  Pose X_WB;
+  std::tuple<int, int, int> last_body(-2, -2, -2);
+  for (size_t k = 0; k < world.instances.size(); ++k) {
+    const SceneImpl::RenderSource& src = s.render_sources[k];
+    std::tuple<int, int, int> body(src.actor_id, src.articulation_id, src.link_index);
+    if (body != last_body) {
+      X_WB = src.actor_id >= 0 ? Actor(this, src.actor_id).GetPose()
+                               : Link(this, src.articulation_id, src.link_index).GetPose();
+      last_body = body;
+    }
+    world.instances[k].X_WV = (X_WB * src.X_BV).ToMatrix();
+  }
+  world.lights = s.lights;
+  world.ambient = s.ambient;
+
+  // cameras follow their mounts; a camera whose mount was removed stays where it was, unmounted
+  for (auto& c : s.cameras) {
+    if (!IsMounted(c)) {
+      c.X_WC = c.local_pose;
+      continue;
+    }
+    Pose X_WM;
+    if (MountPose(this, c, &X_WM)) {
+      c.X_WC = X_WM * c.local_pose;
+    } else {
+      c.mount_actor = c.mount_articulation = c.mount_link = -1;
+      c.local_pose = c.X_WC;
+    }
+  }
+}
+
+const RenderWorld& Scene::GetRenderWorld() const { return impl_->render_world; }
+
+std::vector<RenderEntityInfo> Scene::GetRenderEntities() const {
+  std::vector<RenderEntityInfo> out;
+  for (const auto& a : impl_->actors) {
+    RenderEntityInfo e;
+    e.id = a.render_id;
+    e.is_link = false;
+    e.name = a.desc.name;
+    e.actor_id = a.id;
+    e.semantic_label = a.desc.semantic_label;
+    out.push_back(std::move(e));
+  }
+  for (const auto& a : impl_->articulations) {
+    for (size_t i = 0; i < a.desc.links.size(); ++i) {
+      RenderEntityInfo e;
+      e.id = a.render_id_base + static_cast<uint32_t>(i);
+      e.is_link = true;
+      e.name = a.desc.links[i].name;
+      e.articulation_id = a.id;
+      e.link_index = static_cast<int>(i);
+      e.articulation_name = a.desc.name;
+      e.semantic_label = a.desc.links[i].semantic_label;
+      out.push_back(std::move(e));
+    }
+  }
+  return out;
+}
+
+std::vector<RenderVisualInfo> Scene::GetRenderVisuals() const {
+  std::vector<RenderVisualInfo> out;
+  for (const auto& a : impl_->actors)
+    for (size_t j = 0; j < a.desc.visuals.size(); ++j)
+      out.push_back(
+          {a.visual_id_base + static_cast<uint32_t>(j), a.render_id, a.desc.visuals[j].name});
+  for (const auto& a : impl_->articulations)
+    for (size_t i = 0; i < a.desc.links.size(); ++i)
+      for (size_t j = 0; j < a.desc.links[i].visuals.size(); ++j)
+        out.push_back({a.visual_id_base[i] + static_cast<uint32_t>(j),
+                       a.render_id_base + static_cast<uint32_t>(i),
+                       a.desc.links[i].visuals[j].name});
+  return out;
+}
+
+}  // namespace partsim
