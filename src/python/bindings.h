@@ -16,6 +16,9 @@ void BindCore(py::module_& m);
 void BindPhysics(py::module_& m);
 /// URDF loader and mesh files (assets).
 void BindAssets(py::module_& m);
+/// Cameras, lights, backends and image / point cloud writers (render); after BindPhysics, whose
+/// Scene class it extends.
+void BindRender(py::module_& m);
 
 /// Casts handles to a Python list whose items each keep `owner` alive (py::keep_alive cannot
 /// attach to a list, which holds no weak references).

@@ -9,4 +9,5 @@ PYBIND11_MODULE(_partsim, m) {
   partsim::python::BindCore(m);
   partsim::python::BindPhysics(m);
   partsim::python::BindAssets(m);
+  partsim::python::BindRender(m);
 }

@@ -1,0 +1,343 @@
+// Bindings of the render subsystem: the scene's cameras, lights and backend, the Camera handle,
+// and the image and point cloud writers.
+//
+// Pictures: camera.get_picture(name) returns a read-only numpy view of the C++ picture, no copy.
+// The view holds the picture itself (not the camera), so it stays valid and unchanged after the
+// next take_picture(), which then renders into a new buffer; with no view alive, take_picture()
+// reuses the old buffer.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "partsim/physics/scene.h"
+#include "partsim/render/backend.h"
+#include "partsim/render/camera.h"
+#include "partsim/render/image_io.h"
+
+namespace partsim::python {
+namespace {
+
+using PictureRef = std::shared_ptr<const Picture>;
+
+// A capsule that owns a reference to a picture: the base object of numpy views into it.
+py::capsule PictureOwner(PictureRef picture) {
+  // the capsule's destructor frees the heap-held reference
+  auto* held = new PictureRef(std::move(picture));
+  return py::capsule(held, [](void* p) { delete static_cast<PictureRef*>(p); });
+}
+
+template <typename T>
+py::array ReadOnlyView(const std::vector<ssize_t>& shape, const std::vector<ssize_t>& strides,
+                       const T* data, const py::capsule& owner) {
+  py::array a(py::dtype::of<T>(), shape, strides, data, owner);
+  a.attr("flags").attr("writeable") = false;
+  return a;
+}
+
+// h x w x c view of one output of the camera's last picture
+py::array PictureView(const Camera& camera, const std::string& name) {
+  PictureRef picture = camera.GetSharedPicture();
+  ssize_t h = picture->height, w = picture->width;
+  if (name == "Segmentation") {
+    const std::vector<uint32_t>& v = camera.GetUintPicture(name);
+    ssize_t s = sizeof(uint32_t);
+    return ReadOnlyView<uint32_t>({h, w, 2}, {w * 2 * s, 2 * s, s}, v.data(),
+                                  PictureOwner(picture));
+  }
+  const std::vector<float>& v = camera.GetFloatPicture(name);
+  ssize_t s = sizeof(float);
+  return ReadOnlyView<float>({h, w, 4}, {w * 4 * s, 4 * s, s}, v.data(), PictureOwner(picture));
+}
+
+// numpy array that owns a moved-in vector
+template <typename T>
+py::array Owned(std::vector<T>&& v, const std::vector<ssize_t>& shape) {
+  auto* held = new std::vector<T>(std::move(v));
+  py::capsule owner(held, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(shape, held->data(), owner);
+}
+
+PointCloudFrame FrameFromName(const std::string& frame) {
+  if (frame == "camera") return PointCloudFrame::kCamera;
+  if (frame == "world") return PointCloudFrame::kWorld;
+  throw Error("frame: expected 'camera' or 'world', got '" + frame + "'");
+}
+
+template <typename T>
+using CArray = py::array_t<T, py::array::c_style | py::array::forcecast>;
+
+// checks that an image array is (h, w) or (h, w, c) and returns h, w, c
+std::array<int, 3> ImageShape(const py::array& a, const char* what, bool allow_channels) {
+  if (a.ndim() == 2) return {static_cast<int>(a.shape(0)), static_cast<int>(a.shape(1)), 1};
+  if (allow_channels && a.ndim() == 3)
+    return {static_cast<int>(a.shape(0)), static_cast<int>(a.shape(1)),
+            static_cast<int>(a.shape(2))};
+  throw Error(std::string(what) + ": expected an array of shape (h, w)" +
+              (allow_channels ? " or (h, w, c)" : "") + ", got " + std::to_string(a.ndim()) +
+              " dimensions");
+}
+
+std::vector<size_t> Shape(const py::array& a) {
+  return std::vector<size_t>(a.shape(), a.shape() + a.ndim());
+}
+
+void BindTypes(py::module_& m) {
+  py::enum_<LightType>(m, "LightType", "Light kinds.")
+      .value("DIRECTIONAL", LightType::kDirectional)
+      .value("POINT", LightType::kPoint)
+      .value("SPOT", LightType::kSpot);
+
+  py::class_<LightDesc>(m, "LightDesc", "A light of the scene (read from scene.get_lights()).")
+      .def_readonly("type", &LightDesc::type)
+      .def_readonly("color", &LightDesc::color, "(3,) linear RGB.")
+      .def_readonly("position", &LightDesc::position, "(3,) world, m (point and spot).")
+      .def_readonly("direction", &LightDesc::direction, "(3,) world, unit (directional, spot).")
+      .def_readonly("inner_angle", &LightDesc::inner_angle, "Spot: half angle (rad).")
+      .def_readonly("outer_angle", &LightDesc::outer_angle, "Spot: half angle (rad).")
+      .def_readonly("shadow", &LightDesc::shadow)
+      .def_readonly("name", &LightDesc::name);
+
+  py::class_<RenderEntityInfo>(m, "RenderEntityInfo",
+                               "A render id (segmentation channel 1) and the actor or link it "
+                               "names.")
+      .def_readonly("id", &RenderEntityInfo::id)
+      .def_readonly("is_link", &RenderEntityInfo::is_link)
+      .def_readonly("name", &RenderEntityInfo::name, "Actor or link name.")
+      .def_readonly("actor_id", &RenderEntityInfo::actor_id, "-1 for a link.")
+      .def_readonly("articulation_id", &RenderEntityInfo::articulation_id, "-1 for an actor.")
+      .def_readonly("link_index", &RenderEntityInfo::link_index, "-1 for an actor.")
+      .def_readonly("articulation_name", &RenderEntityInfo::articulation_name)
+      .def_readonly("semantic_label", &RenderEntityInfo::semantic_label, "Part label, '' if none.")
+      .def("__repr__", [](const RenderEntityInfo& self) {
+        return "<RenderEntityInfo " + std::to_string(self.id) + " '" + self.name + "'>";
+      });
+
+  py::class_<RenderVisualInfo>(m, "RenderVisualInfo",
+                               "A visual id (segmentation channel 0), its entity and its name.")
+      .def_readonly("id", &RenderVisualInfo::id)
+      .def_readonly("entity_id", &RenderVisualInfo::entity_id)
+      .def_readonly("name", &RenderVisualInfo::name)
+      .def("__repr__", [](const RenderVisualInfo& self) {
+        return "<RenderVisualInfo " + std::to_string(self.id) + " '" + self.name + "'>";
+      });
+
+  py::class_<RenderBackend>(m, "RenderBackend", "The scene's rendering backend.")
+      .def("get_name", &RenderBackend::Name, "'rasterizer', 'pathtracer' or 'null'.")
+      .def("get_device", &RenderBackend::Device, "Which device renders (e.g. GL_RENDERER).");
+}
+
+void BindCamera(py::module_& m) {
+  py::class_<Camera>(m, "Camera",
+                     "Handle to a camera (x forward, y left, z up). Pictures are read-only numpy "
+                     "views that stay valid after the next take_picture().")
+      .def("get_id", &Camera::GetId)
+      .def("get_name", &Camera::GetName)
+      .def_property_readonly("name", &Camera::GetName)
+      .def_property_readonly("width", &Camera::GetWidth, "Pixels.")
+      .def_property_readonly("height", &Camera::GetHeight, "Pixels.")
+      .def("get_width", &Camera::GetWidth)
+      .def("get_height", &Camera::GetHeight)
+      .def_property_readonly("near", &Camera::GetNear, "Near clipping distance (m).")
+      .def_property_readonly("far", &Camera::GetFar, "Far clipping distance (m).")
+      .def("set_near_far", &Camera::SetNearFar, py::arg("near"), py::arg("far"),
+           "Clipping distances (m), 0 < near < far.")
+      .def_property("fovy", &Camera::GetFovy, &Camera::SetFovy,
+                    "Vertical field of view (rad); setting it makes fx = fy and centres the "
+                    "principal point.")
+      .def_property_readonly("fovx", &Camera::GetFovx, "Horizontal field of view (rad).")
+      .def("get_fovy", &Camera::GetFovy)
+      .def("set_fovy", &Camera::SetFovy, py::arg("fovy"))
+      .def("get_fovx", &Camera::GetFovx)
+      .def("set_intrinsics", &Camera::SetIntrinsics, py::arg("fx"), py::arg("fy"), py::arg("cx"),
+           py::arg("cy"), "Focal lengths and principal point in pixels (OpenCV).")
+      .def("get_intrinsic_matrix", &Camera::GetIntrinsicMatrix, "3x3 OpenCV K (pixels).")
+      .def("get_extrinsic_matrix", &Camera::GetExtrinsicMatrix,
+           "3x4 [R | t]: world -> OpenCV camera frame (x right, y down, z forward).")
+      .def("get_model_matrix", &Camera::GetModelMatrix,
+           "4x4: OpenGL camera frame (x right, y up, z backward) -> world.")
+      .def("get_projection_matrix", &Camera::GetProjectionMatrix,
+           "4x4 OpenGL projection from K, near and far.")
+      .def("get_pose", &Camera::GetPose,
+           "X_WC in the world (for a mounted camera: as of the last update_render()).")
+      .def("set_pose", &Camera::SetLocalPose, py::arg("pose"),
+           "Same as set_local_pose: the world pose of a free camera, the pose in the mount's "
+           "frame of a mounted one.")
+      .def("get_local_pose", &Camera::GetLocalPose)
+      .def("set_local_pose", &Camera::SetLocalPose, py::arg("pose"),
+           "World pose of a free camera, or pose in the mount's frame of a mounted one.")
+      .def("take_picture", &Camera::TakePicture, py::call_guard<py::gil_scoped_release>(),
+           "Renders the scene as of the last update_render() (the first picture of a scene "
+           "updates it first). The GIL is released meanwhile.")
+      .def("get_picture", &PictureView, py::arg("name"),
+           "'Color', 'Albedo', 'Normal', 'Position': float32 (h, w, 4); 'Segmentation': uint32 "
+           "(h, w, 2) (visual id, actor/link id). A read-only view, no copy.")
+      .def(
+          "get_color_rgba8",
+          [](const Camera& self) {
+            return Owned(self.GetColorRGBA8(), {self.GetHeight(), self.GetWidth(), 4});
+          },
+          "Colour as uint8 (h, w, 4), sRGB-encoded.")
+      .def(
+          "get_depth",
+          [](const Camera& self) {
+            // the w channel of Position, viewed with a stride
+            PictureRef picture = self.GetSharedPicture();
+            ssize_t h = picture->height, w = picture->width, s = sizeof(float);
+            return ReadOnlyView<float>({h, w}, {w * 4 * s, 4 * s}, picture->position.data() + 3,
+                                       PictureOwner(picture));
+          },
+          "Depth in metres, float32 (h, w), 0 where nothing was seen (a view, no copy).")
+      .def("__repr__", [](const Camera& self) { return "<Camera '" + self.GetName() + "'>"; });
+}
+
+void BindSceneRender(py::module_& m) {
+  const auto ka = py::keep_alive<0, 1>();
+  auto scene = py::reinterpret_borrow<py::class_<Scene, std::shared_ptr<Scene>>>(m.attr("Scene"));
+  scene
+      .def("add_camera", &Scene::AddCamera, py::arg("name"), py::arg("width"), py::arg("height"),
+           py::arg("fovy"), py::arg("near"), py::arg("far"), ka,
+           "A camera fixed in the world: size in pixels (1 to 16384), vertical field of view "
+           "(rad), clipping distances (m). Place it with set_pose.")
+      .def("add_mounted_camera",
+           py::overload_cast<const std::string&, const Actor&, const Pose&, int, int, double,
+                             double, double>(&Scene::AddMountedCamera),
+           py::arg("name"), py::arg("mount"), py::arg("pose"), py::arg("width"), py::arg("height"),
+           py::arg("fovy"), py::arg("near"), py::arg("far"), ka,
+           "A camera moving with an actor; `pose` is its pose in the actor's frame.")
+      .def("add_mounted_camera",
+           py::overload_cast<const std::string&, const Link&, const Pose&, int, int, double, double,
+                             double>(&Scene::AddMountedCamera),
+           py::arg("name"), py::arg("mount"), py::arg("pose"), py::arg("width"), py::arg("height"),
+           py::arg("fovy"), py::arg("near"), py::arg("far"), ka,
+           "A camera moving with a link; `pose` is its pose in the link's frame.")
+      .def("remove_camera", &Scene::RemoveCamera, py::arg("camera"))
+      .def("get_cameras",
+           [](py::object self) { return HandleList(self.cast<const Scene&>().GetCameras(), self); })
+      .def("add_directional_light", &Scene::AddDirectionalLight, py::arg("direction"),
+           py::arg("color"), py::arg("shadow") = false,
+           "Light travelling along `direction` (3,) (world); color (3,) linear RGB.")
+      .def("add_point_light", &Scene::AddPointLight, py::arg("position"), py::arg("color"),
+           "Point light at `position` (3,) (m, world).")
+      .def("add_spot_light", &Scene::AddSpotLight, py::arg("position"), py::arg("direction"),
+           py::arg("inner_angle"), py::arg("outer_angle"), py::arg("color"),
+           py::arg("shadow") = false,
+           "Spot light; half angles in radians, 0 <= inner <= outer <= pi/2.")
+      .def("set_ambient_light", &Scene::SetAmbientLight, py::arg("color"),
+           "Ambient light (3,), linear RGB.")
+      .def("get_lights", &Scene::GetLights)
+      .def("set_render_backend", py::overload_cast<const std::string&>(&Scene::SetRenderBackend),
+           py::arg("name"), "'rasterizer' (the default), 'pathtracer' or 'null'.")
+      .def("get_render_backend", &Scene::GetRenderBackend, py::return_value_policy::reference, ka,
+           "The backend (created on first use: the rasterizer unless another was set).")
+      .def("update_render", &Scene::UpdateRender,
+           "Copies the current poses of everything visible (and mounted cameras) into the "
+           "render world.")
+      .def("get_render_entities", &Scene::GetRenderEntities,
+           "What the actor/link ids of segmentation (channel 1) name.")
+      .def("get_render_visuals", &Scene::GetRenderVisuals,
+           "What the visual ids of segmentation (channel 0) name.");
+}
+
+void BindImageIo(py::module_& m) {
+  m.def(
+      "get_point_cloud",
+      [](const Camera& camera, const std::string& frame) {
+        PointCloud c = MakePointCloud(camera, FrameFromName(frame));
+        ssize_t n = static_cast<ssize_t>(c.Size());
+        py::dict out;
+        out["positions"] = Owned(std::move(c.positions), {n, 3});
+        out["colors"] = Owned(std::move(c.colors), {n, 4});
+        out["visual_ids"] = Owned(std::move(c.visual_ids), {n});
+        out["entity_ids"] = Owned(std::move(c.entity_ids), {n});
+        return out;
+      },
+      py::arg("camera"), py::arg("frame") = "camera",
+      "Points of the camera's last picture that see a surface, in the 'camera' (OpenGL: x "
+      "right, y up, z backward) or 'world' frame: dict of positions float32 (N, 3) m, colors "
+      "uint8 (N, 4) sRGB, visual_ids and entity_ids uint32 (N,).");
+  m.def(
+      "write_png",
+      [](const std::string& path, const CArray<uint8_t>& image) {
+        std::array<int, 3> s = ImageShape(image, "write_png", true);
+        WritePng(path, s[1], s[0], s[2], image.data());
+      },
+      py::arg("path"), py::arg("image"),
+      "8-bit PNG from uint8 (h, w) grey or (h, w, c) with c = 2, 3 or 4.");
+  m.def(
+      "write_depth_png",
+      [](const std::string& path, const CArray<float>& depth) {
+        std::array<int, 3> s = ImageShape(depth, "write_depth_png", false);
+        WriteDepthPng(path, s[1], s[0], depth.data());
+      },
+      py::arg("path"), py::arg("depth"),
+      "16-bit PNG in millimetres from depth (h, w) in metres (0 stays 0).");
+  m.def(
+      "write_segmentation_png",
+      [](const std::string& path, const CArray<uint32_t>& ids) {
+        std::array<int, 3> s = ImageShape(ids, "write_segmentation_png", false);
+        WriteSegmentationPng(path, s[1], s[0], ids.data());
+      },
+      py::arg("path"), py::arg("ids"),
+      "RGB PNG of ids (h, w) (e.g. picture[..., 1]), one fixed colour per id, 0 black.");
+  m.def(
+      "get_segmentation_color",
+      [](uint32_t id) {
+        std::array<uint8_t, 3> c = SegmentationColor(id);
+        return std::vector<int>(c.begin(), c.end());
+      },
+      py::arg("id"), "The [r, g, b] colour of an id in write_segmentation_png.");
+  m.def(
+      "write_ply",
+      [](const std::string& path, const CArray<float>& positions,
+         const std::optional<CArray<uint8_t>>& colors,
+         const std::optional<CArray<uint32_t>>& visual_ids,
+         const std::optional<CArray<uint32_t>>& entity_ids, bool binary) {
+        PointCloud c;
+        c.positions.assign(positions.data(), positions.data() + positions.size());
+        if (colors) c.colors.assign(colors->data(), colors->data() + colors->size());
+        if (visual_ids)
+          c.visual_ids.assign(visual_ids->data(), visual_ids->data() + visual_ids->size());
+        if (entity_ids)
+          c.entity_ids.assign(entity_ids->data(), entity_ids->data() + entity_ids->size());
+        WritePly(path, c, binary);
+      },
+      py::arg("path"), py::arg("positions"), py::arg("colors") = py::none(),
+      py::arg("visual_ids") = py::none(), py::arg("entity_ids") = py::none(),
+      py::arg("binary") = true,
+      "PLY point cloud: positions (N, 3), colors uint8 (N, 4) (white if None), ids uint32 (N,) "
+      "(0 if None); binary little-endian or ASCII.");
+  m.def(
+      "write_npy",
+      [](const std::string& path, const py::array& array) {
+        if (array.dtype().equal(py::dtype::of<float>())) {
+          auto a = CArray<float>::ensure(array);
+          WriteNpy(path, a.data(), Shape(a));
+        } else if (array.dtype().equal(py::dtype::of<uint32_t>())) {
+          auto a = CArray<uint32_t>::ensure(array);
+          WriteNpy(path, a.data(), Shape(a));
+        } else {
+          throw Error("write_npy: array must be float32 or uint32, got " +
+                      std::string(py::str(array.dtype())));
+        }
+      },
+      py::arg("path"), py::arg("array"), "NumPy .npy of a float32 or uint32 array.");
+}
+
+}  // namespace
+
+void BindRender(py::module_& m) {
+  BindTypes(m);
+  BindCamera(m);
+  BindSceneRender(m);
+  BindImageIo(m);
+}
+
+}  // namespace partsim::python
