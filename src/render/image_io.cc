@@ -191,15 +191,16 @@ std::vector<uint8_t> ToRgba8(const std::vector<float>& rgba) {
 
 std::array<uint8_t, 3> SegmentationColor(uint32_t id) {
   if (id == 0) return {0, 0, 0};
-  // hash the id (murmur3 finaliser), then take a hue from it at full saturation and a value in
-  // [0.6, 1] so that every id is clearly brighter than the background
+  // hue from the golden-ratio sequence (neighbouring ids get far-apart hues); saturation and
+  // value from a hash of the id (murmur3 finaliser), value in [0.6, 1] so that every id is
+  // clearly brighter than the background
   uint32_t h = id;
   h ^= h >> 16;
   h *= 0x85ebca6bu;
   h ^= h >> 13;
   h *= 0xc2b2ae35u;
   h ^= h >> 16;
-  double hue = (h & 0xffff) / 65536.0 * 6.0;
+  double hue = std::fmod(id * 0.6180339887498949, 1.0) * 6.0;
   double sat = 0.55 + 0.45 * ((h >> 16) & 0xff) / 255.0;
   double val = 0.6 + 0.4 * ((h >> 24) & 0xff) / 255.0;
   int sector = static_cast<int>(hue);

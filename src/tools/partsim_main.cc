@@ -1,15 +1,18 @@
-// The `partsim` command-line program: inspect a URDF articulation (`info`) or simulate it and
-// write its joint trajectory (`simulate`). With no file, both use the built-in cabinet of
-// MakeCabinetUrdf(). Exit codes: 0 success, 1 failure while running (missing or bad file), 2 bad
-// command line.
+// The `partsim` command-line program: inspect a URDF articulation (`info`), simulate it and
+// write its joint trajectory (`simulate`), or render it from a few views (`render`). With no
+// file, all use the built-in cabinet of MakeCabinetUrdf(). Exit codes: 0 success, 1 failure while
+// running (missing or bad file), 2 bad command line.
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -24,6 +27,9 @@
 #include "partsim/assets/urdf.h"
 #include "partsim/core/error.h"
 #include "partsim/physics/scene.h"
+#include "partsim/render/backend.h"
+#include "partsim/render/camera.h"
+#include "partsim/render/image_io.h"
 
 namespace {
 
@@ -34,6 +40,7 @@ constexpr char kUsage[] = R"(partsim: simulate robots and articulated objects (d
 usage:
   partsim info [FILE.urdf] [--fix-root | --free-root] [--json]
   partsim simulate [FILE.urdf] --steps N [options]
+  partsim render [FILE.urdf] --out DIR [options]
   partsim --help | --version
 
 info       prints the links (name, parent, mass), the joints (name, type, parent -> child,
@@ -54,7 +61,21 @@ simulate   steps the articulation and writes its joint trajectory: time, then th
   --gravity X,Y,Z            gravity in m/s^2 (default 0,0,-9.81)
   --fix-root | --free-root   as for info (default --fix-root)
 
-With no FILE, both commands use the built-in cabinet (a drawer and a door); `simulate` then runs
+render     places the object on a ground under lights and renders it from N views around it,
+           looking at its centre. Writes into DIR, per view K: color_K.png (8-bit sRGB),
+           depth_K.png (16-bit, millimetres, 0 = nothing), normal_K.png (camera frame,
+           (n + 1) / 2), segmentation_K.png (one colour per actor or link) and cloud_K.ply
+           (binary point cloud in the world frame with colours and ids); plus
+           segmentation.json (id -> actor / link name, part label, colour) and cameras.json
+           (K, extrinsics and pose per view).
+  --out DIR                      output folder (required; created if missing)
+  --backend rasterizer|pathtracer   renderer (default rasterizer)
+  --views N                      number of views (default 4)
+  --width W --height H           image size in pixels (default 640 x 480)
+  --spp N                        path tracer samples per pixel (default 64)
+  --fix-root | --free-root       as for info (default --fix-root)
+
+With no FILE, all commands use the built-in cabinet (a drawer and a door); `simulate` then runs
 a demo that drives the drawer and the door open and prints their final positions.
 Exit codes: 0 success, 1 runtime failure (missing or invalid file), 2 bad command line.
 )";
@@ -67,7 +88,7 @@ class UsageError : public std::runtime_error {
 
 /// Parsed command line.
 struct Args {
-  std::string command;  // "info" or "simulate"
+  std::string command;  // "info", "simulate" or "render"
   std::string file;     // "" for the built-in cabinet
   bool fix_root = true;
   bool json = false;
@@ -79,6 +100,12 @@ struct Args {
   std::optional<double> damping;
   std::optional<std::vector<double>> target;
   Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.81);
+  // render
+  std::string backend = "rasterizer";
+  int views = 4;
+  int width = 640;
+  int height = 480;
+  std::optional<int> spp;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -111,6 +138,18 @@ Args ParseArgs(const std::vector<std::string>& argv) {
   args.command = argv[0];
   const std::string prefix = "partsim " + args.command + ": ";
   bool simulate = args.command == "simulate";
+  bool render = args.command == "render";
+  // a positive integer flag value at most `max`
+  auto count = [&](const std::string& flag, const std::string& v, int max) {
+    char* end = nullptr;
+    errno = 0;
+    long n = std::strtol(v.c_str(), &end, 10);
+    if (v.empty() || *end != '\0' || errno == ERANGE || n < 1 || n > max) {
+      throw UsageError(prefix + flag + " expects an integer in [1, " + std::to_string(max) +
+                       "], got '" + v + "'");
+    }
+    return static_cast<int>(n);
+  };
   for (size_t i = 1; i < argv.size(); ++i) {
     std::string arg = argv[i];
     // positional: the URDF file
@@ -143,7 +182,7 @@ Args ParseArgs(const std::vector<std::string>& argv) {
     } else if (flag == "--free-root") {
       no_value();
       args.fix_root = false;
-    } else if (flag == "--json" && !simulate) {
+    } else if (flag == "--json" && !simulate && !render) {
       no_value();
       args.json = true;
     } else if (flag == "--steps" && simulate) {
@@ -158,9 +197,25 @@ Args ParseArgs(const std::vector<std::string>& argv) {
     } else if (flag == "--dt" && simulate) {
       args.dt = ParseNumber(prefix + "--dt", value());
       if (args.dt <= 0) throw UsageError(prefix + "--dt must be > 0");
-    } else if (flag == "--out" && simulate) {
+    } else if (flag == "--out" && (simulate || render)) {
       args.out = value();
-      if (args.out.empty()) throw UsageError(prefix + "--out needs a file name");
+      if (args.out.empty())
+        throw UsageError(prefix + "--out needs a " + (render ? "folder" : "file") + " name");
+    } else if (flag == "--backend" && render) {
+      // "null" renders nothing; it is left out of the help, for tests
+      args.backend = value();
+      if (args.backend != "rasterizer" && args.backend != "pathtracer" && args.backend != "null") {
+        throw UsageError(prefix + "--backend must be rasterizer or pathtracer, got '" +
+                         args.backend + "'");
+      }
+    } else if (flag == "--views" && render) {
+      args.views = count(flag, value(), 360);
+    } else if (flag == "--width" && render) {
+      args.width = count(flag, value(), 16384);
+    } else if (flag == "--height" && render) {
+      args.height = count(flag, value(), 16384);
+    } else if (flag == "--spp" && render) {
+      args.spp = count(flag, value(), 1 << 20);
     } else if (flag == "--format" && simulate) {
       args.format = value();
       if (args.format != "csv" && args.format != "json") {
@@ -187,6 +242,10 @@ Args ParseArgs(const std::vector<std::string>& argv) {
   }
   if (simulate && !args.file.empty() && !args.steps) {
     throw UsageError(prefix + "--steps N is required when simulating a file");
+  }
+  if (render && args.out.empty()) throw UsageError(prefix + "--out DIR is required");
+  if (render && args.spp && args.backend != "pathtracer") {
+    throw UsageError(prefix + "--spp applies to --backend pathtracer only");
   }
   if (simulate && args.target && !args.stiffness) {
     throw UsageError(prefix +
@@ -447,6 +506,180 @@ int RunSimulate(const Args& args) {
   return 0;
 }
 
+// ---------------------------------------------------------------------------------------------
+// render
+
+/// Camera pose (x forward, y left, z up) at `eye` looking at `target`.
+partsim::Pose LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  Eigen::Vector3d x = (target - eye).normalized();
+  Eigen::Vector3d y = Eigen::Vector3d::UnitZ().cross(x);
+  // looking straight down: any horizontal left axis will do
+  if (y.norm() < 1e-9) y = Eigen::Vector3d::UnitY();
+  y.normalize();
+  Eigen::Matrix3d R;
+  R << x, y, x.cross(y);
+  return partsim::Pose(eye, Eigen::Quaterniond(R));
+}
+
+/// World bounding box of the visuals of entities in `ids` (from the render world); false when
+/// they have none.
+bool VisualBounds(const partsim::RenderWorld& world, const std::vector<uint32_t>& ids,
+                  Eigen::Vector3d* lo, Eigen::Vector3d* hi) {
+  bool any = false;
+  for (const partsim::RenderInstance& inst : world.instances) {
+    if (std::find(ids.begin(), ids.end(), inst.entity_id) == ids.end() || !inst.mesh) continue;
+    for (const Eigen::Vector3f& v : inst.mesh->vertices) {
+      Eigen::Vector3d p = (inst.X_WV * v.cast<double>().homogeneous()).head<3>();
+      *lo = any ? lo->cwiseMin(p) : p;
+      *hi = any ? hi->cwiseMax(p) : p;
+      any = true;
+    }
+  }
+  return any;
+}
+
+std::string ViewFile(const std::filesystem::path& dir, const char* stem, int k, const char* ext) {
+  return (dir / (std::string(stem) + "_" + std::to_string(k) + ext)).string();
+}
+
+void WriteJsonFile(const std::filesystem::path& path, const nlohmann::ordered_json& j) {
+  std::ofstream out(path);
+  out << j.dump(2) << "\n";
+  if (!out) throw std::runtime_error("cannot write '" + path.string() + "'");
+}
+
+int RunRender(const Args& args) {
+  Loaded l = Load(args, partsim::SceneConfig());
+  partsim::Scene& scene = *l.scene;
+  std::filesystem::path dir(args.out);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir)) {
+    throw std::runtime_error("cannot create the output folder '" + args.out +
+                             "': " + (ec ? ec.message() : "not a folder"));
+  }
+
+  // the backend first: a renderer that cannot start fails before any work
+  if (args.backend == "pathtracer") {
+    partsim::PathTracerOptions options;
+    options.samples_per_pixel = args.spp.value_or(64);
+    scene.SetRenderBackend(partsim::MakePathTracerBackend(options));
+  } else {
+    scene.SetRenderBackend(args.backend);
+  }
+  partsim::RenderBackend& backend = scene.GetRenderBackend();
+
+  // the object's extent, from its visuals (else from its link origins)
+  std::vector<uint32_t> ids;
+  for (const partsim::RenderEntityInfo& e : scene.GetRenderEntities())
+    if (e.articulation_id == l.art.GetId()) ids.push_back(e.id);
+  scene.UpdateRender();
+  Eigen::Vector3d lo, hi;
+  if (!VisualBounds(scene.GetRenderWorld(), ids, &lo, &hi)) {
+    std::cerr << "partsim render: the object has no visuals; framing its link origins\n";
+    lo = hi = l.art.GetLink(0).GetPose().p;
+    for (const partsim::Link& link : l.art.GetLinks()) {
+      lo = lo.cwiseMin(link.GetPose().p);
+      hi = hi.cwiseMax(link.GetPose().p);
+    }
+    lo -= Eigen::Vector3d::Constant(0.25);
+    hi += Eigen::Vector3d::Constant(0.25);
+  }
+  Eigen::Vector3d centre = 0.5 * (lo + hi);
+  double radius = std::max(0.5 * (hi - lo).norm(), 1e-3);
+
+  // ground under the object, a key light with shadows, a fill light and some ambient
+  scene.AddGround(lo.z());
+  scene.AddDirectionalLight(Eigen::Vector3d(-0.4, 0.3, -1.0), Eigen::Vector3f(2.5f, 2.4f, 2.3f),
+                            true);
+  scene.AddDirectionalLight(Eigen::Vector3d(0.5, -0.6, -0.4), Eigen::Vector3f(0.6f, 0.6f, 0.7f));
+  scene.SetAmbientLight(Eigen::Vector3f(0.25f, 0.25f, 0.25f));
+
+  // cameras on a circle around the centre, 25 degrees above it, the whole object in view
+  const double fovy = 0.8;
+  const double pi = 3.14159265358979323846;
+  std::vector<partsim::Camera> cameras;
+  for (int k = 0; k < args.views; ++k) {
+    partsim::Camera cam =
+        scene.AddCamera("view_" + std::to_string(k), args.width, args.height, fovy, 0.01, 100.0);
+    double half_fov = 0.5 * std::min(cam.GetFovx(), cam.GetFovy());
+    double distance = 1.1 * radius / std::sin(half_fov);
+    double azimuth = pi / 6 + 2 * pi * k / args.views, elevation = 25 * pi / 180;
+    Eigen::Vector3d dir(std::cos(azimuth) * std::cos(elevation),
+                        std::sin(azimuth) * std::cos(elevation), std::sin(elevation));
+    cam.SetLocalPose(LookAt(centre + distance * dir, centre));
+    cameras.push_back(cam);
+  }
+  scene.UpdateRender();
+  std::printf("rendering %s: %d views of %d x %d with %s on %s\n", l.source.c_str(), args.views,
+              args.width, args.height, backend.Name().c_str(), backend.Device().c_str());
+
+  // pictures and their files
+  nlohmann::ordered_json views = nlohmann::ordered_json::array();
+  for (int k = 0; k < args.views; ++k) {
+    partsim::Camera& cam = cameras[k];
+    auto start = std::chrono::steady_clock::now();
+    cam.TakePicture();
+    double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const partsim::Picture& picture = cam.GetPictureData();
+    partsim::WriteColorPng(ViewFile(dir, "color", k, ".png"), picture);
+    partsim::WriteDepthPng(ViewFile(dir, "depth", k, ".png"), picture);
+    partsim::WriteNormalPng(ViewFile(dir, "normal", k, ".png"), picture);
+    partsim::WriteSegmentationPng(ViewFile(dir, "segmentation", k, ".png"), picture, 1);
+    partsim::PointCloud cloud = partsim::MakePointCloud(cam, partsim::PointCloudFrame::kWorld);
+    partsim::WritePly(ViewFile(dir, "cloud", k, ".ply"), cloud, true);
+    std::printf("view %d: %zu points, %.3f s\n", k, cloud.Size(), seconds);
+
+    nlohmann::ordered_json v;
+    v["index"] = k;
+    v["width"] = args.width;
+    v["height"] = args.height;
+    Eigen::Matrix3d K = cam.GetIntrinsicMatrix();
+    Eigen::Matrix<double, 3, 4> Rt = cam.GetExtrinsicMatrix();
+    v["K"] = {
+        {K(0, 0), K(0, 1), K(0, 2)}, {K(1, 0), K(1, 1), K(1, 2)}, {K(2, 0), K(2, 1), K(2, 2)}};
+    v["extrinsic"] = nlohmann::ordered_json::array();
+    for (int r = 0; r < 3; ++r) v["extrinsic"].push_back({Rt(r, 0), Rt(r, 1), Rt(r, 2), Rt(r, 3)});
+    partsim::Pose X_WC = cam.GetPose();
+    v["pose"] = {{"p", {X_WC.p.x(), X_WC.p.y(), X_WC.p.z()}},
+                 {"q", {X_WC.q.w(), X_WC.q.x(), X_WC.q.y(), X_WC.q.z()}}};
+    v["points"] = cloud.Size();
+    views.push_back(v);
+  }
+
+  // what the ids and colours of segmentation images name
+  nlohmann::ordered_json legend;
+  legend["source"] = l.source;
+  legend["channel"] = "segmentation_K.png colours actors and links (entity ids)";
+  legend["entities"] = nlohmann::ordered_json::array();
+  for (const partsim::RenderEntityInfo& e : scene.GetRenderEntities()) {
+    std::array<uint8_t, 3> c = partsim::SegmentationColor(e.id);
+    nlohmann::ordered_json j;
+    j["id"] = e.id;
+    j["kind"] = e.is_link ? "link" : "actor";
+    j["name"] = e.name;
+    if (e.is_link) j["articulation"] = e.articulation_name;
+    j["semantic_label"] = e.semantic_label;
+    j["color"] = {c[0], c[1], c[2]};
+    legend["entities"].push_back(j);
+  }
+  legend["visuals"] = nlohmann::ordered_json::array();
+  for (const partsim::RenderVisualInfo& v : scene.GetRenderVisuals())
+    legend["visuals"].push_back({{"id", v.id}, {"entity_id", v.entity_id}, {"name", v.name}});
+  WriteJsonFile(dir / "segmentation.json", legend);
+  nlohmann::ordered_json cams;
+  cams["backend"] = backend.Name();
+  cams["device"] = backend.Device();
+  cams["convention"] =
+      "K and extrinsic [R|t] in OpenCV's camera frame (x right, y down, z forward); pose X_WC "
+      "with x forward, y left, z up; quaternion w, x, y, z";
+  cams["views"] = views;
+  WriteJsonFile(dir / "cameras.json", cams);
+  std::printf("wrote %d views to %s\n", args.views, args.out.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -465,9 +698,10 @@ int main(int argc, char** argv) {
     std::printf("partsim %s (MuJoCo %d.%d.%d)\n", kVersion, v / 100, (v / 10) % 10, v % 10);
     return 0;
   }
-  if (command != "info" && command != "simulate") {
+  if (command != "info" && command != "simulate" && command != "render") {
     std::fprintf(stderr,
-                 "partsim: unknown %s '%s' (expected info or simulate; see partsim --help)\n",
+                 "partsim: unknown %s '%s' (expected info, simulate or render; see partsim "
+                 "--help)\n",
                  command[0] == '-' ? "option" : "command", command.c_str());
     return 2;
   }
@@ -479,7 +713,9 @@ int main(int argc, char** argv) {
       }
     }
     Args parsed = ParseArgs(args);
-    return parsed.command == "info" ? RunInfo(parsed) : RunSimulate(parsed);
+    if (parsed.command == "info") return RunInfo(parsed);
+    if (parsed.command == "simulate") return RunSimulate(parsed);
+    return RunRender(parsed);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;

@@ -2,9 +2,14 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <Eigen/Core>
+#include <array>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -99,10 +104,19 @@ TEST_F(CliTest, BadCommandLinesExitWithCodeTwoAndNameTheCulprit) {
       {"simulate --drive-stiffness 10 --target 1 --steps 3", "--target"},  // 2 dof
       {"simulate CABINET", "--steps"},                                     // a file needs --steps
       {"info CABINET other.urdf", "other.urdf"},
+      {"render", "--out"},  // the folder is required
+      {"render --out OUT --views 0", "--views"},
+      {"render --out OUT --width 20000", "--width"},
+      {"render --out OUT --height x", "--height"},
+      {"render --out OUT --backend vulkan", "--backend"},
+      {"render --out OUT --spp 4", "--spp"},  // the rasterizer takes no samples
+      {"info --backend null", "--backend"},   // render's flag
   };
   for (const Case& c : cases) {
     std::string args = c.args;
     if (size_t at = args.find("CABINET"); at != std::string::npos) args.replace(at, 7, cabinet_);
+    if (size_t at = args.find("OUT"); at != std::string::npos)
+      args.replace(at, 3, (dir_ / "out").string());
     RunResult r = RunCli(args);
     EXPECT_EQ(r.code, 2) << args << "\n" << r.output;
     EXPECT_TRUE(Contains(r.output, c.named)) << args << "\n" << r.output;
@@ -111,7 +125,9 @@ TEST_F(CliTest, BadCommandLinesExitWithCodeTwoAndNameTheCulprit) {
 
 TEST_F(CliTest, MissingOrInvalidFileExitsWithCodeOne) {
   std::string missing = (dir_ / "no_such_cabinet.urdf").string();
-  for (const std::string& cmd : {"info ", "simulate --steps 3 "}) {
+  const std::vector<std::string> commands = {
+      "info ", "simulate --steps 3 ", "render --backend null --out " + (dir_ / "r").string() + " "};
+  for (const std::string& cmd : commands) {
     RunResult r = RunCli(cmd + missing);
     EXPECT_EQ(r.code, 1) << r.output;
     EXPECT_TRUE(Contains(r.output, "no_such_cabinet.urdf")) << r.output;
@@ -231,6 +247,109 @@ TEST_F(CliTest, SimulateWritesJsonTrajectoryAndHonoursGravity) {
   nlohmann::json k = nlohmann::json::parse(s.output);
   EXPECT_EQ(k["time"].size(), 4u);
 }
+
+/// PNG width, height, bit depth and colour type, from the IHDR chunk.
+std::array<int, 4> PngHeader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char b[26] = {};
+  in.read(reinterpret_cast<char*>(b), sizeof(b));
+  if (!in || std::memcmp(b, "\x89PNG", 4) != 0) return {-1, -1, -1, -1};
+  auto be32 = [&](int at) { return b[at] << 24 | b[at + 1] << 16 | b[at + 2] << 8 | b[at + 3]; };
+  return {be32(16), be32(20), b[24], b[25]};
+}
+
+/// Points of a binary PLY written by partsim: position and entity id.
+struct PlyPoint {
+  Eigen::Vector3f p;
+  uint32_t entity;
+};
+std::vector<PlyPoint> ReadPly(const std::string& path, std::string* header) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string data = s.str();
+  size_t end = data.find("end_header\n");
+  std::vector<PlyPoint> points;
+  if (end == std::string::npos) return points;
+  *header = data.substr(0, end);
+  for (size_t at = end + 11; at + 24 <= data.size(); at += 24) {
+    PlyPoint pt;
+    std::memcpy(pt.p.data(), data.data() + at, 12);
+    std::memcpy(&pt.entity, data.data() + at + 20, 4);
+    points.push_back(pt);
+  }
+  return points;
+}
+
+/// Renders the built-in cabinet from `views` views with `backend` and checks the files: images
+/// of the asked size, and world-frame points on the cabinet (inside its box: depth 0.5 m along
+/// x, width 0.6 m, height 0.8 m, origin at the bottom centre) or on the ground (z = 0).
+void CheckRender(const fs::path& dir, const std::string& backend, int views, bool expect_points) {
+  std::string out = (dir / backend).string();
+  RunResult r =
+      RunCli("render --backend " + backend + " --views " + std::to_string(views) +
+             " --width 64 --height 48 --out " + out + (backend == "pathtracer" ? " --spp 2" : ""));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Contains(r.output, "with " + backend)) << r.output;
+
+  // the legend names the ground and the cabinet's links, with their colours
+  nlohmann::json legend;
+  std::ifstream(fs::path(out) / "segmentation.json") >> legend;
+  std::map<std::string, nlohmann::json> by_name;
+  for (const auto& e : legend["entities"]) by_name[e["name"].get<std::string>()] = e;
+  ASSERT_EQ(by_name.size(), 4u) << legend.dump();
+  EXPECT_EQ(by_name["ground"]["kind"], "actor");
+  for (const char* link : {"body", "drawer_0", "door_0"}) {
+    EXPECT_EQ(by_name[link]["kind"], "link") << link;
+    EXPECT_EQ(by_name[link]["articulation"], "cabinet") << link;
+    EXPECT_EQ(by_name[link]["color"].size(), 3u);
+  }
+  EXPECT_FALSE(legend["visuals"].empty());
+  uint32_t ground_id = by_name["ground"]["id"].get<uint32_t>();
+  nlohmann::json cams;
+  std::ifstream(fs::path(out) / "cameras.json") >> cams;
+  ASSERT_EQ(cams["views"].size(), static_cast<size_t>(views));
+  EXPECT_EQ(cams["backend"], backend);
+
+  for (int k = 0; k < views; ++k) {
+    std::string n = std::to_string(k);
+    EXPECT_EQ(PngHeader(out + "/color_" + n + ".png"), (std::array<int, 4>{64, 48, 8, 6}));
+    EXPECT_EQ(PngHeader(out + "/depth_" + n + ".png"), (std::array<int, 4>{64, 48, 16, 0}));
+    EXPECT_EQ(PngHeader(out + "/normal_" + n + ".png"), (std::array<int, 4>{64, 48, 8, 2}));
+    EXPECT_EQ(PngHeader(out + "/segmentation_" + n + ".png"), (std::array<int, 4>{64, 48, 8, 2}));
+    std::string header;
+    std::vector<PlyPoint> points = ReadPly(out + "/cloud_" + n + ".ply", &header);
+    EXPECT_TRUE(Contains(header, "element vertex " + std::to_string(points.size()))) << header;
+    EXPECT_EQ(cams["views"][k]["points"].get<size_t>(), points.size());
+    if (!expect_points) {
+      EXPECT_TRUE(points.empty());
+      continue;
+    }
+    // most of the picture sees something, and every point lies on what it names
+    EXPECT_GT(points.size(), 64u * 48 / 2);
+    size_t on_cabinet = 0;
+    for (const PlyPoint& pt : points) {
+      if (pt.entity == ground_id) {
+        EXPECT_NEAR(pt.p.z(), 0.0f, 2e-3f);
+        continue;
+      }
+      ++on_cabinet;
+      // the open-able parts may stick out in front (+x) a little: handles
+      EXPECT_GT(pt.p.x(), -0.25f - 2e-3f);
+      EXPECT_LT(pt.p.x(), 0.25f + 0.08f);
+      EXPECT_LT(std::abs(pt.p.y()), 0.3f + 2e-3f);
+      EXPECT_GT(pt.p.z(), -2e-3f);
+      EXPECT_LT(pt.p.z(), 0.8f + 2e-3f);
+    }
+    EXPECT_GT(on_cabinet, 64u * 48 / 10) << "view " << k;
+  }
+}
+
+TEST_F(CliTest, RenderWritesImagesCloudsAndLegendWithTheNullBackend) {
+  CheckRender(dir_, "null", 3, /*expect_points=*/false);
+}
+
+TEST_F(CliTest, RenderWithThePathTracer) { CheckRender(dir_, "pathtracer", 2, true); }
 
 }  // namespace
 }  // namespace partsim
