@@ -1,0 +1,478 @@
+// Renderer benchmark: frames per second of partsim's rasterizer, read-back included, against a
+// bare OpenGL program in the same binary that draws the same triangles on the same kind of EGL
+// context (one simple shader writing colour and depth, the same read-back of colour and depth).
+//
+// Scenes: (a) a cabinet (body walls, a drawer with a handle, a door) with a parallel gripper
+// (palm, wrist, two fingers) on a ground plane, built from boxes; (b) 50 UV spheres of 1000
+// triangles each (50k triangles) on a ground plane. Sizes 128x128 and 512x512.
+//
+// Runs per scene and size:
+//   bare         the bare program: colour (RGBA float) + depth (float) read back
+//   partsim c+d  partsim with only colour and position/depth read back (like for like in what
+//                crosses to the CPU; it still runs its G-buffer and lighting passes)
+//   partsim all  partsim with every output read back (colour, albedo, normal, position,
+//                segmentation), as Camera::TakePicture does
+// Runs interleave within each repetition; the summary gives medians over repetitions.
+//
+// Usage: partsim_render_bench [--reps N] [--seconds S] [--shadows] [--cpu-time]
+// (--cpu-time: frames per second of process CPU time, all of llvmpipe's threads together)
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "partsim/render/backend.h"
+#include "partsim/render/camera_math.h"
+#include "render/gl_util.h"
+
+namespace {
+
+using partsim::CameraParams;
+using partsim::MeshData;
+using partsim::RenderInstance;
+using partsim::RenderWorld;
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::shared_ptr<MeshData> Box(const Eigen::Vector3f& h) {
+  auto m = std::make_shared<MeshData>();
+  for (int i = 0; i < 8; ++i) {
+    m->vertices.emplace_back((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
+                             (i & 4) ? h.z() : -h.z());
+  }
+  const int quads[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
+                           {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+  for (const auto& q : quads) {
+    m->faces.emplace_back(q[0], q[1], q[2]);
+    m->faces.emplace_back(q[0], q[2], q[3]);
+  }
+  return m;
+}
+
+// UV sphere with smooth normals: 2 * slices * (stacks - 1) triangles (25 x 21 -> 1000)
+std::shared_ptr<MeshData> Sphere(float r, int slices, int stacks) {
+  auto m = std::make_shared<MeshData>();
+  for (int i = 0; i <= stacks; ++i) {
+    double theta = kPi * i / stacks;
+    for (int j = 0; j <= slices; ++j) {
+      double phi = 2 * kPi * j / slices;
+      Eigen::Vector3f n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                        std::cos(theta));
+      m->vertices.push_back(r * n);
+      m->normals.push_back(n);
+    }
+  }
+  auto id = [&](int i, int j) { return i * (slices + 1) + j; };
+  for (int i = 0; i < stacks; ++i) {
+    for (int j = 0; j < slices; ++j) {
+      if (i != 0) m->faces.emplace_back(id(i, j), id(i + 1, j), id(i, j + 1));
+      if (i != stacks - 1) m->faces.emplace_back(id(i, j + 1), id(i + 1, j), id(i + 1, j + 1));
+    }
+  }
+  return m;
+}
+
+RenderInstance Instance(std::shared_ptr<MeshData> mesh, const Eigen::Vector3d& p,
+                        const Eigen::Vector4f& color, uint32_t id, uint32_t entity) {
+  RenderInstance inst;
+  inst.mesh = std::move(mesh);
+  inst.material.base_color = color;
+  inst.X_WV.topRightCorner<3, 1>() = p;
+  inst.visual_id = id;
+  inst.entity_id = entity;
+  return inst;
+}
+
+void AddLights(RenderWorld* world, bool shadows) {
+  partsim::LightDesc sun;
+  sun.direction = Eigen::Vector3d(0.4, 0.3, -1).normalized();
+  sun.color = Eigen::Vector3f::Constant(2.5f);
+  sun.shadow = shadows;
+  world->lights.push_back(sun);
+  partsim::LightDesc point;
+  point.type = partsim::LightType::kPoint;
+  point.position = {-1, 1, 2};
+  point.color = Eigen::Vector3f::Constant(2.0f);
+  world->lights.push_back(point);
+  world->ambient = Eigen::Vector3f::Constant(0.15f);
+}
+
+// (a) cabinet 0.8 x 0.6 x 0.5 m (x depth, y width, z height) with a drawer, a door and a handle;
+// a gripper in front of the handle
+RenderWorld CabinetScene(bool shadows) {
+  RenderWorld w;
+  Eigen::Vector4f wood(0.6f, 0.45f, 0.3f, 1), metal(0.7f, 0.7f, 0.75f, 1),
+      dark(0.2f, 0.2f, 0.2f, 1);
+  uint32_t id = 1;
+  auto add = [&](const Eigen::Vector3f& h, const Eigen::Vector3d& p, const Eigen::Vector4f& c,
+                 uint32_t entity) { w.instances.push_back(Instance(Box(h), p, c, id++, entity)); };
+  add({3, 3, 0.01f}, {0, 0, -0.01}, {0.5f, 0.5f, 0.5f, 1}, 1);  // ground
+  // body walls: back, left, right, top, bottom, middle shelf
+  add({0.01f, 0.3f, 0.25f}, {-0.39, 0, 0.25}, wood, 2);
+  add({0.4f, 0.01f, 0.25f}, {0, 0.29, 0.25}, wood, 2);
+  add({0.4f, 0.01f, 0.25f}, {0, -0.29, 0.25}, wood, 2);
+  add({0.4f, 0.3f, 0.01f}, {0, 0, 0.49}, wood, 2);
+  add({0.4f, 0.3f, 0.01f}, {0, 0, 0.01}, wood, 2);
+  add({0.4f, 0.28f, 0.01f}, {0, 0, 0.25}, wood, 2);
+  // drawer (upper half, pulled 0.15 m): front, bottom, sides, back, handle bar and posts
+  add({0.01f, 0.28f, 0.11f}, {0.54, 0, 0.37}, wood, 3);
+  add({0.38f, 0.27f, 0.005f}, {0.16, 0, 0.275}, wood, 3);
+  add({0.38f, 0.005f, 0.1f}, {0.16, 0.265, 0.37}, wood, 3);
+  add({0.38f, 0.005f, 0.1f}, {0.16, -0.265, 0.37}, wood, 3);
+  add({0.005f, 0.27f, 0.1f}, {-0.22, 0, 0.37}, wood, 3);
+  add({0.01f, 0.1f, 0.01f}, {0.59, 0, 0.37}, metal, 4);
+  add({0.02f, 0.005f, 0.005f}, {0.565, 0.08, 0.37}, metal, 4);
+  add({0.02f, 0.005f, 0.005f}, {0.565, -0.08, 0.37}, metal, 4);
+  // door (lower half) with a knob
+  add({0.01f, 0.28f, 0.11f}, {0.4, 0, 0.13}, wood, 5);
+  add({0.02f, 0.02f, 0.02f}, {0.43, 0.2, 0.13}, metal, 5);
+  // gripper: wrist, palm, two fingers
+  add({0.05f, 0.03f, 0.03f}, {0.78, 0, 0.37}, dark, 6);
+  add({0.02f, 0.08f, 0.03f}, {0.71, 0, 0.37}, dark, 7);
+  add({0.04f, 0.01f, 0.015f}, {0.65, 0.03, 0.37}, metal, 8);
+  add({0.04f, 0.01f, 0.015f}, {0.65, -0.03, 0.37}, metal, 9);
+  AddLights(&w, shadows);
+  return w;
+}
+
+// (b) 50 spheres of 1000 triangles in a 10 x 5 grid on a ground plane
+RenderWorld SpheresScene(bool shadows) {
+  RenderWorld w;
+  auto sphere = Sphere(0.08f, 25, 21);
+  w.instances.push_back(Instance(Box({3, 3, 0.01f}), {0, 0, -0.01}, {0.5f, 0.5f, 0.5f, 1}, 1, 1));
+  for (int i = 0; i < 50; ++i) {
+    double x = -0.4 + 0.2 * (i / 10), y = -0.9 + 0.2 * (i % 10);
+    Eigen::Vector4f c(0.2f + 0.015f * i, 0.8f - 0.01f * i, 0.5f, 1);
+    w.instances.push_back(Instance(sphere, {x, y, 0.08}, c, 2 + i, 2 + i));
+  }
+  AddLights(&w, shadows);
+  return w;
+}
+
+size_t TriangleCount(const RenderWorld& w) {
+  size_t n = 0;
+  for (const auto& i : w.instances) n += i.mesh->faces.size();
+  return n;
+}
+
+CameraParams CameraFor(int size, const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  // partsim camera: x forward, y left, z up
+  Eigen::Vector3d x = (target - eye).normalized();
+  Eigen::Vector3d y = Eigen::Vector3d::UnitZ().cross(x).normalized();
+  Eigen::Matrix3d R;
+  R << x, y, x.cross(y);
+  partsim::Pose X_WC(eye, Eigen::Quaterniond(R));
+  return partsim::MakeCameraParams(size, size, partsim::IntrinsicsFromFovy(size, size, 1.0), 0.05,
+                                   20.0, X_WC);
+}
+
+// ---------------------------------------------------------------------------------------------
+// the bare OpenGL program: same EGL context setup, one VAO per mesh, one draw per instance with
+// its MVP and colour, colour + depth targets, glReadPixels of both
+
+const char* kBareVertex = R"(#version 450 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+uniform mat4 u_mvp;
+uniform mat3 u_normal_matrix;
+out vec3 v_normal;
+void main() {
+  v_normal = u_normal_matrix * a_normal;
+  gl_Position = u_mvp * vec4(a_position, 1.0);
+}
+)";
+
+const char* kBareFragment = R"(#version 450 core
+in vec3 v_normal;
+uniform vec4 u_color;
+layout(location = 0) out vec4 o_color;
+void main() {
+  float l = max(dot(normalize(v_normal), normalize(vec3(0.3, 0.5, 0.8))), 0.0);
+  o_color = vec4(u_color.rgb * (0.2 + 0.8 * l), u_color.a);
+}
+)";
+
+class BareRenderer {
+ public:
+  explicit BareRenderer(const RenderWorld& world) {
+    program_ =
+        partsim::internal::BuildProgram("bare", kBareVertex, "bench", kBareFragment, "bench");
+    mvp_ = glGetUniformLocation(program_, "u_mvp");
+    normal_matrix_ = glGetUniformLocation(program_, "u_normal_matrix");
+    color_ = glGetUniformLocation(program_, "u_color");
+    for (const RenderInstance& inst : world.instances) {
+      const MeshData* key = inst.mesh.get();
+      if (std::find_if(meshes_.begin(), meshes_.end(),
+                       [&](const Mesh& m) { return m.key == key; }) != meshes_.end()) {
+        continue;
+      }
+      meshes_.push_back(Upload(*inst.mesh));
+    }
+  }
+
+  ~BareRenderer() {
+    context_.MakeCurrent();
+    for (Mesh& m : meshes_) {
+      glDeleteVertexArrays(1, &m.vao);
+      glDeleteBuffers(1, &m.vbo);
+      glDeleteBuffers(1, &m.ebo);
+    }
+    glDeleteFramebuffers(1, &fbo_);
+    glDeleteTextures(1, &color_tex_);
+    glDeleteTextures(1, &depth_tex_);
+    glDeleteProgram(program_);
+  }
+
+  void Render(const RenderWorld& world, const CameraParams& cam, std::vector<float>* color,
+              std::vector<float>* depth) {
+    context_.MakeCurrent();
+    Resize(cam.width, cam.height);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, cam.width, cam.height);
+    const float zeros[4] = {0, 0, 0, 0}, one = 1;
+    glClearNamedFramebufferfv(fbo_, GL_COLOR, 0, zeros);
+    glClearNamedFramebufferfv(fbo_, GL_DEPTH, 0, &one);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glUseProgram(program_);
+    Eigen::Matrix4d view_proj = cam.projection * cam.view;
+    for (const RenderInstance& inst : world.instances) {
+      const Mesh* mesh = nullptr;
+      for (const Mesh& m : meshes_) {
+        if (m.key == inst.mesh.get()) mesh = &m;
+      }
+      Eigen::Matrix4f mvp = (view_proj * inst.X_WV).cast<float>();
+      Eigen::Matrix3f nm =
+          (cam.view * inst.X_WV).topLeftCorner<3, 3>().inverse().transpose().cast<float>();
+      glUniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
+      glUniformMatrix3fv(normal_matrix_, 1, GL_FALSE, nm.data());
+      glUniform4fv(color_, 1, inst.material.base_color.data());
+      glBindVertexArray(mesh->vao);
+      glDrawElements(GL_TRIANGLES, mesh->count, GL_UNSIGNED_INT, nullptr);
+    }
+    size_t n = static_cast<size_t>(cam.width) * cam.height;
+    color->resize(4 * n);
+    depth->resize(n);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, cam.width, cam.height, GL_RGBA, GL_FLOAT, color->data());
+    glReadPixels(0, 0, cam.width, cam.height, GL_DEPTH_COMPONENT, GL_FLOAT, depth->data());
+  }
+
+ private:
+  struct Mesh {
+    const MeshData* key = nullptr;
+    GLuint vao = 0, vbo = 0, ebo = 0;
+    GLsizei count = 0;
+  };
+
+  Mesh Upload(const MeshData& data) {
+    // flat normals when the mesh has none, as partsim does
+    std::vector<float> v;
+    std::vector<uint32_t> idx;
+    bool smooth = data.normals.size() == data.vertices.size();
+    if (smooth) {
+      for (size_t i = 0; i < data.vertices.size(); ++i) {
+        v.insert(v.end(), data.vertices[i].data(), data.vertices[i].data() + 3);
+        v.insert(v.end(), data.normals[i].data(), data.normals[i].data() + 3);
+      }
+      for (const auto& f : data.faces)
+        idx.insert(idx.end(), {uint32_t(f[0]), uint32_t(f[1]), uint32_t(f[2])});
+    } else {
+      for (const auto& f : data.faces) {
+        Eigen::Vector3f n = (data.vertices[f[1]] - data.vertices[f[0]])
+                                .cross(data.vertices[f[2]] - data.vertices[f[0]])
+                                .normalized();
+        for (int k = 0; k < 3; ++k) {
+          idx.push_back(static_cast<uint32_t>(v.size() / 6));
+          v.insert(v.end(), data.vertices[f[k]].data(), data.vertices[f[k]].data() + 3);
+          v.insert(v.end(), n.data(), n.data() + 3);
+        }
+      }
+    }
+    Mesh m;
+    m.key = &data;
+    m.count = static_cast<GLsizei>(idx.size());
+    glCreateBuffers(1, &m.vbo);
+    glNamedBufferStorage(m.vbo, v.size() * sizeof(float), v.data(), 0);
+    glCreateBuffers(1, &m.ebo);
+    glNamedBufferStorage(m.ebo, idx.size() * sizeof(uint32_t), idx.data(), 0);
+    glCreateVertexArrays(1, &m.vao);
+    glVertexArrayVertexBuffer(m.vao, 0, m.vbo, 0, 6 * sizeof(float));
+    glVertexArrayElementBuffer(m.vao, m.ebo);
+    for (GLuint a = 0; a < 2; ++a) {
+      glEnableVertexArrayAttrib(m.vao, a);
+      glVertexArrayAttribFormat(m.vao, a, 3, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
+      glVertexArrayAttribBinding(m.vao, a, 0);
+    }
+    return m;
+  }
+
+  void Resize(int w, int h) {
+    if (w == width_ && h == height_) return;
+    glDeleteFramebuffers(1, &fbo_);
+    glDeleteTextures(1, &color_tex_);
+    glDeleteTextures(1, &depth_tex_);
+    glCreateTextures(GL_TEXTURE_2D, 1, &color_tex_);
+    glTextureStorage2D(color_tex_, 1, GL_RGBA32F, w, h);
+    glCreateTextures(GL_TEXTURE_2D, 1, &depth_tex_);
+    glTextureStorage2D(depth_tex_, 1, GL_DEPTH_COMPONENT32F, w, h);
+    glCreateFramebuffers(1, &fbo_);
+    glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, color_tex_, 0);
+    glNamedFramebufferTexture(fbo_, GL_DEPTH_ATTACHMENT, depth_tex_, 0);
+    width_ = w;
+    height_ = h;
+  }
+
+  partsim::internal::EglContext context_;  // constructed (and current) before the GL calls
+  GLuint program_ = 0;
+  GLint mvp_ = -1, normal_matrix_ = -1, color_ = -1;
+  std::vector<Mesh> meshes_;
+  GLuint fbo_ = 0, color_tex_ = 0, depth_tex_ = 0;
+  int width_ = 0, height_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// seconds on the wall clock, or of CPU time of the whole process (llvmpipe renders on worker
+// threads), which other jobs on the machine disturb less
+bool g_cpu_time = false;
+double Now() {
+  if (!g_cpu_time) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
+  timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+// frames per second of `render` over at least `seconds` (after one warm-up frame)
+template <typename F>
+double Fps(F&& render, double seconds) {
+  render();
+  double start = Now();
+  int frames = 0;
+  double elapsed = 0;
+  do {
+    render();
+    ++frames;
+    elapsed = Now() - start;
+  } while (elapsed < seconds);
+  return frames / elapsed;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int reps = 7;
+  double seconds = 0.5;
+  bool shadows = false;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) {
+      reps = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--seconds") && i + 1 < argc) {
+      seconds = std::atof(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--shadows")) {
+      shadows = true;
+    } else if (!std::strcmp(argv[i], "--cpu-time")) {
+      g_cpu_time = true;
+    } else {
+      std::fprintf(stderr, "usage: %s [--reps N] [--seconds S] [--shadows] [--cpu-time]\n",
+                   argv[0]);
+      return 2;
+    }
+  }
+
+  struct Case {
+    const char* name;
+    RenderWorld world;
+    Eigen::Vector3d eye, target;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"cabinet+gripper", CabinetScene(shadows), {1.8, 0.9, 1.2}, {0.2, 0, 0.25}});
+  cases.push_back({"50 spheres", SpheresScene(shadows), {1.6, 0.0, 1.3}, {0, 0, 0}});
+
+  auto partsim_backend = partsim::MakeRasterBackend();
+  auto* control = dynamic_cast<partsim::internal::RasterBackendControl*>(partsim_backend.get());
+  if (control == nullptr) {
+    std::fprintf(stderr, "the raster backend offers no read-back control\n");
+    return 1;
+  }
+  std::printf("device: %s; shadows %s; %d repetitions of >= %.2f s (%s) per run\n",
+              partsim_backend->Device().c_str(), shadows ? "on" : "off", reps, seconds,
+              g_cpu_time ? "process CPU time" : "wall clock");
+  std::printf("%-16s %6s %7s | %10s %12s %12s | %9s %9s\n", "scene", "size", "tris", "bare fps",
+              "partsim c+d", "partsim all", "c+d/bare", "all/bare");
+
+  int status = 0;
+  for (Case& c : cases) {
+    BareRenderer bare(c.world);
+    for (int size : {128, 512}) {
+      CameraParams cam = CameraFor(size, c.eye, c.target);
+      partsim::Picture pic;
+      std::vector<float> color, depth;
+
+      // the same triangles: both see a surface at the same number of pixels
+      control->SetReadbackMask(partsim::internal::kReadAll);
+      partsim_backend->Render(c.world, cam, &pic);
+      bare.Render(c.world, cam, &color, &depth);
+      size_t covered_partsim = 0, covered_bare = 0;
+      for (size_t i = 0; i < depth.size(); ++i) {
+        covered_partsim += pic.position[4 * i + 3] > 0;
+        covered_bare += depth[i] < 1.0f;
+      }
+      if (covered_partsim != covered_bare) {
+        std::fprintf(stderr, "%s %d: partsim sees %zu pixels, bare %zu\n", c.name, size,
+                     covered_partsim, covered_bare);
+        status = 1;
+      }
+
+      std::vector<double> fb, fcd, fall, rcd, rall;
+      for (int r = 0; r < reps; ++r) {
+        // rotate which run goes first
+        double b = 0, cd = 0, all = 0;
+        for (int k = 0; k < 3; ++k) {
+          switch ((r + k) % 3) {
+            case 0:
+              b = Fps([&] { bare.Render(c.world, cam, &color, &depth); }, seconds);
+              break;
+            case 1:
+              control->SetReadbackMask(partsim::internal::kReadColor |
+                                       partsim::internal::kReadPosition);
+              cd = Fps([&] { partsim_backend->Render(c.world, cam, &pic); }, seconds);
+              break;
+            case 2:
+              control->SetReadbackMask(partsim::internal::kReadAll);
+              all = Fps([&] { partsim_backend->Render(c.world, cam, &pic); }, seconds);
+              break;
+          }
+        }
+        fb.push_back(b);
+        fcd.push_back(cd);
+        fall.push_back(all);
+        rcd.push_back(cd / b);
+        rall.push_back(all / b);
+      }
+      std::printf("%-16s %6d %7zu | %10.1f %12.1f %12.1f | %9.3f %9.3f\n", c.name, size,
+                  TriangleCount(c.world), Median(fb), Median(fcd), Median(fall), Median(rcd),
+                  Median(rall));
+      std::fflush(stdout);
+    }
+  }
+  control->SetReadbackMask(partsim::internal::kReadAll);
+  return status;
+}

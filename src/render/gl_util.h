@@ -1,0 +1,80 @@
+// Internal helpers of the rasterizer: a headless EGL context for OpenGL 4.5 core, shader
+// compilation with errors that name the pass, and image loading for textures. The rasterizer
+// backend and the renderer benchmark (its bare OpenGL baseline) share them.
+#pragma once
+
+#include <EGL/egl.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#ifndef GL_GLEXT_PROTOTYPES
+#define GL_GLEXT_PROTOTYPES
+#endif
+#include <GL/glcorearb.h>
+
+namespace partsim::internal {
+
+/// An OpenGL 4.5 core context on a headless EGL display, without any surface (render into
+/// framebuffer objects). The display is an EGL device: a hardware one (e.g. an NVIDIA GPU) when
+/// there is one, else Mesa's software device, else Mesa's surfaceless platform. One context per
+/// object; MakeCurrent binds it to the calling thread.
+class EglContext {
+ public:
+  /// Throws partsim::Error when no display or context can be created.
+  EglContext();
+  ~EglContext();
+  EglContext(const EglContext&) = delete;
+  EglContext& operator=(const EglContext&) = delete;
+
+  /// Makes the context current on this thread (cheap when it already is).
+  void MakeCurrent();
+  /// Releases the context from this thread if it is current here.
+  void Release();
+  /// GL_RENDERER of the context (e.g. "llvmpipe (LLVM 15.0.6, 256 bits)").
+  const std::string& Renderer() const { return renderer_; }
+
+ private:
+  EGLDisplay display_ = EGL_NO_DISPLAY;
+  EGLContext context_ = EGL_NO_CONTEXT;
+  std::string renderer_;
+};
+
+/// Compiles and links a program from vertex and fragment sources (fragment may be empty for a
+/// depth-only pass). On failure throws partsim::Error naming `pass` and quoting the GL info log.
+GLuint BuildProgram(const std::string& pass, const std::string& vertex_source,
+                    const std::string& vertex_origin, const std::string& fragment_source,
+                    const std::string& fragment_origin);
+
+/// An 8-bit RGBA image, row 0 at the top.
+struct Image8 {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> rgba;  ///< height x width x 4
+};
+
+/// Loads a PNG or JPEG file (by content, not by extension) as RGBA8. Throws partsim::Error
+/// naming the file when it is missing or cannot be decoded.
+Image8 LoadImageRgba8(const std::string& path);
+
+/// Which outputs the rasterizer reads back (all by default). Only benchmarks change it, to compare
+/// like for like with a program that reads back less; bits of ReadbackOutput.
+enum ReadbackOutput : unsigned {
+  kReadColor = 1,
+  kReadAlbedo = 2,
+  kReadNormal = 4,
+  kReadPosition = 8,
+  kReadSegmentation = 16,
+  kReadAll = 31,
+};
+
+class RasterBackendControl {
+ public:
+  virtual ~RasterBackendControl() = default;
+  /// Restricts read back to `mask` (ReadbackOutput bits); outputs not read keep old contents.
+  virtual void SetReadbackMask(unsigned mask) = 0;
+};
+
+}  // namespace partsim::internal

@@ -1,0 +1,942 @@
+// The rasterizer: OpenGL 4.5 core on a headless EGL context (a GPU when there is one, else Mesa's
+// llvmpipe). Deferred shading in three steps per picture:
+//   1. shadow maps: depth of every instance seen from each directional or spot light with
+//      shadow = true (up to kMaxShadows of them), layers of one depth array texture;
+//   2. geometry pass: every instance into the G-buffer (albedo, normal, position + depth,
+//      segmentation ids, material parameters), one draw call per instance with its uniforms;
+//   3. lighting pass: a full-screen triangle reads the G-buffer and shades every pixel
+//      (Oren-Nayar diffuse + GGX specular, ambient, directional, point and spot lights, PCF
+//      shadows) into the colour target.
+// Then glReadPixels copies each target into the Picture. The projection is flipped vertically so
+// that framebuffer row 0 is the top row of the image: the read-back needs no flip.
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <mutex>
+#include <unordered_map>
+
+#include "partsim/core/error.h"
+#include "partsim/render/backend.h"
+#include "render/gl_util.h"
+
+namespace partsim {
+namespace {
+
+constexpr int kMaxLights = 32;
+constexpr int kMaxShadows = 4;
+
+// ---------------------------------------------------------------------------------------------
+// built-in shaders (shaders/README.md documents what custom ones must declare)
+
+const char* kGbufferVertex = R"(#version 450 core
+layout(location = 0) in vec3 a_position;  // visual frame (m)
+layout(location = 1) in vec3 a_normal;    // visual frame
+layout(location = 2) in vec2 a_uv;
+uniform mat4 u_model_view;     // visual -> OpenGL camera frame
+uniform mat3 u_normal_matrix;  // inverse transpose of u_model_view's 3x3
+uniform mat4 u_projection;     // OpenGL camera frame -> clip (rows flipped: row 0 at the top)
+out vec3 v_position;           // OpenGL camera frame (m)
+out vec3 v_normal;             // OpenGL camera frame
+out vec2 v_uv;
+void main() {
+  vec4 p = u_model_view * vec4(a_position, 1.0);
+  v_position = p.xyz;
+  v_normal = u_normal_matrix * a_normal;
+  v_uv = a_uv;
+  gl_Position = u_projection * p;
+}
+)";
+
+const char* kGbufferFragment = R"(#version 450 core
+in vec3 v_position;
+in vec3 v_normal;
+in vec2 v_uv;
+uniform vec4 u_base_color;   // linear RGBA
+uniform float u_roughness;
+uniform float u_metallic;
+uniform bool u_has_texture;
+uniform sampler2D u_diffuse;  // sRGB texture, sampled as linear
+uniform uvec2 u_ids;          // visual id, entity id
+layout(location = 0) out vec4 o_albedo;
+layout(location = 1) out vec4 o_normal;
+layout(location = 2) out vec4 o_position;
+layout(location = 3) out uvec4 o_segmentation;
+layout(location = 4) out vec4 o_material;
+void main() {
+  vec4 albedo = u_base_color;
+  if (u_has_texture) albedo *= texture(u_diffuse, v_uv);
+  vec3 n = normalize(v_normal);
+  if (!gl_FrontFacing) n = -n;  // two-sided: thin surfaces seen from behind
+  o_albedo = albedo;
+  o_normal = vec4(n, 0.0);
+  o_position = vec4(v_position, -v_position.z);
+  o_segmentation = uvec4(u_ids, 0u, 0u);
+  o_material = vec4(u_roughness, u_metallic, 0.0, 1.0);
+}
+)";
+
+const char* kFullscreenVertex = R"(#version 450 core
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+// the built-in lighting pass; "#version 450 core" and "#define LIGHTS ..." go before it: one
+// Light(index, type, shadow layer) call per light with literal arguments, so that the compiler
+// drops the branches a light does not need (software rasterizers run both sides of a branch)
+const char* kLightingFragment = R"(
+#define MAX_LIGHTS 32
+#define MAX_SHADOWS 4
+uniform sampler2D u_albedo;
+uniform sampler2D u_normal;
+uniform sampler2D u_position;
+uniform usampler2D u_segmentation;
+uniform sampler2D u_material;
+uniform sampler2DArrayShadow u_shadow_maps;
+uniform vec3 u_ambient;
+uniform int u_num_lights;
+uniform int u_light_type[MAX_LIGHTS];        // 0 directional, 1 point, 2 spot
+uniform vec3 u_light_color[MAX_LIGHTS];
+uniform vec3 u_light_position[MAX_LIGHTS];   // OpenGL camera frame (m)
+uniform vec3 u_light_direction[MAX_LIGHTS];  // OpenGL camera frame, where the light travels
+uniform vec2 u_light_cos_cone[MAX_LIGHTS];   // spot: cos(inner), cos(outer)
+uniform int u_light_shadow[MAX_LIGHTS];      // shadow map layer, -1 for none
+uniform mat4 u_shadow_matrix[MAX_SHADOWS];   // OpenGL camera frame -> shadow map [0,1]^3
+uniform vec2 u_shadow_texel[MAX_SHADOWS];    // texel size (m) = x + y * distance to the light
+layout(location = 0) out vec4 o_color;
+
+const float PI = 3.14159265358979;
+
+// the surface being shaded
+vec3 p, n, v, f0, albedo;
+float n_v, metallic, on_a, on_b, alpha2, k;
+
+float Shadow(int layer, float dist) {
+  vec2 texel = u_shadow_texel[layer];
+  float world_texel = texel.x + texel.y * dist;
+  vec4 s = u_shadow_matrix[layer] * vec4(p + n * (1.5 * world_texel), 1.0);
+  s.xyz /= s.w;
+  if (s.x <= 0.0 || s.x >= 1.0 || s.y <= 0.0 || s.y >= 1.0 || s.z >= 1.0) return 1.0;
+  vec2 step = 1.0 / vec2(textureSize(u_shadow_maps, 0).xy);
+  float lit = 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      lit += texture(u_shadow_maps, vec4(s.xy + vec2(dx, dy) * step, float(layer), s.z));
+  return lit / 9.0;
+}
+
+// light i of `type` (0 directional, 1 point, 2 spot), shadowed by map `layer` (-1: none)
+vec3 Light(int i, int type, int layer) {
+  vec3 l;
+  float attenuation = 1.0;
+  float dist = 0.0;
+  if (type == 0) {
+    l = -u_light_direction[i];
+  } else {
+    vec3 d = u_light_position[i] - p;
+    dist = length(d);
+    l = d / max(dist, 1e-6);
+    attenuation = 1.0 / max(dist * dist, 1e-6);
+    if (type == 2) {
+      float c = dot(-l, u_light_direction[i]);
+      attenuation *= smoothstep(u_light_cos_cone[i].y, u_light_cos_cone[i].x, c);
+    }
+  }
+  float n_l = dot(n, l);
+  if (n_l <= 0.0) return vec3(0.0);
+  if (layer >= 0) attenuation *= Shadow(layer, dist);
+  // Oren-Nayar diffuse (sigma = roughness), GGX specular (alpha = roughness^2, Smith-Schlick G,
+  // Schlick Fresnel)
+  vec3 h = normalize(l + v);
+  float n_h = max(dot(n, h), 0.0);
+  float v_h = max(dot(v, h), 0.0);
+  vec3 f = f0 + (1.0 - f0) * pow(1.0 - v_h, 5.0);
+  float dd = n_h * n_h * (alpha2 - 1.0) + 1.0;
+  float d_ggx = alpha2 / (PI * dd * dd);
+  float g = (n_l / (n_l * (1.0 - k) + k)) * (n_v / (n_v * (1.0 - k) + k));
+  vec3 specular = f * (d_ggx * g / (4.0 * n_l * n_v));
+  float s = dot(l, v) - n_l * n_v;
+  float on = on_a + (s > 0.0 ? on_b * s / max(n_l, n_v) : 0.0);
+  vec3 diffuse = (1.0 - f) * (1.0 - metallic) * albedo / PI * on;
+  // as in the path tracer: a light's colour is the irradiance at normal incidence
+  // (directional) or the intensity (point and spot, divided by the squared distance)
+  return (diffuse + specular) * (n_l * attenuation) * u_light_color[i];
+}
+
+void main() {
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  vec4 position = texelFetch(u_position, px, 0);
+  if (position.w <= 0.0) {  // background
+    o_color = vec4(0.0);
+    return;
+  }
+  albedo = texelFetch(u_albedo, px, 0).rgb;
+  n = normalize(texelFetch(u_normal, px, 0).xyz);
+  vec4 material = texelFetch(u_material, px, 0);
+  float roughness = clamp(material.x, 0.05, 1.0);
+  metallic = clamp(material.y, 0.0, 1.0);
+  p = position.xyz;
+  v = normalize(-p);
+  n_v = max(dot(n, v), 1e-4);
+  float sigma2 = roughness * roughness;
+  on_a = 1.0 - 0.5 * sigma2 / (sigma2 + 0.33);
+  on_b = 0.45 * sigma2 / (sigma2 + 0.09);
+  float alpha = roughness * roughness;
+  alpha2 = alpha * alpha;
+  k = alpha * 0.5;
+  f0 = mix(vec3(0.04), albedo, metallic);
+  // ambient: a uniform environment of radiance u_ambient, unoccluded
+  vec3 color = albedo * u_ambient * (1.0 - metallic) + f0 * u_ambient * metallic;
+  LIGHTS
+  o_color = vec4(clamp(color, 0.0, 1.0), 1.0);
+}
+)";
+
+const char* kShadowVertex = R"(#version 450 core
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_mvp;
+void main() { gl_Position = u_mvp * vec4(a_position, 1.0); }
+)";
+
+// ---------------------------------------------------------------------------------------------
+
+struct GpuMesh {
+  std::weak_ptr<const MeshData> owner;  // guards against a new mesh at a freed mesh's address
+  GLuint vao = 0;
+  GLuint vbo = 0;
+  GLuint ebo = 0;
+  GLsizei index_count = 0;
+  Eigen::AlignedBox3f box;  // in the visual frame
+  uint64_t last_used = 0;   // geometry version that last used it
+};
+
+struct GpuTexture {
+  GLuint id = 0;
+  uint64_t last_used = 0;
+};
+
+struct GbufferLocations {
+  GLint model_view = -1, normal_matrix = -1, projection = -1, base_color = -1, roughness = -1,
+        metallic = -1, has_texture = -1, diffuse = -1, ids = -1;
+};
+
+struct LightingLocations {
+  GLint ambient = -1, num_lights = -1, light_type = -1, light_color = -1, light_position = -1,
+        light_direction = -1, light_cos_cone = -1, light_shadow = -1, shadow_matrix = -1,
+        shadow_texel = -1;
+};
+
+// texture units of the lighting pass
+enum Unit : GLint {
+  kUnitAlbedo = 0,
+  kUnitNormal,
+  kUnitPosition,
+  kUnitSegmentation,
+  kUnitMaterial,
+  kUnitShadow
+};
+
+Eigen::Matrix4f ToFloat(const Eigen::Matrix4d& m) { return m.cast<float>(); }
+
+// a right-handed look-at view matrix (world -> eye, eye looks along -z)
+Eigen::Matrix4d LookAlong(const Eigen::Vector3d& eye, const Eigen::Vector3d& forward) {
+  Eigen::Vector3d f = forward.normalized();
+  Eigen::Vector3d up = std::abs(f.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  Eigen::Vector3d x = f.cross(up).normalized();
+  Eigen::Vector3d y = x.cross(f);
+  Eigen::Matrix4d v = Eigen::Matrix4d::Identity();
+  v.block<1, 3>(0, 0) = x.transpose();
+  v.block<1, 3>(1, 0) = y.transpose();
+  v.block<1, 3>(2, 0) = -f.transpose();
+  v(0, 3) = -x.dot(eye);
+  v(1, 3) = -y.dot(eye);
+  v(2, 3) = f.dot(eye);
+  return v;
+}
+
+Eigen::Matrix4d Ortho(double l, double r, double b, double t, double n, double f) {
+  Eigen::Matrix4d p = Eigen::Matrix4d::Identity();
+  p(0, 0) = 2 / (r - l);
+  p(1, 1) = 2 / (t - b);
+  p(2, 2) = -2 / (f - n);
+  p(0, 3) = -(r + l) / (r - l);
+  p(1, 3) = -(t + b) / (t - b);
+  p(2, 3) = -(f + n) / (f - n);
+  return p;
+}
+
+Eigen::Matrix4d Perspective(double fovy, double n, double f) {
+  double c = 1 / std::tan(fovy / 2);
+  Eigen::Matrix4d p = Eigen::Matrix4d::Zero();
+  p(0, 0) = c;
+  p(1, 1) = c;
+  p(2, 2) = -(f + n) / (f - n);
+  p(2, 3) = -2 * f * n / (f - n);
+  p(3, 2) = -1;
+  return p;
+}
+
+class RasterBackend final : public RenderBackend, public internal::RasterBackendControl {
+ public:
+  explicit RasterBackend(const RasterOptions& options) : options_(options) {
+    if (options_.shadow_map_size < 16 || options_.shadow_map_size > 16384) {
+      throw Error("RasterOptions::shadow_map_size must be in [16, 16384], got " +
+                  std::to_string(options_.shadow_map_size));
+    }
+    context_ = std::make_unique<internal::EglContext>();
+    static std::once_flag logged;
+    std::call_once(logged, [&] {
+      std::fprintf(stderr, "partsim: rasterizer on %s\n", context_->Renderer().c_str());
+    });
+    try {
+      BuildPrograms();
+    } catch (...) {
+      DeleteGlObjects();
+      throw;
+    }
+    glCreateVertexArrays(1, &empty_vao_);
+    glCreateFramebuffers(1, &shadow_fbo_);
+    glCreateTextures(GL_TEXTURE_2D, 1, &white_texture_);
+    const uint8_t white[4] = {255, 255, 255, 255};
+    glTextureStorage2D(white_texture_, 1, GL_RGBA8, 1, 1);
+    glTextureSubImage2D(white_texture_, 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, white);
+  }
+
+  ~RasterBackend() override {
+    try {
+      context_->MakeCurrent();
+      DeleteGlObjects();
+    } catch (...) {
+      // the context cannot be made current here: its objects die with it
+    }
+  }
+
+  std::string Name() const override { return "rasterizer"; }
+  std::string Device() const override { return context_->Renderer(); }
+  void SetReadbackMask(unsigned mask) override { readback_mask_ = mask; }
+
+  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out) override {
+    context_->MakeCurrent();
+    EnsureTargets(camera.width, camera.height);
+    SyncResources(world);
+
+    // world bounds of every instance, for the shadow cameras
+    instance_bounds_.resize(world.instances.size());
+    Eigen::AlignedBox3d scene_box;
+    for (size_t i = 0; i < world.instances.size(); ++i) {
+      const RenderInstance& inst = world.instances[i];
+      GpuMesh* mesh = draw_meshes_[i];
+      Eigen::AlignedBox3d box;
+      if (mesh != nullptr && !mesh->box.isEmpty()) {
+        for (int c = 0; c < 8; ++c) {
+          Eigen::Vector3d corner =
+              mesh->box.corner(Eigen::AlignedBox3f::CornerType(c)).cast<double>();
+          box.extend((inst.X_WV * corner.homogeneous()).head<3>());
+        }
+      }
+      instance_bounds_[i] = box;
+      if (!box.isEmpty()) scene_box.extend(box);
+    }
+
+    int num_shadows = RenderShadowMaps(world, camera, scene_box);
+    RenderGbuffer(world, camera);
+    RenderLighting(world, camera, num_shadows);
+    ReadBack(camera.width, camera.height, out);
+  }
+
+ private:
+  void BuildPrograms() {
+    bool custom_vs = !options_.gbuffer_vertex_shader.empty();
+    bool custom_fs = !options_.gbuffer_fragment_shader.empty();
+    bool custom_ls = !options_.lighting_fragment_shader.empty();
+    gbuffer_program_ = internal::BuildProgram(
+        "gbuffer", custom_vs ? options_.gbuffer_vertex_shader : kGbufferVertex,
+        custom_vs ? "custom RasterOptions::gbuffer_vertex_shader" : "built-in",
+        custom_fs ? options_.gbuffer_fragment_shader : kGbufferFragment,
+        custom_fs ? "custom RasterOptions::gbuffer_fragment_shader" : "built-in");
+    // the built-in lighting pass is compiled for each set of lights; this one has none
+    LightingProgram(custom_ls ? "" : "#define LIGHTS\n");
+    shadow_program_ = internal::BuildProgram("shadow", kShadowVertex, "built-in", "", "none");
+
+    auto g = [&](const char* name) { return glGetUniformLocation(gbuffer_program_, name); };
+    gl_.model_view = g("u_model_view");
+    gl_.normal_matrix = g("u_normal_matrix");
+    gl_.projection = g("u_projection");
+    gl_.base_color = g("u_base_color");
+    gl_.roughness = g("u_roughness");
+    gl_.metallic = g("u_metallic");
+    gl_.has_texture = g("u_has_texture");
+    gl_.diffuse = g("u_diffuse");
+    gl_.ids = g("u_ids");
+    if (gl_.diffuse >= 0) glProgramUniform1i(gbuffer_program_, gl_.diffuse, 0);
+
+    shadow_mvp_ = glGetUniformLocation(shadow_program_, "u_mvp");
+  }
+
+  // the lighting program for a set of lights (`defines`, after the #version line), compiled on
+  // first use; a custom lighting shader is one program for every set
+  struct Lighting {
+    GLuint program = 0;
+    LightingLocations loc;
+  };
+  const Lighting& LightingProgram(const std::string& defines) {
+    bool custom = !options_.lighting_fragment_shader.empty();
+    std::string key = custom ? "" : defines;
+    auto it = lighting_.find(key);
+    if (it != lighting_.end()) return it->second;
+    Lighting out;
+    out.program = internal::BuildProgram(
+        "lighting", kFullscreenVertex, "built-in",
+        custom ? options_.lighting_fragment_shader
+               : std::string("#version 450 core\n") + defines + kLightingFragment,
+        custom ? "custom RasterOptions::lighting_fragment_shader" : "built-in");
+    auto l = [&](const char* name) { return glGetUniformLocation(out.program, name); };
+    out.loc.ambient = l("u_ambient");
+    out.loc.num_lights = l("u_num_lights");
+    out.loc.light_type = l("u_light_type");
+    out.loc.light_color = l("u_light_color");
+    out.loc.light_position = l("u_light_position");
+    out.loc.light_direction = l("u_light_direction");
+    out.loc.light_cos_cone = l("u_light_cos_cone");
+    out.loc.light_shadow = l("u_light_shadow");
+    out.loc.shadow_matrix = l("u_shadow_matrix");
+    out.loc.shadow_texel = l("u_shadow_texel");
+    const std::pair<const char*, GLint> samplers[] = {
+        {"u_albedo", kUnitAlbedo},     {"u_normal", kUnitNormal},
+        {"u_position", kUnitPosition}, {"u_segmentation", kUnitSegmentation},
+        {"u_material", kUnitMaterial}, {"u_shadow_maps", kUnitShadow}};
+    for (const auto& [name, unit] : samplers) {
+      GLint loc = l(name);
+      if (loc >= 0) glProgramUniform1i(out.program, loc, unit);
+    }
+    return lighting_.emplace(key, out).first->second;
+  }
+
+  void DeleteGlObjects() {
+    for (auto& [key, mesh] : meshes_) DeleteMesh(&mesh);
+    meshes_.clear();
+    for (auto& [key, tex] : textures_) glDeleteTextures(1, &tex.id);
+    textures_.clear();
+    DeleteTargets();
+    glDeleteTextures(1, &shadow_maps_);
+    glDeleteTextures(1, &white_texture_);
+    glDeleteFramebuffers(1, &shadow_fbo_);
+    glDeleteVertexArrays(1, &empty_vao_);
+    glDeleteProgram(gbuffer_program_);
+    for (auto& [key, lighting] : lighting_) glDeleteProgram(lighting.program);
+    lighting_.clear();
+    glDeleteProgram(shadow_program_);
+    shadow_maps_ = white_texture_ = shadow_fbo_ = empty_vao_ = 0;
+    gbuffer_program_ = shadow_program_ = 0;
+  }
+
+  static void DeleteMesh(GpuMesh* m) {
+    glDeleteVertexArrays(1, &m->vao);
+    glDeleteBuffers(1, &m->vbo);
+    glDeleteBuffers(1, &m->ebo);
+  }
+
+  void DeleteTargets() {
+    glDeleteFramebuffers(1, &gbuffer_fbo_);
+    glDeleteFramebuffers(1, &color_fbo_);
+    glDeleteTextures(static_cast<GLsizei>(targets_.size()), targets_.data());
+    glDeleteTextures(1, &depth_);
+    gbuffer_fbo_ = color_fbo_ = depth_ = 0;
+    targets_.fill(0);
+    width_ = height_ = 0;
+  }
+
+  // G-buffer and colour targets of the picture's size, re-created when it changes
+  void EnsureTargets(int width, int height) {
+    if (width == width_ && height == height_) return;
+    DeleteTargets();
+    const GLenum formats[kNumTargets] = {GL_RGBA32F, GL_RGBA32F, GL_RGBA32F,
+                                         GL_RG32UI,  GL_RGBA8,   GL_RGBA32F};
+    glCreateTextures(GL_TEXTURE_2D, kNumTargets, targets_.data());
+    for (int i = 0; i < kNumTargets; ++i) {
+      glTextureStorage2D(targets_[i], 1, formats[i], width, height);
+      glTextureParameteri(targets_[i], GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTextureParameteri(targets_[i], GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    glCreateTextures(GL_TEXTURE_2D, 1, &depth_);
+    glTextureStorage2D(depth_, 1, GL_DEPTH_COMPONENT32F, width, height);
+
+    glCreateFramebuffers(1, &gbuffer_fbo_);
+    GLenum draw_buffers[kNumGbuffer];
+    for (int i = 0; i < kNumGbuffer; ++i) {
+      glNamedFramebufferTexture(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + i, targets_[i], 0);
+      draw_buffers[i] = GL_COLOR_ATTACHMENT0 + i;
+    }
+    glNamedFramebufferTexture(gbuffer_fbo_, GL_DEPTH_ATTACHMENT, depth_, 0);
+    glNamedFramebufferDrawBuffers(gbuffer_fbo_, kNumGbuffer, draw_buffers);
+    CheckFramebuffer(gbuffer_fbo_, "G-buffer");
+
+    glCreateFramebuffers(1, &color_fbo_);
+    glNamedFramebufferTexture(color_fbo_, GL_COLOR_ATTACHMENT0, targets_[kColor], 0);
+    glNamedFramebufferDrawBuffer(color_fbo_, GL_COLOR_ATTACHMENT0);
+    CheckFramebuffer(color_fbo_, "colour");
+    width_ = width;
+    height_ = height;
+  }
+
+  static void CheckFramebuffer(GLuint fbo, const char* what) {
+    GLenum status = glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "0x%x", status);
+      throw Error(std::string("rasterizer: the ") + what + " framebuffer is incomplete (" + buf +
+                  ")");
+    }
+  }
+
+  // GPU meshes and textures of this world's instances (uploaded on first use, kept per MeshData
+  // pointer and texture path); when the geometry version changes, unused ones are freed
+  void SyncResources(const RenderWorld& world) {
+    bool new_version = world.geometry_version != synced_version_ || first_sync_;
+    first_sync_ = false;
+    synced_version_ = world.geometry_version;
+    ++frame_;
+    draw_meshes_.assign(world.instances.size(), nullptr);
+    draw_textures_.assign(world.instances.size(), 0);
+    for (size_t i = 0; i < world.instances.size(); ++i) {
+      const RenderInstance& inst = world.instances[i];
+      if (inst.mesh) {
+        GpuMesh& m = meshes_[inst.mesh.get()];
+        bool same_owner = !m.owner.owner_before(inst.mesh) && !inst.mesh.owner_before(m.owner);
+        if (m.vao == 0 || !same_owner || m.owner.expired()) {
+          if (m.vao != 0) DeleteMesh(&m);
+          m = UploadMesh(inst.mesh);
+        }
+        m.last_used = frame_;
+        if (m.index_count > 0) draw_meshes_[i] = &m;
+      }
+      const std::string& path = inst.material.diffuse_texture;
+      if (!path.empty()) {
+        auto it = textures_.find(path);
+        if (it == textures_.end()) {
+          GLuint id = UploadTexture(path);  // throws naming the file
+          it = textures_.emplace(path, GpuTexture{id, 0}).first;
+        }
+        it->second.last_used = frame_;
+        draw_textures_[i] = it->second.id;
+      }
+    }
+    if (!new_version) return;
+    for (auto it = meshes_.begin(); it != meshes_.end();) {
+      if (it->second.last_used != frame_) {
+        DeleteMesh(&it->second);
+        it = meshes_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    for (auto it = textures_.begin(); it != textures_.end();) {
+      if (it->second.last_used != frame_) {
+        glDeleteTextures(1, &it->second.id);
+        it = textures_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+
+  static GpuMesh UploadMesh(const std::shared_ptr<const MeshData>& data) {
+    const MeshData& mesh = *data;
+    GpuMesh m;
+    m.owner = data;
+    struct Vertex {
+      float p[3];
+      float n[3];
+      float uv[2];
+    };
+    std::vector<Vertex> vertices;
+    std::vector<uint32_t> indices;
+    const int nv = static_cast<int>(mesh.vertices.size());
+    bool smooth = mesh.normals.size() == mesh.vertices.size() && nv > 0;
+    bool has_uv = mesh.uvs.size() == mesh.vertices.size();
+    auto make_vertex = [&](int v, const Eigen::Vector3f& n) {
+      Vertex out;
+      for (int k = 0; k < 3; ++k) out.p[k] = mesh.vertices[v][k];
+      for (int k = 0; k < 3; ++k) out.n[k] = n[k];
+      out.uv[0] = has_uv ? mesh.uvs[v].x() : 0.f;
+      out.uv[1] = has_uv ? mesh.uvs[v].y() : 0.f;
+      return out;
+    };
+    if (smooth) {
+      vertices.reserve(nv);
+      for (int v = 0; v < nv; ++v) vertices.push_back(make_vertex(v, mesh.normals[v]));
+      indices.reserve(mesh.faces.size() * 3);
+      for (const Eigen::Vector3i& f : mesh.faces) {
+        if ((f.array() < 0).any() || (f.array() >= nv).any()) continue;
+        for (int k = 0; k < 3; ++k) indices.push_back(static_cast<uint32_t>(f[k]));
+      }
+    } else {
+      // flat normals: three vertices of its own per face
+      vertices.reserve(mesh.faces.size() * 3);
+      indices.reserve(mesh.faces.size() * 3);
+      for (const Eigen::Vector3i& f : mesh.faces) {
+        if ((f.array() < 0).any() || (f.array() >= nv).any()) continue;
+        Eigen::Vector3f n = (mesh.vertices[f[1]] - mesh.vertices[f[0]])
+                                .cross(mesh.vertices[f[2]] - mesh.vertices[f[0]]);
+        float len = n.norm();
+        n = len > 0 ? Eigen::Vector3f(n / len) : Eigen::Vector3f::UnitZ();
+        for (int k = 0; k < 3; ++k) {
+          indices.push_back(static_cast<uint32_t>(vertices.size()));
+          vertices.push_back(make_vertex(f[k], n));
+        }
+      }
+    }
+    for (const Eigen::Vector3f& v : mesh.vertices) m.box.extend(v);
+    m.index_count = static_cast<GLsizei>(indices.size());
+    if (m.index_count == 0) return m;
+
+    glCreateBuffers(1, &m.vbo);
+    glNamedBufferStorage(m.vbo, vertices.size() * sizeof(Vertex), vertices.data(), 0);
+    glCreateBuffers(1, &m.ebo);
+    glNamedBufferStorage(m.ebo, indices.size() * sizeof(uint32_t), indices.data(), 0);
+    glCreateVertexArrays(1, &m.vao);
+    glVertexArrayVertexBuffer(m.vao, 0, m.vbo, 0, sizeof(Vertex));
+    glVertexArrayElementBuffer(m.vao, m.ebo);
+    const GLuint offsets[3] = {offsetof(Vertex, p), offsetof(Vertex, n), offsetof(Vertex, uv)};
+    const GLint sizes[3] = {3, 3, 2};
+    for (GLuint a = 0; a < 3; ++a) {
+      glEnableVertexArrayAttrib(m.vao, a);
+      glVertexArrayAttribFormat(m.vao, a, sizes[a], GL_FLOAT, GL_FALSE, offsets[a]);
+      glVertexArrayAttribBinding(m.vao, a, 0);
+    }
+    return m;
+  }
+
+  static GLuint UploadTexture(const std::string& path) {
+    internal::Image8 image = internal::LoadImageRgba8(path);
+    // rows go in bottom first, so that uv (0, 0) is the bottom-left corner of the image
+    // (OpenGL's convention, which assimp follows)
+    std::vector<uint8_t> flipped(image.rgba.size());
+    size_t row = static_cast<size_t>(image.width) * 4;
+    for (int y = 0; y < image.height; ++y) {
+      std::copy_n(image.rgba.data() + y * row, row, flipped.data() + (image.height - 1 - y) * row);
+    }
+    GLuint id = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &id);
+    int levels = 1;
+    for (int s = std::max(image.width, image.height); s > 1; s /= 2) ++levels;
+    glTextureStorage2D(id, levels, GL_SRGB8_ALPHA8, image.width, image.height);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTextureSubImage2D(id, 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                        flipped.data());
+    glGenerateTextureMipmap(id);
+    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    return id;
+  }
+
+  // depth maps of the shadow-casting lights; fills shadow_light_ (light index -> layer) and the
+  // matrices; returns the number of maps
+  int RenderShadowMaps(const RenderWorld& world, const CameraParams& camera,
+                       const Eigen::AlignedBox3d& scene_box) {
+    int count = 0;
+    shadow_layer_.assign(world.lights.size(), -1);
+    if (scene_box.isEmpty()) return 0;
+    Eigen::Matrix4d X_WG = camera.view.inverse();
+
+    // receivers: the scene's box cut by the box of the view frustum
+    Eigen::AlignedBox3d frustum_box;
+    double far = std::min(camera.far, 1e4);
+    for (int c = 0; c < 8; ++c) {
+      double z = (c & 4) ? far : camera.near;
+      double u = (c & 1) ? camera.width - 0.5 : -0.5;
+      double v = (c & 2) ? camera.height - 0.5 : -0.5;
+      // OpenCV ray through the image corner, into G (y and z flip)
+      Eigen::Vector3d ray = camera.K.inverse() * Eigen::Vector3d(u, v, 1.0);
+      Eigen::Vector3d p_G(ray.x() * z, -ray.y() * z, -z);
+      frustum_box.extend((X_WG * p_G.homogeneous()).head<3>());
+    }
+    Eigen::AlignedBox3d receivers = scene_box.intersection(frustum_box);
+    if (receivers.isEmpty()) receivers = scene_box;
+
+    for (size_t li = 0; li < world.lights.size() && count < kMaxShadows; ++li) {
+      const LightDesc& light = world.lights[li];
+      if (!light.shadow || light.type == LightType::kPoint) continue;
+      Eigen::Vector3d dir = light.direction.normalized();
+      if (!dir.allFinite()) continue;
+      Eigen::Matrix4d view, proj;
+      Eigen::Vector2d texel;
+      if (light.type == LightType::kDirectional) {
+        Eigen::Vector3d c = receivers.center();
+        double r = std::max(0.5 * receivers.diagonal().norm(), 1e-3);
+        view = LookAlong(c, dir);
+        // depth range over every caster: all corners of the scene box
+        double zmin = std::numeric_limits<double>::max(), zmax = -zmin;
+        for (int k = 0; k < 8; ++k) {
+          double z = (view * scene_box.corner(Eigen::AlignedBox3d::CornerType(k)).homogeneous())(2);
+          zmin = std::min(zmin, z);
+          zmax = std::max(zmax, z);
+        }
+        double margin = 0.01 * (zmax - zmin) + 1e-3;
+        proj = Ortho(-r, r, -r, r, -zmax - margin, -zmin + margin);
+        texel = Eigen::Vector2d(2 * r / options_.shadow_map_size, 0);
+      } else {
+        view = LookAlong(light.position, dir);
+        double dmax = 0;
+        for (int k = 0; k < 8; ++k) {
+          dmax = std::max(
+              dmax, (scene_box.corner(Eigen::AlignedBox3d::CornerType(k)) - light.position).norm());
+        }
+        double fovy = std::min(2 * std::max(light.outer_angle, light.inner_angle) + 0.05, 3.0);
+        double f = dmax * 1.01 + 1e-3;
+        double n = std::max(f * 1e-4, 1e-3);
+        proj = Perspective(fovy, n, f);
+        texel = Eigen::Vector2d(0, 2 * std::tan(fovy / 2) / options_.shadow_map_size);
+      }
+      Eigen::Matrix4d view_proj = proj * view;
+      EnsureShadowMaps();
+      glNamedFramebufferTextureLayer(shadow_fbo_, GL_DEPTH_ATTACHMENT, shadow_maps_, 0, count);
+      glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo_);
+      glViewport(0, 0, options_.shadow_map_size, options_.shadow_map_size);
+      glEnable(GL_DEPTH_TEST);
+      glDepthFunc(GL_LESS);
+      glDepthMask(GL_TRUE);
+      glDisable(GL_CULL_FACE);
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(1.5f, 2.0f);
+      const float one = 1.0f;
+      glClearNamedFramebufferfv(shadow_fbo_, GL_DEPTH, 0, &one);
+      glUseProgram(shadow_program_);
+      for (size_t i = 0; i < world.instances.size(); ++i) {
+        const GpuMesh* mesh = draw_meshes_[i];
+        if (mesh == nullptr) continue;
+        Eigen::Matrix4f mvp = ToFloat(view_proj * world.instances[i].X_WV);
+        glUniformMatrix4fv(shadow_mvp_, 1, GL_FALSE, mvp.data());
+        glBindVertexArray(mesh->vao);
+        glDrawElements(GL_TRIANGLES, mesh->index_count, GL_UNSIGNED_INT, nullptr);
+      }
+      glDisable(GL_POLYGON_OFFSET_FILL);
+      // camera G -> light clip -> [0, 1]^3
+      Eigen::Matrix4d bias = Eigen::Matrix4d::Identity() * 0.5;
+      bias(3, 3) = 1;
+      bias.block<3, 1>(0, 3).setConstant(0.5);
+      shadow_matrix_[count] = ToFloat(bias * view_proj * X_WG);
+      shadow_texel_[count] = texel.cast<float>();
+      shadow_layer_[li] = count;
+      ++count;
+    }
+    return count;
+  }
+
+  void EnsureShadowMaps() {
+    if (shadow_maps_ != 0) return;
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &shadow_maps_);
+    glTextureStorage3D(shadow_maps_, 1, GL_DEPTH_COMPONENT32F, options_.shadow_map_size,
+                       options_.shadow_map_size, kMaxShadows);
+    glTextureParameteri(shadow_maps_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(shadow_maps_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(shadow_maps_, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(shadow_maps_, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(shadow_maps_, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTextureParameteri(shadow_maps_, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  }
+
+  void RenderGbuffer(const RenderWorld& world, const CameraParams& camera) {
+    glBindFramebuffer(GL_FRAMEBUFFER, gbuffer_fbo_);
+    glViewport(0, 0, camera.width, camera.height);
+    const float zeros[4] = {0, 0, 0, 0};
+    const GLuint uzeros[4] = {0, 0, 0, 0};
+    const float one = 1.0f;
+    for (int i = 0; i < kNumGbuffer; ++i) {
+      if (i == kSegmentation) {
+        glClearNamedFramebufferuiv(gbuffer_fbo_, GL_COLOR, i, uzeros);
+      } else {
+        glClearNamedFramebufferfv(gbuffer_fbo_, GL_COLOR, i, zeros);
+      }
+    }
+    glClearNamedFramebufferfv(gbuffer_fbo_, GL_DEPTH, 0, &one);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    // the vertical flip of the projection reverses the winding of front faces
+    glFrontFace(GL_CW);
+    glUseProgram(gbuffer_program_);
+
+    Eigen::Matrix4d flip = Eigen::Matrix4d::Identity();
+    flip(1, 1) = -1;
+    Eigen::Matrix4f projection = ToFloat(flip * camera.projection);
+    glUniformMatrix4fv(gl_.projection, 1, GL_FALSE, projection.data());
+    // front to back (by the nearest point of each bounding box), so that the early depth test
+    // spares hidden G-buffer writes
+    draw_order_.clear();
+    Eigen::Vector3d eye = camera.X_WC.p;
+    for (size_t i = 0; i < world.instances.size(); ++i) {
+      if (draw_meshes_[i] == nullptr) continue;
+      const Eigen::AlignedBox3d& box = instance_bounds_[i];
+      double d = box.isEmpty() ? 0.0 : box.squaredExteriorDistance(eye);
+      draw_order_.emplace_back(d, i);
+    }
+    std::sort(draw_order_.begin(), draw_order_.end());
+    GLuint bound_texture = std::numeric_limits<GLuint>::max();
+    for (const auto& [distance, i] : draw_order_) {
+      const GpuMesh* mesh = draw_meshes_[i];
+      const RenderInstance& inst = world.instances[i];
+      Eigen::Matrix4d mv = camera.view * inst.X_WV;
+      Eigen::Matrix4f mv_f = ToFloat(mv);
+      Eigen::Matrix3f normal_matrix = mv.topLeftCorner<3, 3>().inverse().transpose().cast<float>();
+      glUniformMatrix4fv(gl_.model_view, 1, GL_FALSE, mv_f.data());
+      glUniformMatrix3fv(gl_.normal_matrix, 1, GL_FALSE, normal_matrix.data());
+      glUniform4fv(gl_.base_color, 1, inst.material.base_color.data());
+      glUniform1f(gl_.roughness, inst.material.roughness);
+      glUniform1f(gl_.metallic, inst.material.metallic);
+      GLuint tex = draw_textures_[i];
+      glUniform1i(gl_.has_texture, tex != 0);
+      if (tex != bound_texture) {
+        glBindTextureUnit(0, tex != 0 ? tex : white_texture_);
+        bound_texture = tex;
+      }
+      glUniform2ui(gl_.ids, inst.visual_id, inst.entity_id);
+      glBindVertexArray(mesh->vao);
+      glDrawElements(GL_TRIANGLES, mesh->index_count, GL_UNSIGNED_INT, nullptr);
+    }
+    glFrontFace(GL_CCW);
+  }
+
+  void RenderLighting(const RenderWorld& world, const CameraParams& camera, int num_shadows) {
+    glBindFramebuffer(GL_FRAMEBUFFER, color_fbo_);
+    glViewport(0, 0, camera.width, camera.height);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    for (int u = 0; u < kNumGbuffer; ++u) glBindTextureUnit(u, targets_[u]);
+    EnsureShadowMaps();  // the sampler needs a texture even without shadows
+    glBindTextureUnit(kUnitShadow, shadow_maps_);
+
+    // lights into the OpenGL camera frame
+    int n = std::min<int>(static_cast<int>(world.lights.size()), kMaxLights);
+    std::array<GLint, kMaxLights> type{}, shadow{};
+    std::array<Eigen::Vector3f, kMaxLights> color, position, direction;
+    std::array<Eigen::Vector2f, kMaxLights> cone;
+    Eigen::Matrix3d R_GW = camera.view.topLeftCorner<3, 3>();
+    std::string defines = "#define LIGHTS ";
+    for (int i = 0; i < n; ++i) {
+      const LightDesc& light = world.lights[i];
+      type[i] = light.type == LightType::kDirectional ? 0 : light.type == LightType::kPoint ? 1 : 2;
+      color[i] = light.color;
+      position[i] = (camera.view * light.position.homogeneous()).head<3>().cast<float>();
+      Eigen::Vector3d d = R_GW * light.direction;
+      direction[i] = (d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : d).cast<float>();
+      double inner = std::min(light.inner_angle, light.outer_angle);
+      double outer = std::max(light.outer_angle, inner + 1e-4);
+      cone[i] = Eigen::Vector2f(std::cos(inner), std::cos(outer));
+      shadow[i] = shadow_layer_[i];
+      defines += "color += Light(" + std::to_string(i) + ", " + std::to_string(type[i]) + ", " +
+                 std::to_string(shadow[i]) + "); ";
+    }
+    const Lighting& lighting = LightingProgram(defines + "\n");
+    const LightingLocations& loc = lighting.loc;
+    glUseProgram(lighting.program);
+    glUniform3fv(loc.ambient, 1, world.ambient.data());
+    glUniform1i(loc.num_lights, n);
+    if (n > 0) {
+      glUniform1iv(loc.light_type, n, type.data());
+      glUniform3fv(loc.light_color, n, color[0].data());
+      glUniform3fv(loc.light_position, n, position[0].data());
+      glUniform3fv(loc.light_direction, n, direction[0].data());
+      glUniform2fv(loc.light_cos_cone, n, cone[0].data());
+      glUniform1iv(loc.light_shadow, n, shadow.data());
+    }
+    if (num_shadows > 0) {
+      glUniformMatrix4fv(loc.shadow_matrix, num_shadows, GL_FALSE, shadow_matrix_[0].data());
+      glUniform2fv(loc.shadow_texel, num_shadows, shadow_texel_[0].data());
+    }
+    const float zeros[4] = {0, 0, 0, 0};
+    glClearNamedFramebufferfv(color_fbo_, GL_COLOR, 0, zeros);
+    glBindVertexArray(empty_vao_);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDepthMask(GL_TRUE);
+  }
+
+  void ReadBack(int width, int height, Picture* out) {
+    size_t n = static_cast<size_t>(width) * height;
+    out->width = width;
+    out->height = height;
+    out->color.resize(n * 4);
+    out->albedo.resize(n * 4);
+    out->normal.resize(n * 4);
+    out->position.resize(n * 4);
+    out->segmentation.resize(n * 2);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    auto read = [&](GLuint fbo, GLenum attachment, GLenum format, GLenum type, void* dst,
+                    size_t bytes) {
+      glNamedFramebufferReadBuffer(fbo, attachment);
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+      glReadnPixels(0, 0, width, height, format, type, static_cast<GLsizei>(bytes), dst);
+    };
+    if (readback_mask_ & internal::kReadColor) {
+      read(color_fbo_, GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, out->color.data(),
+           out->color.size() * sizeof(float));
+    }
+    if (readback_mask_ & internal::kReadAlbedo) {
+      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kAlbedo, GL_RGBA, GL_FLOAT, out->albedo.data(),
+           out->albedo.size() * sizeof(float));
+    }
+    if (readback_mask_ & internal::kReadNormal) {
+      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kNormal, GL_RGBA, GL_FLOAT, out->normal.data(),
+           out->normal.size() * sizeof(float));
+    }
+    if (readback_mask_ & internal::kReadPosition) {
+      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kPosition, GL_RGBA, GL_FLOAT, out->position.data(),
+           out->position.size() * sizeof(float));
+    }
+    if (readback_mask_ & internal::kReadSegmentation) {
+      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kSegmentation, GL_RG_INTEGER, GL_UNSIGNED_INT,
+           out->segmentation.data(), out->segmentation.size() * sizeof(uint32_t));
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    GLenum err = glGetError();
+    if (err == GL_OUT_OF_MEMORY) throw Error("rasterizer: out of GPU memory");
+  }
+
+  // render targets: G-buffer attachments 0..4, then the lit colour
+  enum Target { kAlbedo = 0, kNormal, kPosition, kSegmentation, kMaterial, kColor, kNumTargets };
+  static constexpr int kNumGbuffer = 5;
+
+  RasterOptions options_;
+  std::unique_ptr<internal::EglContext> context_;
+  unsigned readback_mask_ = internal::kReadAll;
+
+  GLuint gbuffer_program_ = 0, shadow_program_ = 0;
+  GbufferLocations gl_;
+  std::unordered_map<std::string, Lighting> lighting_;
+  GLint shadow_mvp_ = -1;
+
+  int width_ = 0, height_ = 0;
+  std::array<GLuint, kNumTargets> targets_{};
+  GLuint depth_ = 0, gbuffer_fbo_ = 0, color_fbo_ = 0;
+  GLuint empty_vao_ = 0, white_texture_ = 0;
+  GLuint shadow_fbo_ = 0, shadow_maps_ = 0;
+  std::array<Eigen::Matrix4f, kMaxShadows> shadow_matrix_;
+  std::array<Eigen::Vector2f, kMaxShadows> shadow_texel_;
+  std::vector<int> shadow_layer_;
+
+  std::unordered_map<const MeshData*, GpuMesh> meshes_;
+  std::unordered_map<std::string, GpuTexture> textures_;
+  uint64_t synced_version_ = 0;
+  bool first_sync_ = true;
+  uint64_t frame_ = 0;
+  std::vector<GpuMesh*> draw_meshes_;
+  std::vector<GLuint> draw_textures_;
+  std::vector<Eigen::AlignedBox3d> instance_bounds_;
+  std::vector<std::pair<double, size_t>> draw_order_;
+};
+
+}  // namespace
+
+std::unique_ptr<RenderBackend> MakeRasterBackend(const RasterOptions& options) {
+  return std::make_unique<RasterBackend>(options);
+}
+
+}  // namespace partsim
