@@ -15,10 +15,12 @@
 namespace partsim {
 namespace {
 
-// Drive gains for the range check: stiff enough to overcome friction and gravity of household
-// parts, with force limits so that a jammed part cannot force its way through.
-constexpr double kRevoluteStiffness = 200.0, kRevoluteDamping = 20.0, kRevoluteForce = 50.0;
-constexpr double kPrismaticStiffness = 2000.0, kPrismaticDamping = 100.0, kPrismaticForce = 200.0;
+// The range check drives each part as a critically damped second-order system of natural
+// frequency kOmega for its own inertia, with an acceleration cap (so that a jammed part cannot
+// force its way through), and cancels gravity with the passive force.
+constexpr double kOmega = 15.0;            // rad/s
+constexpr double kMaxAcceleration = 30.0;  // m/s^2 or rad/s^2
+constexpr int kControlSteps = 10;          // steps between gravity-compensation updates
 
 QualityCheck Check(const std::string& name, bool passed, const std::string& detail) {
   return {name, passed, detail};
@@ -53,26 +55,27 @@ QualityCheck RangeCheck(Scene& scene, Articulation& art, const QualityOptions& o
   std::vector<Joint> joints = art.GetActiveJoints();
   Eigen::MatrixX2d limits = art.GetQlimits();
   std::vector<char> state = scene.Pack();
-  int steps = static_cast<int>(std::lround(o.range_seconds / scene.GetTimestep()));
+  int chunks = std::max(
+      1, static_cast<int>(std::lround(o.range_seconds / scene.GetTimestep())) / kControlSteps);
+  // gains from each dof's own inertia at rest
+  Eigen::VectorXd inertia = art.ComputeManipulatorInertiaMatrix().diagonal();
+  for (size_t j = 0; j < joints.size(); ++j)
+    joints[j].SetDriveProperty(inertia[j] * kOmega * kOmega, 2 * inertia[j] * kOmega,
+                               inertia[j] * kMaxAcceleration);
   std::vector<std::string> jammed;
   for (size_t k = 0; k < joints.size(); ++k) {
     scene.Unpack(state);
-    Eigen::VectorXd hold = art.GetQpos();
-    // every other joint holds its rest position; this one goes to each end
-    for (size_t j = 0; j < joints.size(); ++j) {
-      bool rev = joints[j].GetType() != JointType::kPrismatic;
-      joints[j].SetDriveProperty(rev ? kRevoluteStiffness : kPrismaticStiffness,
-                                 rev ? kRevoluteDamping : kPrismaticDamping,
-                                 rev ? kRevoluteForce : kPrismaticForce);
-    }
-    art.SetDriveTarget(hold);
+    art.SetDriveTarget(art.GetQpos());  // every other joint holds its rest position
     double lo = limits(k, 0), hi = limits(k, 1);
     if (!std::isfinite(lo)) lo = -M_PI;
     if (!std::isfinite(hi)) hi = M_PI;
     double span = hi - lo;
     for (double end : {hi, lo}) {
       joints[k].SetDriveTarget(end);
-      scene.Step(steps);
+      for (int c = 0; c < chunks; ++c) {
+        art.SetQf(art.ComputePassiveForce(true, false));
+        scene.Step(kControlSteps);
+      }
       double q = art.GetQpos()[k];
       if (std::abs(q - end) > (1.0 - o.range_fraction) * span) {
         jammed.push_back("'" + joints[k].GetName() + "' stopped at " + Fmt(q) + " on its way to " +
@@ -82,6 +85,7 @@ QualityCheck RangeCheck(Scene& scene, Articulation& art, const QualityOptions& o
     }
   }
   scene.Unpack(state);
+  art.SetQf(Eigen::VectorXd::Zero(art.Dof()));
   for (Joint& j : joints) j.SetDriveProperty(0, 0);
   if (jammed.empty())
     return Check("range", true, std::to_string(joints.size()) + " parts cover their ranges");

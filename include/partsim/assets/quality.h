@@ -11,7 +11,7 @@ namespace partsim {
 struct QualityOptions {
   double rest_seconds = 1.0;     ///< simulated time at rest, undriven
   double rest_tolerance = 2e-3;  ///< largest joint motion allowed at rest (rad or m)
-  double range_seconds = 0.6;    ///< simulated time to drive a part to each limit
+  double range_seconds = 1.0;    ///< simulated time to drive a part to each limit
   double range_fraction = 0.95;  ///< a part must cover this fraction of its range each way
   bool check_visibility = true;  ///< render segmentation from several viewpoints
   std::string render_backend = "rasterizer";

@@ -1,0 +1,98 @@
+#include "partsim/assets/quality.h"
+
+#include <gtest/gtest.h>
+
+#include "assets/partnet_test_folder.h"
+
+namespace partsim {
+namespace {
+
+using testing::BoxObj;
+using testing::Folder;
+using testing::Write;
+
+const QualityCheck* Find(const ObjectQualityReport& r, const std::string& name) {
+  for (const QualityCheck& c : r.checks)
+    if (c.name == name) return &c;
+  return nullptr;
+}
+
+TEST(QualityTest, AGoodObjectPassesEveryCheck) {
+  Folder f("quality_good");
+  ObjectQualityReport r = CheckPartNetObject(f.Path());
+  EXPECT_TRUE(r.Passed()) << r.ToString();
+  EXPECT_EQ(r.category, "StorageFurniture");
+  EXPECT_EQ(r.movable_parts, 2);
+  for (const char* name : {"labels", "load", "rest", "range", "visible"})
+    EXPECT_NE(Find(r, name), nullptr) << name;
+}
+
+TEST(QualityTest, APartThatJamsFailsTheRangeCheck) {
+  Folder f("quality_jam");
+  // a collision-only stop in front of the drawer, 0.1 m into its 0.3 m travel
+  f.urdf.replace(f.urdf.find("</link>"), 7,
+                 "<collision><geometry><mesh filename=\"textured_objs/original-5.obj\"/>"
+                 "</geometry></collision></link>");
+  f.WriteAll();
+  Write(f.dir / "textured_objs/original-5.obj", BoxObj({0, -0.2, 0.27}, {0.2, 0.05, 0.01}));
+  ObjectQualityReport r = CheckPartNetObject(f.Path());
+  EXPECT_FALSE(r.Passed());
+  const QualityCheck* range = Find(r, "range");
+  ASSERT_NE(range, nullptr);
+  EXPECT_FALSE(range->passed);
+  EXPECT_NE(range->detail.find("joint_1"), std::string::npos) << range->detail;
+  EXPECT_TRUE(Find(r, "rest")->passed) << r.ToString();
+}
+
+TEST(QualityTest, AHiddenPartFailsTheVisibilityCheck) {
+  Folder f("quality_hidden");
+  // the drawer shrinks to a sliver inside a closed box around the whole object
+  f.urdf.replace(f.urdf.find("<link name=\"link_2\">") + 20, 0,
+                 "\n    <visual name=\"shell-9\"><geometry><mesh "
+                 "filename=\"textured_objs/original-6.obj\"/></geometry></visual>");
+  f.json.replace(f.json.find("{\"id\": 1, \"name\": \"body\""), 0,
+                 "{\"id\": 9, \"name\": \"shell\", \"children\": []}, ");
+  f.WriteAll();
+  // a shell: six thin boxes would be exact; one closed box (outward faces) hides what is inside
+  Write(f.dir / "textured_objs/original-6.obj", BoxObj({0, 0, 0.1}, {0.7, 0.8, 0.7}));
+  QualityOptions o;
+  o.image_size = 48;
+  ObjectQualityReport r = CheckPartNetObject(f.Path(), o);
+  const QualityCheck* visible = Find(r, "visible");
+  ASSERT_NE(visible, nullptr) << r.ToString();
+  EXPECT_FALSE(visible->passed) << r.ToString();
+}
+
+TEST(QualityTest, AnInconsistentFolderFailsToLoadWithTheReason) {
+  Folder f("quality_bad");
+  f.semantics = "link_0 hinge door\nlink_1 slider drawer\nlink_2 heavy cabinet_body\n";
+  f.WriteAll();
+  ObjectQualityReport r = CheckPartNetObject(f.Path());
+  EXPECT_FALSE(r.Passed());
+  ASSERT_FALSE(r.checks.empty());
+  EXPECT_EQ(r.checks[0].name, "load");
+  EXPECT_NE(r.checks[0].detail.find("semantics.txt"), std::string::npos);
+}
+
+TEST(QualityTest, StatisticsTableMatchesThePapersTotals) {
+  int models = 0, parts = 0;
+  for (const auto& [cat, mp] : PaperStatistics()) {
+    models += mp.first;
+    parts += mp.second;
+  }
+  EXPECT_EQ(PaperStatistics().size(), 46u);
+  EXPECT_EQ(models, 2346);
+  EXPECT_EQ(parts, 14068);
+  DatasetStatistics stats;
+  stats.Add("Door", 3);
+  stats.Add("Door", 2);
+  stats.Add("Faucet", 2);
+  EXPECT_EQ(stats.models, 3);
+  EXPECT_EQ(stats.parts, 7);
+  std::string table = stats.ToTable();
+  EXPECT_NE(table.find("Door"), std::string::npos);
+  EXPECT_NE(table.find("2346"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace partsim
