@@ -7,10 +7,11 @@
 // top-level BVH is rebuilt.
 //
 // Light transport:
-// - materials: Lambert diffuse (base colour * (1 - metallic)) + GGX specular (alpha =
-//   roughness^2, roughness clamped to >= 0.05; Smith height-correlated visibility; Schlick
-//   Fresnel with F0 = mix(0.04, base colour, metallic)), the rasterizer's metallic/roughness
-//   model; surfaces are two-sided; base colour alpha (transparency) is ignored;
+// - materials: the rasterizer's metallic/roughness model: Oren-Nayar diffuse (sigma =
+//   roughness) weighted by (1 - F) (1 - metallic), GGX specular (alpha = roughness^2,
+//   Smith-Schlick G, Schlick Fresnel with F0 = mix(0.04, base colour, metallic)), roughness
+//   clamped to [0.05, 1]; bounces sample a mixture of a cosine lobe and GGX normals; surfaces are
+//   two-sided; base colour alpha (transparency) is ignored;
 // - next-event estimation towards every light at every vertex, with soft shadows: directional
 //   lights subtend a cone of 0.5 degree angular radius, point and spot lights are disks of 2 cm
 //   radius facing the shaded point; light colour is the irradiance at normal incidence for a
@@ -27,8 +28,8 @@
 // K^-1 (u, v, 1), and its first hit fills Albedo, Normal (shading normal turned towards the
 // camera, in the OpenGL camera frame), Position and Segmentation; Color is the mean over
 // samples_per_pixel samples jittered uniformly within the pixel (samples that miss add black),
-// with alpha 1 where the centre ray hits a surface. Every sample seeds its own PCG32 from
-// (seed, pixel index, sample index), so images do not depend on the number of threads.
+// clamped to [0, 1], with alpha 1 where the centre ray hits a surface. Every sample seeds its own
+// PCG32 from (seed, pixel index, sample index), so images do not depend on the number of threads.
 #include <embree3/rtcore.h>
 
 #include <Eigen/Geometry>
@@ -537,8 +538,9 @@ class PathTracerBackend : public RenderBackend {
       Vec3 l = PathRadiance(sp, d, rng);
       if (l.allFinite()) sum += l;
     }
+    // the mean of the samples, clamped to the documented [0, 1] as the rasterizer does
     sum /= static_cast<float>(spp);
-    for (int k = 0; k < 3; ++k) out->color[4 * pixel + k] = sum[k];
+    for (int k = 0; k < 3; ++k) out->color[4 * pixel + k] = std::clamp(sum[k], 0.0f, 1.0f);
   }
 
   PathTracerOptions options_;

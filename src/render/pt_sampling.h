@@ -1,6 +1,5 @@
 // Internal to the path tracer: random numbers, direction sampling and the material model
-// (Lambert diffuse + GGX specular with Smith height-correlated visibility and Schlick Fresnel,
-// the metallic/roughness model of the rasterizer).
+// (Oren-Nayar diffuse + GGX specular, the metallic/roughness model of the rasterizer).
 #pragma once
 
 #include <Eigen/Core>
@@ -91,22 +90,30 @@ inline Eigen::Vector2f SampleDisk(float u1, float u2) {
   return {r * std::cos(phi), r * std::sin(phi)};
 }
 
-/// A surface point's material, ready to shade.
+/// A surface point's material, ready to shade: the rasterizer's model, i.e. Oren-Nayar diffuse
+/// (sigma = roughness) weighted by (1 - F) (1 - metallic), GGX specular (alpha = roughness^2,
+/// Smith-Schlick G with k = alpha / 2, Schlick Fresnel with F0 = mix(0.04, base, metallic)),
+/// roughness clamped to [0.05, 1].
 struct Bsdf {
-  Vec3 diffuse;  ///< base colour * (1 - metallic)
+  Vec3 base;
+  float metallic;
   Vec3 f0;       ///< specular reflectance at normal incidence
   float alpha;   ///< GGX alpha = roughness^2
+  float on_a;    ///< Oren-Nayar A
+  float on_b;    ///< Oren-Nayar B
   float p_spec;  ///< probability of sampling the specular lobe
 
-  Bsdf(const Vec3& base, float roughness, float metallic, float n_dot_v) {
-    metallic = std::clamp(metallic, 0.0f, 1.0f);
-    // very smooth surfaces give fireflies with lights of small size: clamp roughness
+  Bsdf(const Vec3& base_color, float roughness, float metallic_in, float n_dot_v) {
+    base = base_color;
+    metallic = std::clamp(metallic_in, 0.0f, 1.0f);
     float r = std::clamp(roughness, 0.05f, 1.0f);
     alpha = r * r;
-    diffuse = base * (1.0f - metallic);
+    float sigma2 = r * r;
+    on_a = 1.0f - 0.5f * sigma2 / (sigma2 + 0.33f);
+    on_b = 0.45f * sigma2 / (sigma2 + 0.09f);
     f0 = Vec3::Constant(0.04f) * (1.0f - metallic) + base * metallic;
     float ws = Luminance(Fresnel(n_dot_v));
-    float wd = Luminance(diffuse);
+    float wd = Luminance(base) * (1.0f - metallic);
     p_spec = ws + wd > 0.0f ? std::clamp(ws / (ws + wd), 0.1f, 1.0f) : 0.5f;
     if (wd <= 0.0f) p_spec = 1.0f;
   }
@@ -123,12 +130,12 @@ struct Bsdf {
     return a2 / (kPi * d * d);
   }
 
-  /// Smith height-correlated visibility term V = G / (4 NoL NoV).
+  /// Smith-Schlick G(l, v) / (4 NoL NoV).
   float Visibility(float n_dot_l, float n_dot_v) const {
-    float a2 = alpha * alpha;
-    float gv = n_dot_l * std::sqrt(n_dot_v * n_dot_v * (1.0f - a2) + a2);
-    float gl = n_dot_v * std::sqrt(n_dot_l * n_dot_l * (1.0f - a2) + a2);
-    return 0.5f / std::max(gv + gl, 1e-12f);
+    float k = 0.5f * alpha;
+    float gl = n_dot_l * (1.0f - k) + k;
+    float gv = n_dot_v * (1.0f - k) + k;
+    return 0.25f / std::max(gl * gv, 1e-12f);
   }
 
   /// f(wo, wi) * cos(wi), all vectors unit, n the shading normal.
@@ -139,8 +146,12 @@ struct Bsdf {
     Vec3 h = (wo + wi).normalized();
     float n_dot_h = std::max(n.dot(h), 0.0f);
     float v_dot_h = std::max(wo.dot(h), 0.0f);
-    Vec3 spec = Fresnel(v_dot_h) * (D(n_dot_h) * Visibility(n_dot_l, n_dot_v));
-    return (diffuse * (1.0f / kPi) + spec) * n_dot_l;
+    Vec3 f = Fresnel(v_dot_h);
+    Vec3 spec = f * (D(n_dot_h) * Visibility(n_dot_l, n_dot_v));
+    float s = wi.dot(wo) - n_dot_l * n_dot_v;
+    float on = on_a + (s > 0.0f ? on_b * s / std::max(n_dot_l, n_dot_v) : 0.0f);
+    Vec3 diffuse = (Vec3::Ones() - f).cwiseProduct(base) * ((1.0f - metallic) * on / kPi);
+    return (diffuse + spec) * n_dot_l;
   }
 
   /// Density of Sample() for wi (solid angle).
