@@ -314,8 +314,7 @@ class PathTracerBackend : public RenderBackend {
       const std::string& path = ri.material.diffuse_texture;
       if (!path.empty()) {
         auto it = textures_.find(path);
-        if (it == textures_.end())
-          it = textures_.emplace(path, internal::LoadPngTexture(path)).first;
+        if (it == textures_.end()) it = textures_.emplace(path, internal::LoadTexture(path)).first;
         s.texture = it->second.get();
       }
     }

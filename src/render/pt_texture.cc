@@ -1,12 +1,8 @@
 #include "render/pt_texture.h"
 
-#include <png.h>
-
 #include <cmath>
-#include <cstring>
-#include <fstream>
 
-#include "partsim/core/error.h"
+#include "render/gl_util.h"
 
 namespace partsim::internal {
 
@@ -40,31 +36,17 @@ Eigen::Vector4f PtTexture::Sample(float u, float v) const {
   return (a * (1 - tx) + b * tx) * (1 - ty) + (c * (1 - tx) + d * tx) * ty;
 }
 
-std::shared_ptr<const PtTexture> LoadPngTexture(const std::string& path) {
-  if (!std::ifstream(path).good()) {
-    throw Error("diffuse_texture '" + path + "': file not found");
-  }
-  png_image image;
-  std::memset(&image, 0, sizeof(image));
-  image.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&image, path.c_str())) {
-    throw Error("diffuse_texture '" + path + "': not a readable PNG (" + image.message + ")");
-  }
-  image.format = PNG_FORMAT_RGBA;
-  std::vector<png_byte> bytes(PNG_IMAGE_SIZE(image));
-  if (!png_image_finish_read(&image, nullptr, bytes.data(), 0, nullptr)) {
-    std::string message = image.message;
-    png_image_free(&image);
-    throw Error("diffuse_texture '" + path + "': " + message);
-  }
+std::shared_ptr<const PtTexture> LoadTexture(const std::string& path) {
+  // the rasterizer's decoder, so that both backends read the same files the same way
+  Image8 image = LoadImageRgba8(path);
   auto tex = std::make_shared<PtTexture>();
-  tex->width = static_cast<int>(image.width);
-  tex->height = static_cast<int>(image.height);
+  tex->width = image.width;
+  tex->height = image.height;
   tex->texels.resize(static_cast<size_t>(tex->width) * tex->height);
   float lut[256];
   for (int i = 0; i < 256; ++i) lut[i] = SrgbToLinear(i / 255.0f);
   for (size_t i = 0; i < tex->texels.size(); ++i) {
-    const png_byte* p = &bytes[4 * i];
+    const uint8_t* p = &image.rgba[4 * i];
     tex->texels[i] = Eigen::Vector4f(lut[p[0]], lut[p[1]], lut[p[2]], p[3] / 255.0f);
   }
   return tex;

@@ -1,4 +1,4 @@
-// Internal to the path tracer: diffuse textures read from PNG files.
+// Internal to the path tracer: diffuse textures (PNG or JPEG, decoded as the rasterizer does).
 #pragma once
 
 #include <Eigen/Core>
@@ -19,7 +19,8 @@ struct PtTexture {
   Eigen::Vector4f Sample(float u, float v) const;
 };
 
-/// Reads a PNG file; throws partsim::Error naming `path` when it is missing or unreadable.
-std::shared_ptr<const PtTexture> LoadPngTexture(const std::string& path);
+/// Reads a PNG or JPEG file (sRGB) into linear colour; throws partsim::Error naming `path` when
+/// it is missing or cannot be decoded.
+std::shared_ptr<const PtTexture> LoadTexture(const std::string& path);
 
 }  // namespace partsim::internal

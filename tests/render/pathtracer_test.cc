@@ -2,6 +2,7 @@
 // soft shadows and colour bleeding, built on hand-made render worlds; then through a scene and
 // its camera, and against the rasterizer.
 #include <gtest/gtest.h>
+#include <jpeglib.h>
 #include <png.h>
 
 #include <Eigen/Geometry>
@@ -458,7 +459,7 @@ void WritePng(const std::string& path, int w, int h, const std::vector<uint8_t>&
   ASSERT_TRUE(png_image_write_to_file(&image, path.c_str(), 0, rgba.data(), 0, nullptr));
 }
 
-TEST(PathTracerTest, DiffuseTextureInAlbedoAndMissingFileNamed) {
+TEST(PathTracerTest, DiffuseTexturesInAlbedoAndMissingFileNamed) {
   // 8 x 8 texture of four quadrants: top red | green, bottom blue | white (sRGB 255 = linear 1)
   std::string path = ::testing::TempDir() + "/pt_texture_test.png";
   std::vector<uint8_t> rgba;
@@ -488,6 +489,42 @@ TEST(PathTracerTest, DiffuseTextureInAlbedoAndMissingFileNamed) {
   EXPECT_LT((albedo(33, 6) - Eigen::Vector3f(0, 1, 0)).norm(), 1e-3);
   EXPECT_LT((albedo(6, 33) - Eigen::Vector3f(0, 0, 1)).norm(), 1e-3);
   EXPECT_LT((albedo(33, 33) - Eigen::Vector3f(1, 1, 1)).norm(), 1e-3);
+  std::remove(path.c_str());
+
+  // a JPEG of one sRGB colour (200, 100, 50)
+  path = ::testing::TempDir() + "/pt_texture_test.jpg";
+  {
+    jpeg_compress_struct cinfo;
+    jpeg_error_mgr err;
+    cinfo.err = jpeg_std_error(&err);
+    jpeg_create_compress(&cinfo);
+    FILE* f = std::fopen(path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    jpeg_stdio_dest(&cinfo, f);
+    cinfo.image_width = 16;
+    cinfo.image_height = 16;
+    cinfo.input_components = 3;
+    cinfo.in_color_space = JCS_RGB;
+    jpeg_set_defaults(&cinfo);
+    jpeg_set_quality(&cinfo, 100, TRUE);
+    jpeg_start_compress(&cinfo, TRUE);
+    std::vector<uint8_t> row;
+    for (int x = 0; x < 16; ++x) row.insert(row.end(), {200, 100, 50});
+    while (cinfo.next_scanline < 16) {
+      JSAMPROW r = row.data();
+      jpeg_write_scanlines(&cinfo, &r, 1);
+    }
+    jpeg_finish_compress(&cinfo);
+    jpeg_destroy_compress(&cinfo);
+    std::fclose(f);
+  }
+  world.instances[0].material.diffuse_texture = path;
+  pic = Render(world, cam, 1, 1);
+  auto linear = [](double c) { return std::pow((c / 255 + 0.055) / 1.055, 2.4); };
+  EXPECT_LT((albedo(20, 20) - Eigen::Vector3d(linear(200), linear(100), linear(50)).cast<float>())
+                .cwiseAbs()
+                .maxCoeff(),
+            0.02);
   std::remove(path.c_str());
 
   world.instances[0].material.diffuse_texture = "/nonexistent/wood.png";
