@@ -1,0 +1,403 @@
+#include "partsim/assets/convex_decomposition.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <tuple>
+
+#include "partsim/assets/mesh.h"
+#include "partsim/assets/urdf.h"
+#include "partsim/core/error.h"
+#include "partsim/physics/scene.h"
+
+namespace partsim {
+namespace {
+
+namespace fs = std::filesystem;
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+
+// Closed surface of a set of voxels (cells of side `h`, cell (0,0,0) at the origin): one quad per
+// face between an occupied and an empty cell, vertices shared, counter-clockwise from outside.
+MeshData VoxelMesh(int nx, int ny, int nz, double h,
+                   const std::function<bool(int, int, int)>& occ) {
+  MeshData m;
+  std::map<std::tuple<int, int, int>, int> ids;
+  auto vertex = [&](int i, int j, int k) {
+    auto [it, fresh] = ids.emplace(std::make_tuple(i, j, k), static_cast<int>(m.vertices.size()));
+    if (fresh) m.vertices.emplace_back(i * h, j * h, k * h);
+    return it->second;
+  };
+  auto full = [&](int i, int j, int k) {
+    return i >= 0 && j >= 0 && k >= 0 && i < nx && j < ny && k < nz && occ(i, j, k);
+  };
+  for (int i = 0; i < nx; ++i) {
+    for (int j = 0; j < ny; ++j) {
+      for (int k = 0; k < nz; ++k) {
+        if (!full(i, j, k)) continue;
+        for (int a = 0; a < 3; ++a) {
+          for (int s = 0; s < 2; ++s) {
+            int c[3] = {i, j, k};
+            c[a] += s ? 1 : -1;
+            if (full(c[0], c[1], c[2])) continue;
+            const int b = (a + 1) % 3, d = (a + 2) % 3;
+            auto corner = [&](int u, int v) {
+              int q[3] = {i, j, k};
+              q[a] += s;
+              q[b] += u;
+              q[d] += v;
+              return vertex(q[0], q[1], q[2]);
+            };
+            const int v00 = corner(0, 0), v10 = corner(1, 0), v11 = corner(1, 1),
+                      v01 = corner(0, 1);
+            if (s) {
+              m.faces.emplace_back(v00, v10, v11);
+              m.faces.emplace_back(v00, v11, v01);
+            } else {
+              m.faces.emplace_back(v00, v11, v10);
+              m.faces.emplace_back(v00, v01, v11);
+            }
+          }
+        }
+      }
+    }
+  }
+  return m;
+}
+
+// An L in the xz plane extruded along y: a floor 0.3 x 0.05 and a wall 0.05 x 0.3 (m); cells of
+// 0.05 m, 0.15 m deep. Its inner corner is at x = z = 0.05.
+MeshData LShape() {
+  return VoxelMesh(6, 3, 6, 0.05, [](int i, int, int k) { return i == 0 || k == 0; });
+}
+
+// A box 0.2 x 0.1 x 0.05 m.
+MeshData Box() {
+  return VoxelMesh(4, 2, 1, 0.05, [](int, int, int) { return true; });
+}
+
+// A round torus about z: major radius R, minor radius r (m).
+MeshData Torus(double R, double r, int nu = 32, int nv = 16) {
+  MeshData m;
+  for (int i = 0; i < nu; ++i) {
+    const double u = 2 * M_PI * i / nu;
+    for (int j = 0; j < nv; ++j) {
+      const double v = 2 * M_PI * j / nv;
+      m.vertices.emplace_back((R + r * std::cos(v)) * std::cos(u),
+                              (R + r * std::cos(v)) * std::sin(u), r * std::sin(v));
+    }
+  }
+  auto id = [nu, nv](int i, int j) { return (i % nu) * nv + (j % nv); };
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) {
+      m.faces.emplace_back(id(i, j), id(i + 1, j), id(i + 1, j + 1));
+      m.faces.emplace_back(id(i, j), id(i + 1, j + 1), id(i, j + 1));
+    }
+  }
+  return m;
+}
+
+// A cup about z: outer radius, height and wall thickness (m), turned in n steps; triangles
+// counter-clockwise from outside. Its bottom's two faces are flat discs that touch only the walls.
+MeshData Cup(double radius, double height, double wall, int n) {
+  const std::vector<std::pair<double, double>> profile = {
+      {radius, 0}, {radius, height}, {radius - wall, height}, {radius - wall, wall}};
+  const int np = static_cast<int>(profile.size());
+  MeshData m;
+  m.vertices.emplace_back(0, 0, 0);     // outer bottom centre
+  m.vertices.emplace_back(0, 0, wall);  // inner bottom centre
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    for (const auto& [r, z] : profile) m.vertices.emplace_back(r * std::cos(a), r * std::sin(a), z);
+  }
+  auto id = [n, np](int i, int p) { return 2 + (i % n) * np + p; };
+  for (int i = 0; i < n; ++i) {
+    m.faces.emplace_back(0, id(i + 1, 0), id(i, 0));
+    for (int p = 0; p + 1 < np; ++p) {
+      m.faces.emplace_back(id(i, p), id(i + 1, p), id(i + 1, p + 1));
+      m.faces.emplace_back(id(i, p), id(i + 1, p + 1), id(i, p + 1));
+    }
+    m.faces.emplace_back(1, id(i, np - 1), id(i + 1, np - 1));
+  }
+  return m;
+}
+
+// Whether x is inside the convex piece (on the inner side of every face plane).
+bool InsidePiece(const MeshData& p, const Vector3d& x) {
+  for (const Eigen::Vector3i& f : p.faces) {
+    const Vector3d a = p.vertices[f[0]].cast<double>();
+    const Vector3d n =
+        (p.vertices[f[1]].cast<double>() - a).cross(p.vertices[f[2]].cast<double>() - a);
+    if (n.dot(x - a) > 0) return false;
+  }
+  return true;
+}
+
+// Every vertex on the inner side of every face plane (within `tol`, m), and every edge shared by
+// exactly two triangles in opposite directions.
+void ExpectConvexAndClosed(const MeshData& m, double tol = 1e-6) {
+  ASSERT_GE(m.vertices.size(), 4u);
+  for (const Eigen::Vector3i& f : m.faces) {
+    const Vector3d a = m.vertices[f[0]].cast<double>(), b = m.vertices[f[1]].cast<double>(),
+                   c = m.vertices[f[2]].cast<double>();
+    Vector3d n = (b - a).cross(c - a);
+    if (n.norm() < 1e-12) continue;  // a sliver has no meaningful plane
+    n.normalize();
+    for (const Vector3f& v : m.vertices) {
+      ASSERT_LE(n.dot(v.cast<double>() - a), tol) << "vertex outside a face plane";
+    }
+  }
+  // edges between vertex positions (a loaded OBJ repeats vertices per face)
+  std::map<std::tuple<float, float, float>, int> position_id;
+  std::vector<int> id;
+  for (const Vector3f& v : m.vertices) {
+    id.push_back(position_id.emplace(std::make_tuple(v.x(), v.y(), v.z()), position_id.size())
+                     .first->second);
+  }
+  std::map<std::pair<int, int>, int> directed;
+  for (const Eigen::Vector3i& f : m.faces) {
+    for (int k = 0; k < 3; ++k) ++directed[{id[f[k]], id[f[(k + 1) % 3]]}];
+  }
+  for (const auto& [edge, count] : directed) {
+    EXPECT_EQ(count, 1) << "edge used twice in one direction";
+    EXPECT_EQ(directed.count({edge.second, edge.first}), 1u) << "open edge";
+  }
+  EXPECT_GT(MeshVolume(m), 0.0) << "not outward";
+}
+
+TEST(ConvexDecompositionTest, LShapeSplitsIntoConvexPiecesThatCoverIt) {
+  MeshData l = LShape();
+  ConvexDecompositionResult r = DecomposeConvex(l);
+  EXPECT_GE(r.pieces.size(), 2u);
+  for (const auto& p : r.pieces) ExpectConvexAndClosed(*p);
+  // volume: 0.3 * 0.05 * 0.15 + 0.25 * 0.05 * 0.15
+  EXPECT_NEAR(r.mesh_volume, 0.55 * 0.05 * 0.15, 1e-9);
+  EXPECT_GE(r.coverage, 0.99);
+  EXPECT_LE(r.coverage_tolerance, 0.01 * r.diagonal);
+  EXPECT_LT(r.excess, 0.10);
+  EXPECT_NEAR(r.hull_union_volume_estimate, r.mesh_volume, 0.1 * r.mesh_volume);
+}
+
+TEST(ConvexDecompositionTest, HullOfTheWholeLIsMeasuredAsExcess) {
+  // one piece forced: the measures see the hull fill the L's inner corner
+  ConvexDecompositionOptions o;
+  o.max_pieces = 1;
+  ConvexDecompositionResult r = DecomposeConvex(LShape(), o);
+  ASSERT_EQ(r.pieces.size(), 1u);
+  EXPECT_GE(r.coverage, 0.99);
+  // the hull adds the triangle between the arms: 0.5 * 0.25^2 * 0.15 over 0.55 * 0.05 * 0.15
+  EXPECT_NEAR(r.excess, 0.5 * 0.25 * 0.25 / (0.55 * 0.05), 0.1);
+}
+
+TEST(ConvexDecompositionTest, BoxStaysOnePiece) {
+  ConvexDecompositionResult r = DecomposeConvex(Box());
+  ASSERT_EQ(r.pieces.size(), 1u);
+  ExpectConvexAndClosed(*r.pieces[0]);
+  EXPECT_EQ(r.pieces[0]->vertices.size(), 8u);
+  EXPECT_NEAR(MeshVolume(*r.pieces[0]), 0.2 * 0.1 * 0.05, 1e-9);
+  EXPECT_GE(r.coverage, 0.999);
+  EXPECT_DOUBLE_EQ(r.max_surface_distance, 0.0);
+  EXPECT_LT(r.excess, 0.01);
+}
+
+TEST(ConvexDecompositionTest, TorusGivesSeveralPiecesCoveringIt) {
+  MeshData torus = Torus(0.1, 0.03);
+  ConvexDecompositionResult r = DecomposeConvex(torus);
+  EXPECT_GE(r.pieces.size(), 4u);
+  EXPECT_LE(r.pieces.size(), 32u);
+  for (const auto& p : r.pieces) ExpectConvexAndClosed(*p);
+  EXPECT_GE(r.coverage, 0.99);
+  EXPECT_LT(r.excess, 0.15);
+  // the hole stays empty: its centre is in no piece
+  for (const auto& p : r.pieces) {
+    EXPECT_FALSE(InsidePiece(*p, Vector3d::Zero())) << "a piece fills the torus's hole";
+  }
+}
+
+TEST(ConvexDecompositionTest, ThinWalledCupKeepsItsCavityEmpty) {
+  MeshData cup = Cup(0.04, 0.1, 0.004, 24);
+  ASSERT_GT(MeshVolume(cup), 0.0);
+  ConvexDecompositionResult r = DecomposeConvex(cup);
+  EXPECT_GE(r.pieces.size(), 4u);
+  for (const auto& p : r.pieces) ExpectConvexAndClosed(*p);
+  EXPECT_GE(r.coverage, 0.99);
+  // the flat bottom faces join each other, not a wall: nothing fills the cup
+  EXPECT_LT(r.excess, 0.5);
+  for (double z : {0.02, 0.05, 0.09}) {
+    for (const auto& p : r.pieces) {
+      EXPECT_FALSE(InsidePiece(*p, Vector3d(0, 0, z))) << "a piece fills the cup at z = " << z;
+    }
+  }
+}
+
+TEST(ConvexDecompositionTest, MaxPiecesCapsTheCount) {
+  ConvexDecompositionOptions o;
+  o.max_pieces = 3;
+  ConvexDecompositionResult r = DecomposeConvex(Torus(0.1, 0.03), o);
+  EXPECT_LE(r.pieces.size(), 3u);
+  EXPECT_GE(r.pieces.size(), 1u);
+  // fewer pieces fit worse
+  EXPECT_GT(r.excess, DecomposeConvex(Torus(0.1, 0.03)).excess);
+}
+
+TEST(ConvexDecompositionTest, SimplifiedHullsReportTheirCoverage) {
+  ConvexDecompositionOptions o;
+  o.max_hull_vertices = 6;
+  ConvexDecompositionResult r = DecomposeConvex(Torus(0.1, 0.03), o);
+  for (const auto& p : r.pieces) {
+    EXPECT_LE(p->vertices.size(), 6u);
+    ExpectConvexAndClosed(*p);
+  }
+  // hulls of 6 vertices cut the round surface: the distance says by how much
+  EXPECT_GT(r.max_surface_distance, 0.0);
+  EXPECT_LT(r.max_surface_distance, 0.03);
+}
+
+TEST(ConvexDecompositionTest, BadInputThrowsNamingTheCause) {
+  auto message = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message([] { DecomposeConvexFile("/nonexistent/part.obj"); }).find("part.obj"),
+            std::string::npos);
+
+  MeshData nan = LShape();
+  nan.source = "bad_part.obj";
+  nan.vertices[3].x() = std::numeric_limits<float>::quiet_NaN();
+  std::string m = message([&] { DecomposeConvex(nan); });
+  EXPECT_NE(m.find("bad_part.obj"), std::string::npos) << m;
+  EXPECT_NE(m.find("vertex 3"), std::string::npos) << m;
+
+  // a single square: a flat open surface has no volume
+  MeshData flat;
+  flat.vertices = {Vector3f(0, 0, 0), Vector3f(1, 0, 0), Vector3f(1, 1, 0), Vector3f(0, 1, 0)};
+  flat.faces = {Eigen::Vector3i(0, 1, 2), Eigen::Vector3i(0, 2, 3)};
+  m = message([&] { DecomposeConvex(flat); });
+  EXPECT_NE(m.find("no volume"), std::string::npos) << m;
+
+  MeshData empty;
+  EXPECT_NE(message([&] { DecomposeConvex(empty); }).find("no triangles"), std::string::npos);
+
+  MeshData out_of_range = Box();
+  out_of_range.faces[0][1] = 1000;
+  EXPECT_NE(message([&] { DecomposeConvex(out_of_range); }).find("face 0"), std::string::npos);
+
+  ConvexDecompositionOptions o;
+  o.max_pieces = 0;
+  EXPECT_NE(message([&] { DecomposeConvex(Box(), o); }).find("max_pieces"), std::string::npos);
+}
+
+// Drops a ball of radius 0.02 m above the L's inner corner onto the given static collision and
+// returns where it rests.
+Vector3d DropBallIntoCorner(Scene& scene) {
+  Actor ball = scene.CreateActorBuilder()
+                   .AddSphereCollision(Pose(), 0.02)
+                   .SetInitialPose(Pose(Vector3d(0.1, 0.075, 0.4)))
+                   .Build();
+  scene.Step(1500);
+  return ball.GetPose().p;
+}
+
+TEST(ConvexDecompositionTest, WrittenPiecesLoadAndMakeANonConvexCollisionShape) {
+  const fs::path dir = fs::temp_directory_path() / "partsim_convex_decomposition_test";
+  fs::remove_all(dir);
+  ConvexDecompositionResult r = DecomposeConvex(LShape());
+  std::vector<std::string> files = WriteConvexPieces(r, dir.string(), "ell");
+  ASSERT_EQ(files.size(), r.pieces.size() + 1);
+
+  // OBJ files load back with the same vertices
+  for (size_t k = 0; k < r.pieces.size(); ++k) {
+    EXPECT_EQ(files[k], (dir / ("ell_" + std::to_string(k) + ".obj")).string());
+    std::shared_ptr<MeshData> back = LoadMergedMesh(files[k]);
+    EXPECT_NEAR(MeshVolume(*back), MeshVolume(*r.pieces[k]), 1e-9);
+    ExpectConvexAndClosed(*back);
+  }
+
+  // a URDF around the snippet, its link fixed to the world
+  std::ifstream snippet(files.back());
+  std::stringstream text;
+  text << "<robot name=\"ell\"><link name=\"base\">" << snippet.rdbuf() << "</link></robot>";
+  {
+    Scene scene;
+    scene.AddGround(0.0);
+    UrdfLoader loader(&scene);
+    Articulation ell = loader.LoadFromString(text.str(), dir.string());
+    ASSERT_EQ(ell.GetLinks().size(), 1u);
+    EXPECT_EQ(ell.GetLinks()[0].GetDesc().collisions.size(), r.pieces.size());
+    // the ball lands on the L's floor, inside the corner
+    Vector3d p = DropBallIntoCorner(scene);
+    EXPECT_NEAR(p.z(), 0.05 + 0.02, 0.003);
+    EXPECT_GT(p.x(), 0.05);
+    EXPECT_LT(p.x(), 0.3);
+  }
+  {
+    // the hull of the whole L fills the corner with a slope: the ball rolls off onto the ground
+    Scene scene;
+    scene.AddGround(0.0);
+    const std::string whole = (dir / "whole.obj").string();
+    ConvexDecompositionResult one = r;
+    one.pieces = {ConvexHull([&] {
+      std::vector<Vector3d> pts;
+      MeshData l = LShape();
+      for (const Vector3f& v : l.vertices) pts.push_back(v.cast<double>());
+      return pts;
+    }())};
+    WriteConvexPieces(one, dir.string(), "whole");
+    scene.CreateActorBuilder()
+        .AddConvexCollisionFromFile((dir / "whole_0.obj").string())
+        .BuildStatic();
+    Vector3d p = DropBallIntoCorner(scene);
+    EXPECT_FALSE(std::abs(p.z() - 0.07) < 0.003 && p.x() > 0.05 && p.x() < 0.3)
+        << "ball at " << p.transpose();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(ConvexDecompositionTest, CommandWritesPiecesAndRejectsBadArguments) {
+  const fs::path dir = fs::temp_directory_path() / "partsim_decompose_command_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // the L as an OBJ file
+  MeshData l = LShape();
+  const std::string obj = (dir / "ell.obj").string();
+  {
+    std::ofstream out(obj);
+    for (const Vector3f& v : l.vertices)
+      out << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
+    for (const Eigen::Vector3i& f : l.faces) {
+      out << "f " << f[0] + 1 << " " << f[1] + 1 << " " << f[2] + 1 << "\n";
+    }
+  }
+  const std::string out_dir = (dir / "pieces").string();
+  std::vector<std::string> args = {"decompose", obj, "--out", out_dir, "--max-pieces", "4"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  EXPECT_EQ(RunDecomposeCommand(static_cast<int>(argv.size()), argv.data()), 0);
+  EXPECT_TRUE(fs::exists(fs::path(out_dir) / "ell_0.obj"));
+  EXPECT_TRUE(fs::exists(fs::path(out_dir) / "ell_1.obj"));
+  EXPECT_TRUE(fs::exists(fs::path(out_dir) / "ell_collision.urdf.xml"));
+
+  std::vector<std::string> bad = {"decompose", obj, "--max-pieces", "x"};
+  argv.clear();
+  for (std::string& a : bad) argv.push_back(a.data());
+  EXPECT_EQ(RunDecomposeCommand(static_cast<int>(argv.size()), argv.data()), 2);
+
+  std::vector<std::string> missing = {"decompose", (dir / "nope.obj").string(), "--out", out_dir};
+  argv.clear();
+  for (std::string& a : missing) argv.push_back(a.data());
+  EXPECT_EQ(RunDecomposeCommand(static_cast<int>(argv.size()), argv.data()), 1);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace partsim
