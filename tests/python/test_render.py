@@ -254,3 +254,28 @@ def test_ply_and_npy_writers(tmp_path):
     np.testing.assert_array_equal(np.load(tmp_path / "t.npy"), positions.T)
     with pytest.raises(partsim.PartsimError, match="float32 or uint32"):
         partsim.write_npy(str(tmp_path / "x.npy"), np.zeros(3, np.float64))
+
+
+@pytest.mark.parametrize("backend", ["pathtracer", "rasterizer"])
+def test_a_real_backend_sees_a_box_where_it_is(scene, backend):
+    # a 0.2 m box at the origin, seen from 1.5 m along +x
+    scene.set_render_backend(backend)
+    box = build_box(scene, half=0.1, z=0.0, name="crate")
+    scene.add_directional_light([0, 0, -1], [1, 1, 1])
+    cam = scene.add_camera("c", 32, 24, 0.8, 0.05, 10.0)
+    cam.set_pose(look_at([1.5, 0, 0], [0, 0, 0]))
+    scene.update_render()
+    cam.take_picture()
+    crate_id = {e.name: e.id for e in scene.get_render_entities()}["crate"]
+    seg = cam.get_picture("Segmentation")
+    depth = cam.get_depth()
+    hit = seg[..., 1] == crate_id
+    assert hit[12, 16] and not hit[0, 0]
+    # the visible face is x = 0.1: 1.4 m straight ahead
+    assert depth[12, 16] == pytest.approx(1.4, abs=1e-3)
+    assert (depth[~hit] == 0).all()
+    cloud = partsim.get_point_cloud(cam, "world")
+    assert len(cloud["positions"]) == hit.sum()
+    np.testing.assert_allclose(cloud["positions"][:, 0], 0.1, atol=1e-3)
+    assert (cloud["entity_ids"] == crate_id).all()
+    assert box.get_id() == {e.name: e.actor_id for e in scene.get_render_entities()}["crate"]
