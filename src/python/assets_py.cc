@@ -5,6 +5,8 @@
 
 #include "bindings.h"
 #include "partsim/assets/mesh.h"
+#include "partsim/assets/partnet_mobility.h"
+#include "partsim/assets/quality.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/physics/scene.h"
 
@@ -71,6 +73,95 @@ void BindAssets(py::module_& m) {
   m.def("load_convex_pieces", &LoadConvexPieces, py::arg("path"),
         py::arg("scale") = Eigen::Vector3d::Ones().eval(),
         "Collision pieces of a file: one per sub-mesh and connected component.");
+
+  // PartNet-Mobility objects
+  py::class_<PartNetPart>(m, "PartNetPart",
+                          "An annotated part piece: a visual named '<name>-<id>'.")
+      .def_readonly("id", &PartNetPart::id)
+      .def_readonly("name", &PartNetPart::name);
+  py::class_<PartNetLink>(m, "PartNetLink",
+                          "One entry of mobility_v2.json: a link's motion, axis (file frame, "
+                          "y-up), limits (degrees for hinges, metres for sliders) and parts.")
+      .def_readonly("id", &PartNetLink::id)
+      .def_readonly("parent", &PartNetLink::parent)
+      .def_readonly("joint", &PartNetLink::joint, "hinge, slider, free, heavy or static.")
+      .def_readonly("semantic_label", &PartNetLink::semantic_label)
+      .def_readonly("parts", &PartNetLink::parts)
+      .def_readonly("has_axis", &PartNetLink::has_axis)
+      .def_readonly("axis_origin", &PartNetLink::axis_origin)
+      .def_readonly("axis_direction", &PartNetLink::axis_direction)
+      .def_readonly("limit_a", &PartNetLink::limit_a)
+      .def_readonly("limit_b", &PartNetLink::limit_b)
+      .def_readonly("no_limit", &PartNetLink::no_limit)
+      .def_readonly("rotates", &PartNetLink::rotates)
+      .def_readonly("no_rotation_limit", &PartNetLink::no_rotation_limit)
+      .def_readonly("rotation_limit", &PartNetLink::rotation_limit);
+  py::class_<PartNetMobilityObject>(m, "PartNetMobilityObject",
+                                    "A parsed PartNet-Mobility folder: its articulation (z-up, "
+                                    "root 'base') and its annotations.")
+      .def_readonly("folder", &PartNetMobilityObject::folder)
+      .def_readonly("category", &PartNetMobilityObject::category)
+      .def_readonly("model_id", &PartNetMobilityObject::model_id)
+      .def_readonly("articulation", &PartNetMobilityObject::articulation)
+      .def_readonly("links", &PartNetMobilityObject::links)
+      .def_readonly("bbox_min", &PartNetMobilityObject::bbox_min)
+      .def_readonly("bbox_max", &PartNetMobilityObject::bbox_max)
+      .def("link", &PartNetMobilityObject::Link, py::arg("id"), py::return_value_policy::copy,
+           "The mobility_v2.json entry of link_<id>.")
+      .def("link_index", &PartNetMobilityObject::LinkIndex, py::arg("id"),
+           "Index of link_<id> in the articulation.")
+      .def("part_visuals", &PartNetMobilityObject::PartVisuals, py::arg("id"), py::arg("part_name"),
+           "Indices of the visuals of part `part_name` on link_<id> (e.g. its handle).");
+  py::class_<PartNetMobilityLoader>(
+      m, "PartNetMobilityLoader",
+      "Reads PartNet-Mobility folders. Get one from Scene.create_partnet_mobility_loader(); one "
+      "made with PartNetMobilityLoader() can only parse. `urdf` holds the URDF options.")
+      .def(py::init<>())
+      .def_readwrite("urdf", &PartNetMobilityLoader::urdf)
+      .def("parse", &PartNetMobilityLoader::Parse, py::arg("folder"),
+           "Reads and cross-checks a folder; raises PartsimError naming the file and entry.")
+      .def("load", &PartNetMobilityLoader::Load, py::arg("folder"), ka,
+           "Parses a folder and adds its articulation to the scene.");
+  py::class_<Scene, std::shared_ptr<Scene>>(m.attr("Scene"))
+      .def(
+          "create_partnet_mobility_loader",
+          [](Scene& scene) { return PartNetMobilityLoader(&scene); }, ka);
+  py::class_<PartNetBatchEntry>(m, "PartNetBatchEntry")
+      .def_readonly("folder", &PartNetBatchEntry::folder)
+      .def_readonly("ok", &PartNetBatchEntry::ok)
+      .def_readonly("error", &PartNetBatchEntry::error)
+      .def_readonly("object", &PartNetBatchEntry::object);
+  m.def("parse_partnet_mobility_batch", &ParsePartNetMobilityBatch, py::arg("root"),
+        py::arg("loader"),
+        "Parses every object folder under `root`; bad folders carry their error, the rest load.");
+
+  // quality checks
+  py::class_<QualityOptions>(m, "QualityOptions")
+      .def(py::init<>())
+      .def_readwrite("rest_seconds", &QualityOptions::rest_seconds)
+      .def_readwrite("rest_tolerance", &QualityOptions::rest_tolerance)
+      .def_readwrite("range_seconds", &QualityOptions::range_seconds)
+      .def_readwrite("range_fraction", &QualityOptions::range_fraction)
+      .def_readwrite("check_visibility", &QualityOptions::check_visibility)
+      .def_readwrite("render_backend", &QualityOptions::render_backend)
+      .def_readwrite("image_size", &QualityOptions::image_size);
+  py::class_<QualityCheck>(m, "QualityCheck")
+      .def_readonly("name", &QualityCheck::name)
+      .def_readonly("passed", &QualityCheck::passed)
+      .def_readonly("detail", &QualityCheck::detail);
+  py::class_<ObjectQualityReport>(m, "ObjectQualityReport")
+      .def_readonly("folder", &ObjectQualityReport::folder)
+      .def_readonly("category", &ObjectQualityReport::category)
+      .def_readonly("model_id", &ObjectQualityReport::model_id)
+      .def_readonly("movable_parts", &ObjectQualityReport::movable_parts)
+      .def_readonly("checks", &ObjectQualityReport::checks)
+      .def("passed", &ObjectQualityReport::Passed)
+      .def("__str__", &ObjectQualityReport::ToString);
+  m.def("check_partnet_object", &CheckPartNetObject, py::arg("folder"),
+        py::arg("options") = QualityOptions(), py::call_guard<py::gil_scoped_release>(),
+        "Runs the quality checks (load, labels, rest, range, visible) on one folder.");
+  m.def("paper_statistics", &PaperStatistics,
+        "The SAPIEN paper's models and movable parts per category.");
 }
 
 }  // namespace partsim::python

@@ -208,6 +208,8 @@ void BindDescription(py::module_& m) {
                        "are copies: assign a whole list to change them.")
       .def(py::init<>())
       .def_readwrite("name", &BodyDesc::name)
+      .def_readwrite("semantic_label", &BodyDesc::semantic_label,
+                     "Part label (e.g. \"drawer\"), \"\" if none.")
       .def_readwrite("collisions", &BodyDesc::collisions)
       .def_readwrite("visuals", &BodyDesc::visuals)
       .def_readwrite("inertial", &BodyDesc::inertial, "None: from the collision shapes.");
