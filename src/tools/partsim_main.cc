@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "commands.h"
 #include "partsim/assets/default_objects.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/core/error.h"
@@ -41,6 +42,7 @@ usage:
   partsim info [FILE.urdf] [--fix-root | --free-root] [--json]
   partsim simulate [FILE.urdf] --steps N [options]
   partsim render [FILE.urdf] --out DIR [options]
+  partsim assets generate --out DIR [options]   (see partsim assets --help)
   partsim --help | --version
 
 info       prints the links (name, parent, mass), the joints (name, type, parent -> child,
@@ -698,6 +700,7 @@ int main(int argc, char** argv) {
     std::printf("partsim %s (MuJoCo %d.%d.%d)\n", kVersion, v / 100, (v / 10) % 10, v % 10);
     return 0;
   }
+  if (command == "assets") return partsim::tools::RunAssetsCommand(argc - 2, argv + 2);
   if (command != "info" && command != "simulate" && command != "render") {
     std::fprintf(stderr,
                  "partsim: unknown %s '%s' (expected info, simulate or render; see partsim "

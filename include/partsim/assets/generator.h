@@ -1,0 +1,105 @@
+// Procedural articulated objects in the 46 categories of the PartNet-Mobility dataset (SAPIEN,
+// Xiang et al. 2020), written as PartNet-Mobility folders (docs/partnet_mobility_format.md).
+//
+// Objects are built in the files' frame: y up, metres, the object's front facing +z, its base
+// resting on y = 0 (wall-mounted objects such as doors and windows stand on y = 0 too). Every
+// part piece is a closed, outward-facing, convex triangle mesh, so that it is both the visual and
+// the exact collision shape of the piece. Every joint is at rest at q = 0, which lies inside its
+// limits, and moving parts keep a few millimetres of clearance from the rest of the object over
+// their whole range.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace partsim {
+
+/// A closed convex triangle mesh of one part piece, in the file frame at rest (metres), with the
+/// material it is made of.
+struct GeneratedPiece {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<int, 3>> triangles;  ///< counter-clockwise seen from outside
+  std::string material;                       ///< material name in the .mtl, e.g. "wood"
+  Eigen::Vector3d color = Eigen::Vector3d::Constant(0.8);  ///< diffuse colour (Kd), 0..1
+  double density = 1000.0;                                 ///< kg/m^3
+};
+
+/// One annotated part of a link ("handle", "door", "drawer", ...), made of convex pieces.
+struct GeneratedPart {
+  int id = 0;        ///< unique in the object; visuals are named "<name>-<id>"
+  std::string name;  ///< part name
+  std::vector<GeneratedPiece> pieces;
+};
+
+/// One link_N of the object and the joint that attaches it to its parent.
+struct GeneratedLink {
+  int id = 0;         ///< N of link_N
+  int parent = -1;    ///< id of the parent link, -1 for base
+  std::string joint;  ///< hinge | slider | heavy | static | free
+  std::string name;   ///< semantic label, e.g. "drawer", "rotation_door"
+  std::vector<GeneratedPart> parts;
+  Eigen::Vector3d axis_origin = Eigen::Vector3d::Zero();      ///< file frame (m)
+  Eigen::Vector3d axis_direction = Eigen::Vector3d::UnitY();  ///< file frame, unit
+  double limit_a = 0.0;            ///< lower limit: degrees (hinge) or metres (slider)
+  double limit_b = 0.0;            ///< upper limit: degrees (hinge) or metres (slider)
+  bool no_limit = false;           ///< continuous hinge
+  bool rotates = false;            ///< slider that also turns about its axis
+  bool no_rotation_limit = false;  ///< ... without limit
+  double rotation_limit = 0.0;     ///< ... over [0, rotation_limit] degrees
+  double friction = 0.0;           ///< dry friction, N (slider) or N m (hinge)
+  double damping = 0.0;            ///< viscous damping, N s/m or N m s/rad
+};
+
+/// One generated object, in memory.
+struct GeneratedObject {
+  std::string category;  ///< e.g. "StorageFurniture"
+  std::string model_id;  ///< folder name, unique per (category, index)
+  std::string anno_id;
+  int index = 0;                     ///< index within its category
+  std::uint64_t seed = 0;            ///< dataset seed it was generated with
+  std::vector<GeneratedLink> links;  ///< by id
+};
+
+/// Options of GenerateDataset.
+struct GeneratorOptions {
+  std::vector<std::string> categories;  ///< empty: all 46
+  int per_category = 1;                 ///< objects per category; <= 0: the paper's #M
+  std::uint64_t seed = 0;
+  std::string out_dir;  ///< objects go to <out_dir>/<category>/<model_id>/
+  int jobs = 1;         ///< worker threads, >= 1
+};
+
+/// Progress of GenerateDataset: objects written so far, of `total`.
+using GeneratorProgress = std::function<void(int done, int total, const GeneratedObject& last)>;
+
+/// The 46 category names, in the order of the paper's table.
+std::vector<std::string> GeneratorCategories();
+
+/// The paper's number of models (#M) of a category (2,346 in all); throws partsim::Error naming
+/// an unknown category.
+int PaperModelCount(const std::string& category);
+
+/// The paper's number of parts (#P) of a category (14,068 in all). The paper's counts are the
+/// links of the models, body included (Laptop: 112 parts for 56 models); throws like
+/// PaperModelCount.
+int PaperPartCount(const std::string& category);
+
+/// Generates object `index` of `category`. The result depends only on (category, index, seed).
+/// Throws partsim::Error naming an unknown category or a negative index.
+GeneratedObject GenerateObject(const std::string& category, int index, std::uint64_t seed);
+
+/// Writes `object` into folder `dir` (created with its parents): mobility.urdf,
+/// mobility_v2.json, semantics.txt, meta.json, bounding_box.json, textured_objs/original-K.obj
+/// and .mtl. Same object, same bytes. Throws partsim::Error naming the file it cannot write.
+void WriteObject(const GeneratedObject& object, const std::string& dir);
+
+/// Generates and writes the objects of `options` on `options.jobs` threads; calls `progress`
+/// (serialised) after each object. Returns the number of objects written.
+int GenerateDataset(const GeneratorOptions& options,
+                    const GeneratorProgress& progress = GeneratorProgress());
+
+}  // namespace partsim

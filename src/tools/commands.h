@@ -1,0 +1,10 @@
+// Sub-commands of the `partsim` program that live in their own files.
+#pragma once
+
+namespace partsim::tools {
+
+/// `partsim assets ...`: generate procedural PartNet-Mobility objects. `argv` holds the
+/// arguments after "assets". Returns the exit code (0 success, 1 failure, 2 bad command line).
+int RunAssetsCommand(int argc, char** argv);
+
+}  // namespace partsim::tools
