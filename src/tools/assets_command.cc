@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "commands.h"
+#include "partsim/assets/convex_decomposition.h"
 #include "partsim/assets/generator.h"
+#include "partsim/assets/quality.h"
 
 namespace partsim::tools {
 namespace {
@@ -19,6 +21,8 @@ constexpr char kAssetsUsage[] = R"(usage:
   partsim assets generate --out DIR [--categories all|Cat1,Cat2] [--per-category N|paper]
                           [--seed S] [--jobs J]
   partsim assets categories
+  partsim assets check DIR [--jobs J] [--no-visibility] [--backend B] [--report FILE]
+  partsim assets decompose MESH --out DIR [--concavity C] [--max-pieces N]
 
 generate     writes DIR/<Category>/<model_id>/ folders in the PartNet-Mobility format
              (mobility.urdf, mobility_v2.json, semantics.txt, meta.json, bounding_box.json,
@@ -29,6 +33,10 @@ generate     writes DIR/<Category>/<model_id>/ folders in the PartNet-Mobility f
   --seed S                dataset seed, an unsigned integer (default 0)
   --jobs J                worker threads (default 1)
 categories   lists the 46 categories with the paper's model and part counts.
+check        runs the quality checks on every object folder under DIR and prints the models and
+             movable parts per category beside the paper's (`check --help` for more).
+decompose    splits a non-convex mesh into convex OBJ pieces with a URDF <collision> snippet and
+             reports coverage and excess (`decompose --help` for more).
 )";
 
 struct AssetsUsageError : std::runtime_error {
@@ -141,6 +149,9 @@ int ListCategories() {
 }  // namespace
 
 int RunAssetsCommand(int argc, char** argv) {
+  // check and decompose parse their own arguments (and --help)
+  if (argc > 0 && std::string(argv[0]) == "check") return RunQualityCommand(argc - 1, argv + 1);
+  if (argc > 0 && std::string(argv[0]) == "decompose") return RunDecomposeCommand(argc, argv);
   std::vector<std::string> args(argv, argv + argc);
   try {
     if (args.empty())
@@ -156,7 +167,7 @@ int RunAssetsCommand(int argc, char** argv) {
     if (sub == "generate") return Generate(args);
     if (sub == "categories" && args.empty()) return ListCategories();
     throw AssetsUsageError("partsim assets: unknown sub-command '" + sub +
-                           "' (expected generate or categories)");
+                           "' (expected generate, categories, check or decompose)");
   } catch (const AssetsUsageError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
