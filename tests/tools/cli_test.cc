@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "assets/partnet_test_folder.h"
 #include "partsim/assets/default_objects.h"
 
 #ifndef PARTSIM_CLI_PATH
@@ -352,6 +353,57 @@ TEST_F(CliTest, RenderWritesImagesCloudsAndLegendWithTheNullBackend) {
 TEST_F(CliTest, RenderWithThePathTracer) { CheckRender(dir_, "pathtracer", 2, true); }
 
 TEST_F(CliTest, RenderWithTheRasterizer) { CheckRender(dir_, "rasterizer", 2, true); }
+
+}  // namespace
+}  // namespace partsim
+
+namespace partsim {
+namespace {
+
+TEST_F(CliTest, AssetsCheckPassesAGoodFolderAndFailsABadOneButChecksBoth) {
+  testing::Folder good("cli_check/a_good");
+  testing::Folder bad("cli_check/b_bad");
+  bad.semantics = "link_0 hinge door\nlink_1 slider drawer\nlink_2 heavy cabinet_body\n";
+  bad.WriteAll();
+  std::string root = good.dir.parent_path().string();
+  RunResult r = RunCli("assets check '" + root + "' --jobs 1 --no-visibility");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(Contains(r.output, "checked 2 objects")) << r.output;
+  EXPECT_TRUE(Contains(r.output, "1 passed, 1 failed")) << r.output;
+  EXPECT_TRUE(Contains(r.output, "semantics.txt")) << r.output;
+  EXPECT_TRUE(Contains(r.output, "StorageFurniture")) << r.output;
+  RunResult ok = RunCli("assets check '" + good.Path() + "' --no-visibility");
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_EQ(RunCli("assets check").code, 2);
+  EXPECT_EQ(RunCli("assets check '" + (dir_ / "nothing").string() + "'").code, 1);
+}
+
+TEST_F(CliTest, AssetsDecomposeWritesConvexPieces) {
+  // an L of two boxes, as one OBJ
+  std::string obj = testing::BoxObj({0, 0, 0}, {0.2, 0.05, 0.05});
+  std::string second = testing::BoxObj({-0.15, 0, 0.15}, {0.05, 0.05, 0.1});
+  // renumber the second box's faces after the first's 8 vertices
+  std::string merged = obj;
+  std::istringstream in(second);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("f ", 0) == 0) {
+      std::istringstream f(line.substr(2));
+      merged += "f";
+      int i;
+      while (f >> i) merged += " " + std::to_string(i + 8);
+      merged += "\n";
+    } else if (line.rfind("v ", 0) == 0) {
+      merged += line + "\n";
+    }
+  }
+  testing::Write(dir_ / "l.obj", merged);
+  RunResult r = RunCli("assets decompose '" + (dir_ / "l.obj").string() + "' --out '" +
+                       (dir_ / "pieces").string() + "'");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir_ / "pieces" / "l_0.obj")) << r.output;
+  EXPECT_TRUE(fs::exists(dir_ / "pieces" / "l_collision.urdf.xml")) << r.output;
+}
 
 }  // namespace
 }  // namespace partsim
