@@ -16,7 +16,8 @@
 //   lights subtend a cone of 0.5 degree angular radius, point and spot lights are disks of 2 cm
 //   radius facing the shaded point; light colour is the irradiance at normal incidence for a
 //   directional light and the intensity (divided by the squared distance) for point and spot
-//   lights; spot lights fade smoothly from inner_angle to outer_angle;
+//   lights; spot lights fade smoothly from inner_angle to outer_angle; every light casts
+//   shadows (LightDesc::shadow only switches the rasterizer's shadow maps);
 // - the ambient colour is a uniform environment light (radiance), gathered when a bounce ray
 //   escapes the scene;
 // - up to max_depth bounces: at most max_depth surface vertices are shaded, and the bounce ray
