@@ -52,6 +52,8 @@ struct GeneratedLink {
   double rotation_limit = 0.0;     ///< ... over [0, rotation_limit] degrees
   double friction = 0.0;           ///< dry friction, N (slider) or N m (hinge)
   double damping = 0.0;            ///< viscous damping, N s/m or N m s/rad
+  double rotation_friction = 0.0;  ///< rotating sliders: dry friction of the turn, N m
+  double rotation_damping = 0.0;   ///< rotating sliders: damping of the turn, N m s/rad
 };
 
 /// One generated object, in memory.

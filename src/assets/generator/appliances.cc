@@ -43,7 +43,7 @@ void BuildDishwasher(ObjectBuilder& b, Rng& rng) {
   b.Dynamics(door, 0.5, 1.0);
   AddHandle(b, door, rng.P(0.5) ? HandleStyle::kBar : HandleStyle::kEdge,
             V3(0, hi.y() - 0.05, hi.z()), V3::UnitZ(), V3::UnitX(), 0.6 * w, steel);
-  if (panel > 0.01 && rng.P(0.66)) {
+  if (panel > 0.06 && rng.P(0.66)) {
     Knob(b, body, V3(w / 2 - 0.08, h - panel / 2, d / 2), V3::UnitZ(), 0.02, 0.02, 300,
          DarkPlastic(rng));
   }
@@ -226,7 +226,7 @@ void BuildWashingMachine(ObjectBuilder& b, Rng& rng) {
   double cy = 0.5 * (h - panel) + 0.02;
   V3 c(0, cy, d / 2 + kGap);
   double hx = -r - 0.015;
-  int door = b.Hinge(body, "door", V3(hx, cy, d / 2 + kGap), -V3::UnitY(), 0, rng.U(90, 120));
+  int door = b.Hinge(body, "door", V3(hx, cy, d / 2 + kGap), -V3::UnitY(), 0, 90);
   int dp = b.Part(door, "door");
   Frame f = FrameZ(c, V3::UnitZ());
   Annulus(b, dp, f, 0.72 * r, r, 0.0, 0.05, 12, skin.WithDensity(1200));
@@ -253,8 +253,8 @@ void BuildWashingMachine(ObjectBuilder& b, Rng& rng) {
   double x = w / 2 - 0.08;
   for (int k = 0; k < knobs; ++k, x -= 0.11)
     Knob(b, body, V3(x, py, d / 2), V3::UnitZ(), 0.035, 0.03, rng.P(0.5) ? 0 : 330, dark);
-  int buttons = rng.I(3, 6);
   double x0 = -w / 2 + 0.06 + dw, x1 = x + 0.03;
+  int buttons = std::min(rng.I(3, 6), static_cast<int>((x1 - x0) / 0.022));
   double pitch = std::min(0.035, (x1 - x0) / std::max(1, buttons));
   for (int i = 0; i < buttons; ++i) {
     Button(b, body, V3(x0 + pitch * (i + 0.5), py, d / 2), V3::UnitZ(), V3::UnitX(),
@@ -314,6 +314,7 @@ void BuildCoffeeMachine(ObjectBuilder& b, Rng& rng) {
   if (rng.P(0.5)) {
     V3 pivot(w / 2 + kGap, head_y + 0.03, 0.0);
     int lever = b.Hinge(body, "lever", pivot, V3::UnitX(), 0, 60);
+    b.RestOnLimit(lever);
     int lp = b.Part(lever, "lever");
     b.Add(lp, Cylinder(FrameZ(pivot, V3::UnitX()), 0.012, 0.0, 0.01, 16), steel);
     b.Add(lp,
@@ -346,20 +347,20 @@ void BuildToaster(ObjectBuilder& b, Rng& rng) {
   double zf = d / 2;
   for (int i = 0; i < levers; ++i) {
     double x = levers == 1 ? -w / 2 + 0.05 : (i == 0 ? -w / 2 + 0.05 : w / 2 - 0.05);
-    V3 top(x, h - 0.04, zf + kGap);
-    int lever = b.Slider(body, "slider", top, -V3::UnitY(), 0, h - 0.09);
-    b.AddPart(
-        lever, "lever",
-        BoxLoHi(V3(x - 0.02, h - 0.055, zf + kGap), V3(x + 0.02, h - 0.035, zf + kGap + 0.025)),
-        dark);
+    // the lever rests at the bottom of its slot (pushed down) and lifts up
+    V3 bottom(x, 0.045, zf + kGap);
+    int lever = b.Slider(body, "slider", bottom, V3::UnitY(), 0, h - 0.09);
+    b.AddPart(lever, "lever",
+              BoxLoHi(V3(x - 0.02, 0.035, zf + kGap), V3(x + 0.02, 0.055, zf + kGap + 0.025)),
+              dark);
     b.Dynamics(lever, 0.3, 0.2);
   }
   double xc = levers == 1 ? w / 2 - 0.05 : 0.0;
   Knob(b, body, V3(xc, 0.09, zf), V3::UnitZ(), 0.016, 0.015, 240, dark);
   int buttons = rng.I(1, 3);
   for (int i = 0; i < buttons; ++i) {
-    Button(b, body, V3(xc, 0.05 - 0.02 * i + (buttons > 2 ? 0.02 : 0.0), zf), V3::UnitZ(),
-           V3::UnitX(), RoundRect(0.022, 0.012, 0.003, 2), 0.004, 0.002, dark);
+    Button(b, body, V3(xc, 0.058 - 0.018 * i, zf), V3::UnitZ(), V3::UnitX(),
+           RoundRect(0.022, 0.012, 0.003, 2), 0.004, 0.002, dark);
   }
 }
 
@@ -531,8 +532,11 @@ void BuildLamp(ObjectBuilder& b, Rng& rng) {
     // direction angle from -z towards +y
     double angle = i == 0 ? rng.U(55, 80) * kPi / 180 : kPi - rng.U(10, 35) * kPi / 180;
     double len = rng.U(0.25, 0.4);
-    double lo = i == 0 ? -(angle * 180 / kPi - 25) : -30, hi = i == 0 ? 45 : 20;
-    int arm = b.Hinge(parent, "rotation_bar", pivot + V3(x, 0, 0), V3::UnitX(), lo, hi);
+    // the arms rest against a stop: the range goes one way or the other (Finalize picks the
+    // side gravity pushes into); the first arm stays above 25 degrees, the second above 190
+    double span = i == 0 ? std::min(45.0, angle * 180 / kPi - 25) : 20;
+    int arm = b.Hinge(parent, "rotation_bar", pivot + V3(x, 0, 0), V3::UnitX(), 0, span);
+    b.RestOnLimit(arm);
     b.Dynamics(arm, 0.5, 0.1);
     V3 dir(0, std::sin(angle), -std::cos(angle));
     V3 end = pivot + dir * len;
@@ -546,7 +550,8 @@ void BuildLamp(ObjectBuilder& b, Rng& rng) {
     x += aw + kGap;
   }
   // head: a shade beside the last arm, turning about x at the arm's end
-  int head = b.Hinge(parent, "head", pivot + V3(x, 0, 0), V3::UnitX(), -40, 40);
+  int head = b.Hinge(parent, "head", pivot + V3(x, 0, 0), V3::UnitX(), 0, 60);
+  b.RestOnLimit(head);
   b.Dynamics(head, 0.3, 0.05);
   int hp = b.Part(head, "head");
   double sr = rng.U(0.06, 0.1);
@@ -574,7 +579,8 @@ void BuildDisplay(ObjectBuilder& b, Rng& rng) {
       BoxLoHi(V3(-0.03, 0.014, axis_z - nt / 2), V3(0.03, axis_y - hub_r - kGap, axis_z + nt / 2)),
       skin);
   // screen: hub on the axis, bracket, panel; tilts about x
-  int screen = b.Hinge(body, "rotation_screen", V3(0, axis_y, axis_z), -V3::UnitX(), -5, 20);
+  int screen = b.Hinge(body, "rotation_screen", V3(0, axis_y, axis_z), -V3::UnitX(), 0, 25);
+  b.RestOnLimit(screen);
   b.Dynamics(screen, 1.0, 0.2);
   int sp = b.Part(screen, "screen");
   b.Add(sp, Cylinder(FrameZ(V3(-0.03, axis_y, axis_z), V3::UnitX()), hub_r, 0.0, 0.06, 24), skin);
@@ -631,22 +637,21 @@ void BuildKettle(ObjectBuilder& b, Rng& rng) {
     b.Dynamics(lid, 0.02, 0.01);
     if (rng.P(0.5)) {
       // power switch at the handle's foot
-      V3 pivot(0, 0.22 * h, zb - 0.012 - kGap);
-      int sw = b.Hinge(body, "button", pivot, V3::UnitX(), -15, 0);
-      b.AddPart(sw, "button",
-                BoxLoHi(V3(-0.008, 0.22 * h - 0.008, zb - 0.012 - kGap - 0.01),
-                        V3(0.008, 0.22 * h + 0.012, zb - 0.012 - kGap)),
-                dark);
+      // power switch at the handle's foot: a button pushed into the handle (along +z)
+      Button(b, body, V3(0, 0.22 * h, zb - 0.012), -V3::UnitZ(), V3::UnitX(),
+             RoundRect(0.014, 0.01, 0.003, 2), 0.006, 0.002, dark);
     }
   } else {
     // stove kettle: arch handle above, lid lifts off
     double hh = rng.U(0.09, 0.13);
-    Polyline(b, b.Part(body, "handle"),
-             Arc(V3(0, h, 0), V3::UnitX(), V3::UnitY(), 0.75 * rt, 0.0, kPi, 8), 0.008, dark);
-    b.Add(bp, Box(V3(0.75 * rt, h - 0.01, 0), V3(0.02, 0.03, 0.02)), skin);
-    b.Add(bp, Box(V3(-0.75 * rt, h - 0.01, 0), V3(0.02, 0.03, 0.02)), skin);
+    double ar = std::max(0.75 * rt, 0.5 * rt + 0.028);  // arch radius
+    Polyline(b, b.Part(body, "handle"), Arc(V3(0, h, 0), V3::UnitX(), V3::UnitY(), ar, 0.0, kPi, 8),
+             0.008, dark);
+    b.Add(bp, Box(V3(ar, h - 0.01, 0), V3(0.02, 0.03, 0.02)), skin);
+    b.Add(bp, Box(V3(-ar, h - 0.01, 0), V3(0.02, 0.03, 0.02)), skin);
     (void)hh;
-    double travel = std::max(0.003, std::min(0.75 * rt - 0.053, 0.51 * rt - 0.025));
+    double travel =
+        std::max(0.003, std::min(ar - 0.053, std::sqrt(ar * ar - 0.25 * rt * rt) - 0.035));
     int lid = b.Slider(body, "lid", V3(0, h + kGap, 0), V3::UnitY(), 0, travel);
     int lp = b.Part(lid, "lid");
     b.Add(
@@ -685,16 +690,6 @@ void BuildKitchenPot(ObjectBuilder& b, Rng& rng) {
              FrameZ(V3(0, top + 0.012, 0), V3::UnitY())),
         dark);
   b.Dynamics(lid, 0.1, 0.1);
-  if (rng.P(0.12)) {
-    // a long folding handle on a saucepan
-    V3 pivot(r + 0.06 + kGap, 0.8 * h - 0.0075, 0);
-    b.Add(bp, Box(V3(r + 0.03, 0.8 * h, 0), V3(0.06, 0.02, 0.03)), metal);
-    int fh = b.Hinge(body, "handle", pivot, V3::UnitZ(), -80, 0);
-    b.AddPart(
-        fh, "handle",
-        Bar(pivot + V3(0.0, 0.0075, 0), pivot + V3(0.15, 0.0275, 0), 0.025, 0.015, V3::UnitZ()),
-        dark);
-  }
 }
 
 void BuildDispenser(ObjectBuilder& b, Rng& rng) {
@@ -719,10 +714,11 @@ void BuildDispenser(ObjectBuilder& b, Rng& rng) {
     b.Dynamics(collar, 0.05, 0.01);
     y0 += kGap + 0.015;
   }
+  // the pump head rests locked down and lifts (and turns) to unlock
   double travel = 0.012;
-  int pump = b.ScrewSlider(parent, "lid", V3(0, y0 + kGap + travel, 0), -V3::UnitY(), 0, travel);
+  int pump = b.ScrewSlider(parent, "lid", V3(0, y0 + kGap, 0), V3::UnitY(), 0, travel);
   int pp = b.Part(pump, "pump_head");
-  double py = y0 + kGap + travel;
+  double py = y0 + kGap;
   b.Add(pp, Cylinder(FrameZ(V3(0, py, 0), V3::UnitY()), 0.006, 0.0, 0.03, 12), dark);
   b.Add(pp,
         Loft(RoundRect(1.0, 0.6, 0.2, 3), {Ring{0.0, 0.04}, Ring{0.02, 0.04}, Ring{0.026, 0.034}},

@@ -234,10 +234,9 @@ void BuildChair(ObjectBuilder& b, Rng& rng) {
     double a = 2 * kPi * i / n_legs + 0.3;
     V3 dir(std::cos(a), 0, std::sin(a));
     V3 tip = dir * base_r;
-    b.Add(
-        star,
-        Bar(V3(0, leg_y + 0.015, 0), V3(tip.x(), leg_y + 0.015, tip.z()), 0.035, 0.03, V3::UnitY()),
-        frame);
+    b.Add(star,
+          Bar(V3(0, leg_y + 0.02, 0), V3(tip.x(), leg_y + 0.02, tip.z()), 0.03, 0.03, V3::UnitY()),
+          frame);
     b.Add(star, Cylinder(FrameZ(V3(tip.x(), leg_y, tip.z()), V3::UnitY()), 0.015, 0.0, 0.03, 16),
           frame);
     Caster(b, body, V3(tip.x(), leg_y - kGap, tip.z()), caster_h - kGap + 0.004 - 0.004, dark,
@@ -299,13 +298,14 @@ void BuildChair(ObjectBuilder& b, Rng& rng) {
   int levers = rng.P(0.7) ? 2 : 1;
   for (int i = 0; i < levers; ++i) {
     double s = i == 0 ? 1.0 : -1.0;
-    V3 pivot(s * (0.1 + kGap), seat_y - st - 0.025, 0.0);
-    int lever = b.Hinge(seat, "lever", pivot, s * V3::UnitZ(), -15, 0);
+    V3 pivot(s * (0.1 + kGap), seat_y - st - 0.045, 0.0);
+    int lever = b.Hinge(seat, "lever", pivot, s * V3::UnitZ(), -12, 0);
+    b.RestOnLimit(lever);
     int part = b.Part(lever, "lever");
     b.Add(part,
-          Bar(pivot + V3(s * 0.003, 0, 0), pivot + V3(s * 0.13, 0, 0), 0.012, 0.008, V3::UnitZ()),
+          Bar(pivot + V3(s * 0.003, 0, 0), pivot + V3(s * 0.095, 0, 0), 0.012, 0.008, V3::UnitZ()),
           dark);
-    b.Add(part, Sphere(pivot + V3(s * 0.14, 0, 0), 0.012, 6, 12), dark);
+    b.Add(part, Sphere(pivot + V3(s * 0.105, 0, 0), 0.012, 6, 12), dark);
   }
   int knobs = rng.P(0.7) ? 2 : 1;
   for (int i = 0; i < knobs; ++i) {
@@ -364,7 +364,10 @@ void BuildDoor(ObjectBuilder& b, Rng& rng) {
   b.Add(frame, BoxLoHi(V3(w / 2, 0, zb), V3(w / 2 + jw, h + jw, zf)), wood);
   b.Add(frame, BoxLoHi(V3(-w / 2, h, zb), V3(w / 2, h + jw, zf)), wood);
   bool left = rng.P(0.5);
-  V3 lo(-w / 2 + kGap, kGap + 0.005, -T / 2), hi(w / 2 - kGap, h - kGap, T / 2);
+  // the free edge of an inset door swings out past its closed position by up to T^2 / 2w
+  double free = kGap + T * T / w;
+  V3 lo(-w / 2 + (left ? kGap : free), kGap + 0.005, -T / 2),
+      hi(w / 2 - (left ? free : kGap), h - kGap, T / 2);
   int door = HingedPanel(b, body, "rotation_door", "door", lo, hi, V3::UnitZ(),
                          left ? V3(1, 0, 0) : V3(-1, 0, 0), rng.U(90, 110), wood, true);
   b.Dynamics(door, 1.0, 2.0);
@@ -377,21 +380,21 @@ void BuildDoor(ObjectBuilder& b, Rng& rng) {
       b.Add(deco, BoxLoHi(V3(x0, 0.25, T / 2 - 0.001), V3(x0 + pw, h - 0.25, T / 2 + 0.006)), wood);
     }
   }
-  // lever handle: a rose and a lever on each side, turning about the door's normal
+  // door knobs on both sides (a rose, a stem and a knob), turning about the door's normal;
+  // round, so that they balance at rest
   double hx = left ? w / 2 - 0.07 : -w / 2 + 0.07, hy = rng.U(0.95, 1.05);
-  double sgn = left ? -1.0 : 1.0;  // the lever points towards the hinge side
-  V3 c(hx, hy, T / 2);
-  int handle = b.Hinge(door, "handle", V3(hx, hy, 0), V3::UnitZ() * (left ? -1.0 : 1.0), -45, 0);
-  b.Dynamics(handle, 0.3, 0.02);
+  int handle = b.Hinge(door, "handle", V3(hx, hy, 0), V3::UnitZ(), 0, rng.U(45, 90));
+  b.Dynamics(handle, 0.05, 0.005);
   int hp = b.Part(handle, "handle");
-  double len = rng.U(0.11, 0.15);
+  double kr = rng.U(0.024, 0.032);
   for (int side : {-1, 1}) {
     double z0 = side * (T / 2 + kGap);
     Frame f = FrameZ(V3(hx, hy, z0), side * V3::UnitZ());
     b.Add(hp, Cylinder(f, 0.027, 0.0, 0.008, 24), metal);
-    b.Add(hp, Cylinder(f, 0.009, 0.006, 0.05, 16), metal);
+    b.Add(hp, Cylinder(f, 0.008, 0.006, 0.04, 16), metal);
     b.Add(hp,
-          Rod(V3(hx, hy, z0 + side * 0.05), V3(hx + sgn * len, hy, z0 + side * 0.05), 0.009, 14),
+          Loft(Circle(1.0, 32),
+               {Ring{0.036, 0.6 * kr}, Ring{0.046, kr}, Ring{0.062, kr}, Ring{0.068, 0.7 * kr}}, f),
           metal);
   }
   // a keyhole escutcheon below (part of the door)
@@ -400,7 +403,6 @@ void BuildDoor(ObjectBuilder& b, Rng& rng) {
               Cylinder(FrameZ(V3(hx, hy - 0.08, T / 2), V3::UnitZ()), 0.015, -0.001, 0.004, 20),
               metal);
   }
-  (void)c;
 }
 
 void BuildWindow(ObjectBuilder& b, Rng& rng) {
@@ -457,7 +459,7 @@ void BuildWindow(ObjectBuilder& b, Rng& rng) {
     // casement sashes set in the frame, hinged at the sides, and an optional awning on top
     double depth = sash_t + rng.U(0.01, 0.04);
     double zf = sash_t / 2, zb = zf - depth;
-    bool awning = rng.P(0.45);
+    bool awning = rng.P(0.45);  // a hopper sash above the casements
     double ha = awning ? rng.U(0.25, 0.4) * h : 0.0;
     double hc = h - ha - (awning ? fw : 0.0);
     b.Add(frame, BoxLoHi(V3(-w / 2 - fw, -fw, zb), V3(w / 2 + fw, 0, zf)), frame_mat);
@@ -468,9 +470,13 @@ void BuildWindow(ObjectBuilder& b, Rng& rng) {
     int n = w > 0.8 ? 2 : 1;
     bool left_first = rng.P(0.5);
     for (int i = 0; i < n; ++i) {
-      double x0 = n == 1 ? -w / 2 + kGap : (i == 0 ? -w / 2 + kGap : kGap / 2);
-      double x1 = n == 1 ? w / 2 - kGap : (i == 0 ? -kGap / 2 : w / 2 - kGap);
       bool left = n == 1 ? left_first : i == 0;
+      // an inset sash's free edge swings out past its closed position by up to t^2 / 2w:
+      // leave room for it
+      double sw_ = n == 1 ? w : w / 2;
+      double free = kGap + sash_t * sash_t / sw_;
+      double x0 = n == 1 ? -w / 2 + (left ? kGap : free) : (i == 0 ? -w / 2 + kGap : free / 2);
+      double x1 = n == 1 ? w / 2 - (left ? free : kGap) : (i == 0 ? -free / 2 : w / 2 - kGap);
       V3 lo(x0, kGap, -sash_t / 2), hi(x1, hc - kGap, sash_t / 2);
       int sash = PanelHinge(b, body, "window", lo, hi, V3::UnitZ(),
                             left ? V3(1, 0, 0) : V3(-1, 0, 0), rng.U(80, 100), true);
@@ -480,9 +486,11 @@ void BuildWindow(ObjectBuilder& b, Rng& rng) {
                 V3::UnitZ(), V3::UnitY(), 0.07, Steel(rng));
     }
     if (awning) {
-      V3 lo(-w / 2 + kGap, hc + fw + kGap, -sash_t / 2), hi(w / 2 - kGap, h - kGap, sash_t / 2);
+      // a hopper: hinged at the bottom, its top tilts inwards (-z); gravity holds it closed
+      V3 lo(-w / 2 + kGap, hc + fw + kGap, -sash_t / 2),
+          hi(w / 2 - kGap, h - kGap - sash_t * sash_t / (h - hc - fw), sash_t / 2);
       int sash =
-          PanelHinge(b, body, "window", lo, hi, V3::UnitZ(), -V3::UnitY(), rng.U(30, 60), true);
+          PanelHinge(b, body, "window", lo, hi, -V3::UnitZ(), V3::UnitY(), rng.U(30, 50), true);
       sash_parts(sash, lo, hi);
       b.Dynamics(sash, 0.5, 0.5);
     }
@@ -541,16 +549,18 @@ void BuildToilet(ObjectBuilder& b, Rng& rng) {
   double tank_top = bh - 0.01 + th;
   if (rng.P(0.7)) {
     if (rng.P(0.6)) {
-      // flush lever on the front left of the tank
-      V3 pivot(-tw / 2 + 0.06, tank_top - 0.06, tank_front + kGap);
-      int lever = b.Hinge(body, "lever", pivot, V3::UnitZ(), -35, 0);
+      // flush lever on the left side of the tank, clear of the raised lid, pointing back
+      V3 pivot(-tw / 2 - kGap, tank_top - 0.05, tank_front - 0.045);
+      int lever = b.Hinge(body, "lever", pivot, -V3::UnitX(), 0, 35);
+      b.RestOnLimit(lever);
       int lp = b.Part(lever, "lever");
-      b.Add(lp, Cylinder(FrameZ(pivot, V3::UnitZ()), 0.018, 0.0, 0.012, 20), Steel(rng));
-      b.Add(lp, Bar(pivot + V3(0, 0, 0.012), pivot + V3(0.09, 0, 0.016), 0.015, 0.008, V3::UnitY()),
+      b.Add(lp, Cylinder(FrameZ(pivot, -V3::UnitX()), 0.018, 0.0, 0.012, 20), Steel(rng));
+      b.Add(lp,
+            Bar(pivot - V3(0.012, 0, 0), pivot + V3(-0.016, 0, -0.09), 0.015, 0.008, V3::UnitY()),
             Steel(rng));
     } else {
       Button(b, body, V3(0, tank_top, tank_front - td / 2), V3::UnitY(), V3::UnitX(),
-             Circle(0.025, 24), 0.008, 0.006, Steel(rng));
+             Circle(0.025, 24), 0.008, 0.003, Steel(rng));
     }
   }
 }
@@ -585,7 +595,8 @@ void BuildTrashCan(ObjectBuilder& b, Rng& rng) {
   if (rng.P(0.5)) {
     // pedal at the front foot
     double zf = (round ? 1.0 : 0.8) * (0.88 * r + 0.12 * r * 0.06 / h);
-    V3 pivot(0, 0.03, zf + kGap);
+    // a rocker pivoting at its middle, so that it balances at rest
+    V3 pivot(0, 0.036, zf + kGap + 0.045);
     int pedal = b.Hinge(body, "pad", pivot, V3::UnitX(), 0, 12);
     b.AddPart(pedal, "pad", BoxLoHi(V3(-0.05, 0.03, zf + kGap), V3(0.05, 0.042, zf + kGap + 0.09)),
               Steel(rng));
@@ -655,11 +666,12 @@ void BuildCart(ObjectBuilder& b, Rng& rng) {
     for (int s : {-1, 1}) {
       V3 c(s * (w / 2 + 0.03 + ww / 2), wr, zf - wr - 0.04);
       Wheel(b, body, c, V3::UnitX(), wr, ww, Rubber(), metal);
+      // axle stub along x, held by a strut from the frame
       b.Add(fp,
-            Rod(V3(s * (w / 2 - 0.01), wr, zf - 0.03),
-                V3(s * (w / 2 + 0.03 - kGap - 0.001), wr, c.z()), 0.008),
+            Rod(V3(s * (w / 2 - 0.012), wr, c.z()), V3(s * (w / 2 + 0.03 - 2 * kGap), wr, c.z()),
+                0.008),
             metal);
-      b.Add(fp, Rod(V3(s * w / 2, 0.1, zf), V3(s * w / 2, wr, zf - 0.03), 0.01), metal);
+      b.Add(fp, Rod(V3(s * w / 2, 0.1, zf), V3(s * w / 2, wr, c.z()), 0.01), metal);
     }
   }
 }
@@ -714,21 +726,23 @@ void BuildBox(ObjectBuilder& b, Rng& rng) {
   double u = rng.U(0, 1);
   if (u < 0.2) {
     // one lid hinged at the back
-    int lid = HingedPanel(b, body, "rotation_lid", "lid", V3(-w / 2, y0, -d / 2),
+    int lid = HingedPanel(b, body, "rotation_lid", "lid", V3(-w / 2, y0, -d / 2 - kGap),
                           V3(w / 2, y0 + t, d / 2), V3::UnitY(), V3::UnitZ(), 110, card);
     b.Dynamics(lid, 0.05, 0.02);
   } else if (u < 0.8) {
     // two flaps meeting in the middle
     for (int s : {-1, 1}) {
-      V3 lo(s < 0 ? -w / 2 : kGap / 2, y0, -d / 2), hi(s < 0 ? -kGap / 2 : w / 2, y0 + t, d / 2);
+      // the flaps overhang the walls a little so that, turned over, they clear them
+      V3 lo(s < 0 ? -w / 2 - kGap : kGap / 2, y0, -d / 2),
+          hi(s < 0 ? -kGap / 2 : w / 2 + kGap, y0 + t, d / 2);
       int flap = HingedPanel(b, body, "rotation_lid", "flap", lo, hi, V3::UnitY(),
                              s < 0 ? V3(1, 0, 0) : V3(-1, 0, 0), 180, card);
       b.Dynamics(flap, 0.03, 0.01);
     }
   } else {
     // four flaps cut along the diagonals of the top (a hip-roof plan), in (x, z)
-    double m = std::min(w, d) / 2;
-    const double X = w / 2, Z = d / 2;
+    double m = std::min(w, d) / 2 + kGap;
+    const double X = w / 2 + kGap, Z = d / 2 + kGap;
     std::vector<std::vector<V2>> flaps = {
         {V2(-X, -Z), V2(-X, Z), V2(-X + m, Z - m), V2(-X + m, -Z + m)},
         {V2(X, Z), V2(X, -Z), V2(X - m, -Z + m), V2(X - m, Z - m)},

@@ -10,6 +10,22 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kGravity = 9.81;
+// joint dynamics limits (accelerations in m/s^2 or rad/s^2): dry friction below
+// kMaxFrictionAccel; damping such that an effort of kDriveAccel sweeps the range kMinSweeps
+// times a second (kMinSweepsLoaded for parts whose damping holds them against gravity)
+constexpr double kMaxFrictionAccel = 3.0;
+constexpr double kDriveAccel = 30.0;
+constexpr double kDriveStiffness = 225.0;  // 1/s^2 (per unit inertia)
+constexpr double kMaxDampingRate = 10.0;   // 1/s (per unit inertia)
+// wheels, knobs and rotors: some bearing friction (m/s^2 or rad/s^2) and damping (1/s)
+constexpr double kFreeTurnFriction = 1.0;
+constexpr double kFreeTurnDamping = 2.0;
+constexpr double kMinSweeps = 4.0;
+constexpr double kMinSweepsLoaded = 1.5;
+// gravity creep: allowed acceleration load of a part not resting on a limit, and damping
+// (per unit inertia and load acceleration) that keeps the creep below ~1 mm/s
+constexpr double kCreepAccel = 0.5;
+constexpr double kCreepDampingPerAccel = 500.0;
 
 std::uint64_t SplitMix(std::uint64_t* x) {
   std::uint64_t z = (*x += 0x9e3779b97f4a7c15ULL);
@@ -213,9 +229,11 @@ int ObjectBuilder::AddPart(int link, const std::string& name, const Mesh& mesh,
 
 void ObjectBuilder::Finalize() {
   const int n = LinkCount();
-  // mass and first moment of each link, then of each subtree (children have larger ids)
+  // mass, first and second moments of each link, then of each subtree (children have larger
+  // ids), in the file frame at rest
   std::vector<double> mass(n, 0.0);
   std::vector<V3> first(n, V3::Zero());
+  std::vector<M3> second(n, M3::Zero());
   for (int i = 0; i < n; ++i) {
     for (const GeneratedPart& part : Link(i).parts) {
       for (const GeneratedPiece& piece : part.pieces) {
@@ -225,6 +243,7 @@ void ObjectBuilder::Finalize() {
         VolumeProps vp = ComputeVolumeProps(m);
         mass[i] += piece.density * vp.volume;
         first[i] += piece.density * vp.first;
+        second[i] += piece.density * vp.second;
       }
     }
   }
@@ -233,25 +252,76 @@ void ObjectBuilder::Finalize() {
     if (p >= 0) {
       mass[p] += mass[i];
       first[p] += first[i];
+      second[p] += second[i];
     }
   }
   for (int i = 0; i < n; ++i) {
     GeneratedLink& l = Link(i);
     if (l.joint != "hinge" && l.joint != "slider") continue;
-    // default dynamics, scaled with the size of the part
+    const bool slider = l.joint == "slider";
+    const V3& o = l.axis_origin;
+    const V3& d = l.axis_direction;
+    // effective inertia of the joint at rest: subtree mass, or moment about the axis (for a
+    // rotating slider both)
+    M3 so = second[i] - o * first[i].transpose() - first[i] * o.transpose() +
+            mass[i] * o * o.transpose();
+    double moment = std::max(d.dot((so.trace() * M3::Identity() - so) * d), 1e-12);
+    double inertia = std::max(slider ? mass[i] : moment, 1e-9);
+    double range = std::max(l.limit_b - l.limit_a, 1e-6);  // m or degrees
+    if (!slider) range *= kPi / 180.0;
+    if (l.no_limit) range = 2 * kPi;
+    // default dynamics, scaled with the part
     if (l.friction <= 0 && l.damping <= 0) {
-      double m = std::max(mass[i], 1e-3);
-      l.friction = l.joint == "slider" ? std::max(0.05, 0.3 * m) : std::max(0.002, 0.02 * m);
-      l.damping = l.joint == "slider" ? std::max(0.02, 0.5 * m) : std::max(0.0005, 0.02 * m);
+      l.friction = 0.5 * inertia;
+      l.damping = 0.5 * inertia;
+    }
+    // a part must be movable through its range by a modest effort: dry friction below an
+    // acceleration of kMaxFrictionAccel (and below what a position drive of stiffness
+    // kDriveStiffness gives a tenth of the range away from its target); damping that allows
+    // kMinSweeps ranges per second at an acceleration of kDriveAccel. Free-turning parts (wheels,
+    // knobs, rotors) keep some bearing friction and damping.
+    double friction_cap = std::min(kMaxFrictionAccel, 0.02 * kDriveStiffness * range) * inertia;
+    double damping_cap = std::min(kMaxDampingRate, kDriveAccel / (kMinSweeps * range)) * inertia;
+    l.friction = std::min(l.friction, friction_cap);
+    l.damping = std::min(l.damping, damping_cap);
+    if (l.no_limit) {
+      l.friction = kFreeTurnFriction * inertia;
+      l.damping = kFreeTurnDamping * inertia;
+    }
+    if (l.rotates) {
+      l.rotation_friction = kFreeTurnFriction * moment;
+      l.rotation_damping = kFreeTurnDamping * moment;
     }
     // generalised gravity force on the joint at rest
     V3 force = V3(0, -kGravity, 0) * mass[i];
-    V3 com = mass[i] > 0 ? V3(first[i] / mass[i]) : l.axis_origin;
-    double g = l.joint == "slider" ? l.axis_direction.dot(force)
-                                   : l.axis_direction.dot((com - l.axis_origin).cross(force));
+    V3 com = mass[i] > 0 ? V3(first[i] / mass[i]) : o;
+    double g = slider ? d.dot(force) : d.dot((com - o).cross(force));
     // a joint at a limit that gravity pushes into holds by the limit
     bool held = !l.no_limit && ((l.limit_a == 0.0 && g < 0) || (l.limit_b == 0.0 && g > 0));
-    if (std::abs(g) > 1e-9 && !held) l.friction = std::max(l.friction, 2.0 * std::abs(g));
+    bool mirror =
+        !held && !l.no_limit &&
+        std::find(rest_on_limit_.begin(), rest_on_limit_.end(), i) != rest_on_limit_.end() &&
+        ((l.limit_b == 0.0 && g < 0) || (l.limit_a == 0.0 && g > 0));
+    if (mirror) {
+      double a = l.limit_a;
+      l.limit_a = -l.limit_b + 0.0;
+      l.limit_b = -a + 0.0;
+      held = true;
+    }
+    // otherwise the part would creep: the physics engine's dry friction is a soft constraint
+    // that lets a part under load slide at about 1 % of its free acceleration per (1/s) whatever
+    // the friction; damping slows that down. Short-travel parts (keys, buttons) may carry the
+    // damping that needs; parts that would then be too sluggish must rest on a limit instead.
+    double accel = std::abs(g) / inertia;
+    if (!held && accel > kCreepAccel) {
+      double damping = kCreepDampingPerAccel * accel * inertia;
+      double cap = kDriveAccel / (kMinSweepsLoaded * range) * inertia;
+      if (damping > cap) {
+        throw Error("generator: " + out_->category + " link_" + std::to_string(i) + " ('" + l.name +
+                    "') rests under a gravity load it cannot hold");
+      }
+      l.damping = std::max(l.damping, damping);
+    }
   }
 }
 

@@ -86,6 +86,9 @@ class ObjectBuilder {
                   double hi);
   /// Base friction and damping of link's joint (raised later where gravity needs it).
   void Dynamics(int link, double friction, double damping);
+  /// Lets Finalize mirror the link's range ([lo, hi] -> [-hi, -lo]) when that puts the rest
+  /// position at the limit gravity pushes into (for parts that move either way, e.g. lamp arms).
+  void RestOnLimit(int link) { rest_on_limit_.push_back(link); }
 
   /// A new part of `link` named `name`; returns its part id.
   int Part(int link, const std::string& name);
@@ -105,6 +108,7 @@ class ObjectBuilder {
   int NewLink(int parent, const std::string& joint, const std::string& label);
   GeneratedObject* out_;
   std::vector<std::pair<int, int>> part_index_;  // part id -> (link, index in link's parts)
+  std::vector<int> rest_on_limit_;
 };
 
 // ---------------------------------------------------------------------------------------------

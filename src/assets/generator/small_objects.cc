@@ -197,11 +197,27 @@ void BuildClock(ObjectBuilder& b, Rng& rng) {
     V3 dir(std::cos(a), std::sin(a), 0);
     double len = lengths[i] * r, wdt = (0.05 - 0.015 * i) * r;
     Frame hf = FrameZ(V3(0, cy, z) + dir * (0.35 * len), V3::UnitZ(), dir);
-    b.AddPart(hand, names[i],
-              Prism({V2(-0.5 * len, -wdt / 2), V2(0.65 * len, -wdt / 4), V2(0.65 * len, wdt / 4),
-                     V2(-0.5 * len, wdt / 2)},
-                    hf, 0.0, 0.0015),
-              i == 2 ? Material{"paint_red", V3(0.8, 0.1, 0.1), 2700} : dark);
+    Material hm = i == 2 ? Material{"paint_red", V3(0.8, 0.1, 0.1), 2700} : dark;
+    int hp = b.AddPart(hand, names[i],
+                       Prism({V2(-0.5 * len, -wdt / 2), V2(0.65 * len, -wdt / 4),
+                              V2(0.65 * len, wdt / 4), V2(-0.5 * len, wdt / 2)},
+                             hf, 0.0, 0.0015),
+                       hm);
+    // a round counterweight on the tail balances the hand about its axis
+    {
+      const GeneratedPiece& blade = b.Link(hand).parts.back().pieces.back();
+      Mesh m;
+      m.v = blade.vertices;
+      m.f = blade.triangles;
+      VolumeProps vp = ComputeVolumeProps(m);
+      double moment = (vp.first - vp.volume * V3(0, cy, z)).dot(dir);  // volume x arm
+      double s_cw = 0.12 * len;
+      const int sides = 24;
+      double unit_area = 0.5 * sides * std::sin(2 * kPi / sides);  // polygon of radius 1
+      double rc = std::sqrt(moment / (s_cw * 0.0015 * unit_area));
+      b.Add(hp, Cylinder(FrameZ(V3(0, cy, z) - s_cw * dir, V3::UnitZ()), rc, 0.0, 0.0015, sides),
+            hm);
+    }
     b.Dynamics(hand, 0.001, 0.0001);
     z += 0.0015 + kGap;
   }
@@ -215,8 +231,9 @@ void BuildEyeglasses(ObjectBuilder& b, Rng& rng) {
   double lw = rng.U(0.045, 0.058), lh = rng.U(0.03, 0.045), bridge = rng.U(0.014, 0.022);
   double ft = 0.004;  // frame depth
   double cy = 0.03;
-  double leg_len = rng.U(0.12, 0.15);
   double ew = bridge / 2 + lw + 0.006;  // half width to the end pieces
+  // a folded leg (and its ear hook) stops short of the other hinge
+  double leg_len = 2 * ew - 0.045;
   for (int s : {-1, 1}) {
     V3 c(s * (bridge / 2 + lw / 2), cy, 0);
     Frame f = FrameZ(c, V3::UnitZ(), V3::UnitX());
@@ -240,7 +257,7 @@ void BuildEyeglasses(ObjectBuilder& b, Rng& rng) {
     double xi = s * (ew - 0.001);  // inner face of the leg
     double zf = -ft / 2 - 0.008 - kGap;
     int leg = b.Hinge(body, "leg", V3(xi, cy + 0.3 * lh, zf), s > 0 ? V3(0, 1, 0) : V3(0, -1, 0), 0,
-                      rng.U(85, 95));
+                      rng.U(80, 88));
     int p = b.Part(leg, "leg");
     // the leg extends outwards from its inner face, where the axis lies
     double lo_x = s > 0 ? xi : xi - 0.0035, hi_x = s > 0 ? xi + 0.0035 : xi;
@@ -250,7 +267,7 @@ void BuildEyeglasses(ObjectBuilder& b, Rng& rng) {
         frame);
     b.Add(p,
           Bar(V3(0.5 * (lo_x + hi_x), cy + 0.3 * lh, zf - leg_len),
-              V3(0.5 * (lo_x + hi_x), cy + 0.3 * lh - 0.03, zf - leg_len - 0.025), 0.006, 0.0035,
+              V3(0.5 * (lo_x + hi_x), cy + 0.3 * lh - 0.03, zf - leg_len - 0.02), 0.006, 0.0035,
               V3::UnitY()),
           frame);
     b.Dynamics(leg, 0.005, 0.001);
@@ -264,8 +281,10 @@ void BuildGlobe(ObjectBuilder& b, Rng& rng) {
   int body = b.Fixed(-1, "heavy", "frame");
   int bp = b.Part(body, "frame");
   double R = rng.U(0.1, 0.2);
-  double base_h = rng.U(0.04, 0.2);
-  double cy = base_h + R + 0.03;
+  double post = rng.U(0.04, 0.2);  // height of the post above the base
+  const int n = 14;
+  double rm = (R + 0.006) / std::cos(kPi / (2 * n)) + 0.004;  // meridian radius (bar centres)
+  double cy = 0.03 + post + rm + 0.006;
   V3 c(0, cy, 0);
   b.Add(bp,
         Loft(Circle(1.0, 40), {Ring{0.0, 0.7 * R}, Ring{0.015, 0.7 * R}, Ring{0.03, 0.5 * R}},
@@ -274,37 +293,28 @@ void BuildGlobe(ObjectBuilder& b, Rng& rng) {
   double tilt = 23.5 * kPi / 180;
   V3 axis(std::sin(tilt), std::cos(tilt), 0);
   V3 side(std::cos(tilt), -std::sin(tilt), 0);  // perpendicular to the axis in the x-y plane
-  // meridian: a half ring on the -side of the sphere, in the plane of the axis
+  // the meridian (a half ring in the plane of the axis) passes under the sphere at angle
+  // pi - tilt, where the post holds it; it swivels on the post for some globes
   bool swivel = rng.P(0.13);
   int mer_link = body;
+  double split = 0.03 + 0.5 * post;
   if (swivel) {
-    mer_link = b.Continuous(body, "frame", V3(0, base_h + 0.03 + kGap, 0), V3::UnitY());
+    mer_link = b.Continuous(body, "frame", V3(0, split + kGap, 0), V3::UnitY());
     b.Dynamics(mer_link, 0.05, 0.02);
+    b.Add(bp, Cylinder(FrameZ(V3(0, 0.029, 0), V3::UnitY()), 0.012, 0.0, split - 0.029, 16), frame);
   }
   int mp = b.Part(mer_link, "meridian");
-  const int n = 14;
-  double rm = (R + 0.006) / std::cos(kPi / (2 * n)) + 0.004;
   for (int i = 0; i < n; ++i) {
     double a0 = kPi * i / n, a1 = kPi * (i + 1) / n;
-    V3 p0 = c + rm * (std::cos(a0) * axis - std::sin(a0) * side);
-    V3 p1 = c + rm * (std::cos(a1) * axis - std::sin(a1) * side);
+    V3 p0 = c + rm * (std::cos(a0) * axis + std::sin(a0) * side);
+    V3 p1 = c + rm * (std::cos(a1) * axis + std::sin(a1) * side);
     b.Add(mp, Bar(p0, p1, 0.008, 0.012, V3(0, 0, 1)), frame);
   }
   // pins from the meridian towards the poles, stopping short of the sphere
   for (int s : {-1, 1})
     b.Add(mp, Rod(c + s * axis * (R + kGap + 0.001), c + s * axis * (rm + 0.004), 0.004), frame);
-  // stand: from the base to the meridian's lowest point
-  V3 low = c - side * rm * std::sin(kPi / 2) * 0.0 - V3(0, 0, 0);
-  (void)low;
-  V3 bottom = c + rm * (std::cos(kPi * 0.62) * axis - std::sin(kPi * 0.62) * side);
-  double stand_y0 = base_h + 0.03 + (swivel ? kGap : 0.0);
-  b.Add(mp, Rod(V3(bottom.x(), stand_y0, 0), bottom, 0.01), frame);
-  b.Add(mp, Cylinder(FrameZ(V3(0, stand_y0, 0), V3::UnitY()), 0.025, 0.0, 0.01, 24), frame);
-  b.Add(mp, Rod(V3(0, stand_y0 + 0.005, 0), V3(bottom.x(), stand_y0 + 0.005, 0), 0.008), frame);
-  if (!swivel)
-    b.Add(bp, Cylinder(FrameZ(V3(0, 0.029, 0), V3::UnitY()), 0.02, 0.0, base_h + 0.002, 16), frame);
-  if (swivel)
-    b.Add(bp, Cylinder(FrameZ(V3(0, 0.029, 0), V3::UnitY()), 0.02, 0.0, base_h + 0.001, 16), frame);
+  double y0 = swivel ? split + kGap : 0.029;
+  b.Add(mp, Cylinder(FrameZ(V3(0, y0, 0), V3::UnitY()), 0.012, 0.0, cy - rm - y0, 16), frame);
   // the sphere turns about the tilted axis
   int sphere = b.Continuous(mer_link, "sphere", c, axis);
   b.AddPart(sphere, "sphere", Ellipsoid(FrameZ(c, axis), V3::Constant(R), 16, 32), earth);
@@ -399,7 +409,7 @@ void BuildLaptop(ObjectBuilder& b, Rng& rng) {
             skin);
   // screen lid closed on the base, hinged at the back
   V3 lo(-w / 2, hb + kGap, -d / 2), hi(w / 2, hb + kGap + ts, d / 2);
-  int screen = PanelHinge(b, body, "screen", lo, hi, V3::UnitY(), V3::UnitZ(), rng.U(120, 170));
+  int screen = PanelHinge(b, body, "screen", lo, hi, V3::UnitY(), V3::UnitZ(), rng.U(110, 150));
   int sp = b.Part(screen, "screen");
   b.Add(sp,
         RoundedSlab(FrameZ(V3(0, hi.y(), 0), -V3::UnitY(), V3::UnitX()), w, d, ts, 0.008, 0.001),
@@ -427,18 +437,19 @@ void BuildLighter(ObjectBuilder& b, Rng& rng) {
   for (int s : {-1, 1}) {
     double x = s * (ww / 2 + kGap + 0.001);
     b.Add(bp,
-          BoxLoHi(V3(s > 0 ? x : x - 0.002, h - 0.001, -0.0045),
-                  V3(s > 0 ? x + 0.002 : x, h + 0.012, 0.0045)),
+          BoxLoHi(V3(s > 0 ? x : x - 0.002, h - 0.001, -0.002 - wr - 0.001),
+                  V3(s > 0 ? x + 0.002 : x, h + 0.012, -0.002 + wr - 0.001)),
           metal);
   }
   int wheel = Wheel(b, body, V3(0, wy, -0.002), V3::UnitX(), wr, ww, metal, metal, "wheel");
   b.Dynamics(wheel, 0.002, 0.0002);
   // fork button in front of the wheel, pressed down about its back edge
   double bz0 = -0.002 + wr + kGap;
-  V3 pivot(0, h + kGap, bz0);
-  int button = b.Hinge(body, "button", pivot, -V3::UnitX(), 0, 8);
+  V3 pivot(0, h + kGap + 0.003, bz0 + 0.006);  // pivots at its middle, balanced
+  int button = b.Hinge(body, "button", pivot, V3::UnitX(), 0, 6);
   b.AddPart(button, "button",
-            BoxLoHi(V3(-0.006, h + kGap, bz0), V3(0.006, h + kGap + 0.006, d / 2)), Plastic(rng));
+            BoxLoHi(V3(-0.006, h + kGap, bz0), V3(0.006, h + kGap + 0.006, bz0 + 0.012)),
+            Plastic(rng));
   b.Dynamics(button, 0.05, 0.002);
 }
 
@@ -452,9 +463,9 @@ void BuildMouse(ObjectBuilder& b, Rng& rng) {
   b.Add(bp, Loft(Ellipse(w / 2, l / 2, 40), {Ring{0.0, 0.92}, Ring{0.004, 1.0}, Ring{h1, 1.0}}, fy),
         skin);
   // rear hump
-  Frame fh = FrameZ(V3(0, h1, -0.05 * l), V3::UnitY(), V3::UnitX());
+  Frame fh = FrameZ(V3(0, h1, -0.22 * l), V3::UnitY(), V3::UnitX());
   b.Add(bp,
-        Loft(Ellipse(w / 2 - 0.001, 0.45 * l, 40),
+        Loft(Ellipse(w / 2 - 0.001, 0.25 * l, 40),
              {Ring{0.0, 1.0}, Ring{0.4 * (h2 - h1), 0.9}, Ring{0.8 * (h2 - h1), 0.6},
               Ring{h2 - h1, 0.25}},
              fh),
@@ -535,28 +546,28 @@ void BuildPhone(ObjectBuilder& b, Rng& rng) {
   b.Add(bp, RoundedSlab(FrameZ(V3::Zero(), V3::UnitY(), V3::UnitX()), w, l, t, 0.008, 0.0015),
         skin);
   // the phone lies on its back, keys up (y), its top end towards -z
-  double za0 = flip ? -l / 2 + 0.012 : 0.0, za1 = l / 2 - 0.01;
+  double za0 = flip ? -l / 2 + 0.012 : -0.1 * l, za1 = l / 2 - 0.01;
   if (!flip) {
     b.AddPart(body, "screen",
-              BoxLoHi(V3(-0.4 * w, t - 0.0005, -0.45 * l), V3(0.4 * w, t + 0.0003, -0.04 * l)),
+              BoxLoHi(V3(-0.4 * w, t - 0.0005, -0.45 * l), V3(0.4 * w, t + 0.0003, -0.13 * l)),
               Material{"screen", V3(0.04, 0.05, 0.06), 2500});
   }
   double travel = 0.0012, hb = 0.0025;
   // call / end / select row
-  double zr = za0 + 0.007;
+  double zr = za0 + 0.0045;
   Button(b, body, V3(-0.33 * w, t, zr), V3::UnitY(), V3::UnitX(), RoundRect(0.011, 0.007, 0.002, 2),
          hb, travel, keys);
   Button(b, body, V3(0.33 * w, t, zr), V3::UnitY(), V3::UnitX(), RoundRect(0.011, 0.007, 0.002, 2),
          hb, travel, keys);
   Button(b, body, V3(0, t, zr), V3::UnitY(), V3::UnitX(), Circle(0.0055, 20), hb, travel, keys);
   if (rng.P(0.5)) {
-    Button(b, body, V3(-0.33 * w, t, zr + 0.011), V3::UnitY(), V3::UnitX(),
+    Button(b, body, V3(-0.33 * w, t, zr + 0.0095), V3::UnitY(), V3::UnitX(),
            RoundRect(0.011, 0.006, 0.002, 2), hb, travel, keys);
-    Button(b, body, V3(0.33 * w, t, zr + 0.011), V3::UnitY(), V3::UnitX(),
+    Button(b, body, V3(0.33 * w, t, zr + 0.0095), V3::UnitY(), V3::UnitX(),
            RoundRect(0.011, 0.006, 0.002, 2), hb, travel, keys);
   }
   // keypad 3 x 4 below
-  double g0 = zr + 0.02, kz = std::min(0.012, (za1 - g0) / 4.0);
+  double g0 = zr + 0.016, kz = std::min(0.012, (za1 - g0) / 4.0);
   ButtonGrid(b, body, V3(0, t, g0 + 2 * kz - 0.5 * kz + 0.5 * kz), 4, 3, 0.26 * w, kz, 0.8, 0.72,
              hb, travel, keys);
   // side buttons (volume)
@@ -658,8 +669,9 @@ void BuildSwitch(ObjectBuilder& b, Rng& rng) {
     } else if (kind == 1) {
       // toggle bat on a round boss
       b.Add(bp, Cylinder(FrameZ(c, V3::UnitZ()), 0.008, 0.0, 0.004, 20), Steel(rng));
-      V3 pivot(x, h / 2, t + 0.004 + kGap);
+      V3 pivot(x, h / 2, t + 0.004 + kGap + 0.003);
       int lever = b.Hinge(body, "lever", pivot, V3::UnitX(), 0, 40);
+      b.RestOnLimit(lever);
       Frame f = FrameZ(pivot, V3(0, -std::sin(0.35), std::cos(0.35)), V3::UnitX());
       b.AddPart(lever, "lever", Frustum(f, 0.003, 0.0022, 0.0, 0.02, 12), Steel(rng));
       b.Dynamics(lever, 0.05, 0.001);

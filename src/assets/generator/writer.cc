@@ -154,8 +154,8 @@ std::string LimitXml(const GeneratedLink& l, bool rotation) {
   return "    <limit lower=\"" + F6(l.limit_a) + "\" upper=\"" + F6(l.limit_b) + "\"/>\n";
 }
 
-std::string DynamicsXml(const GeneratedLink& l) {
-  return "    <dynamics damping=\"" + G9(l.damping) + "\" friction=\"" + G9(l.friction) + "\"/>\n";
+std::string DynamicsXml(double damping, double friction) {
+  return "    <dynamics damping=\"" + G9(damping) + "\" friction=\"" + G9(friction) + "\"/>\n";
 }
 
 std::string UrdfText(const GeneratedObject& o, const std::vector<std::vector<int>>& files) {
@@ -199,7 +199,7 @@ std::string UrdfText(const GeneratedObject& o, const std::vector<std::vector<int
     if (l.joint == "hinge" || l.joint == "slider") {
       s += axis;
       if (!l.no_limit) s += LimitXml(l, false);
-      s += DynamicsXml(l);
+      s += DynamicsXml(l.damping, l.friction);
     }
     s += "  </joint>\n";
     if (l.rotates) {
@@ -209,7 +209,7 @@ std::string UrdfText(const GeneratedObject& o, const std::vector<std::vector<int
       s += "    <parent link=\"" + name + "_helper\"/>\n    <child link=\"" + name + "\"/>\n";
       s += axis;
       if (!l.no_rotation_limit) s += LimitXml(l, true);
-      s += DynamicsXml(l);
+      s += DynamicsXml(l.rotation_damping, l.rotation_friction);
       s += "  </joint>\n";
     }
   }
