@@ -21,6 +21,7 @@ namespace {
 constexpr double kOmega = 15.0;            // rad/s
 constexpr double kMaxAcceleration = 30.0;  // m/s^2 or rad/s^2
 constexpr int kControlSteps = 10;          // steps between gravity-compensation updates
+constexpr double kCrossingTime = 0.25;     // s
 
 QualityCheck Check(const std::string& name, bool passed, const std::string& detail) {
   return {name, passed, detail};
@@ -57,11 +58,17 @@ QualityCheck RangeCheck(Scene& scene, Articulation& art, const QualityOptions& o
   std::vector<char> state = scene.Pack();
   int chunks = std::max(
       1, static_cast<int>(std::lround(o.range_seconds / scene.GetTimestep())) / kControlSteps);
-  // gains from each dof's own inertia at rest
+  // gains from each dof's own inertia at rest, and its own damping and friction: the drive's
+  // time constant stays near 1 / kOmega, and its force cap covers the acceleration cap, the
+  // damping at the speed that crosses the range in kCrossingTime, and the dry friction
   Eigen::VectorXd inertia = art.ComputeManipulatorInertiaMatrix().diagonal();
-  for (size_t j = 0; j < joints.size(); ++j)
-    joints[j].SetDriveProperty(inertia[j] * kOmega * kOmega, 2 * inertia[j] * kOmega,
-                               inertia[j] * kMaxAcceleration);
+  for (size_t j = 0; j < joints.size(); ++j) {
+    double span = std::min(limits(j, 1) - limits(j, 0), 2 * M_PI);
+    double damping = joints[j].GetDamping();
+    joints[j].SetDriveProperty(
+        inertia[j] * kOmega * kOmega + damping * kOmega, 2 * inertia[j] * kOmega,
+        inertia[j] * kMaxAcceleration + damping * span / kCrossingTime + joints[j].GetFriction());
+  }
   std::vector<std::string> jammed;
   for (size_t k = 0; k < joints.size(); ++k) {
     scene.Unpack(state);
@@ -94,7 +101,7 @@ QualityCheck RangeCheck(Scene& scene, Articulation& art, const QualityOptions& o
   return Check("range", false, detail);
 }
 
-// Six views around the object, from slightly above: each movable link's render id must show.
+// Ten views around the object: each movable link's render id must show.
 QualityCheck VisibilityCheck(Scene& scene, Articulation& art, const QualityOptions& o) {
   // the object's extent from its links' rest positions and shapes' offsets
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
@@ -117,13 +124,21 @@ QualityCheck VisibilityCheck(Scene& scene, Articulation& art, const QualityOptio
   scene.SetRenderBackend(o.render_backend);
   scene.AddDirectionalLight(Eigen::Vector3d(-0.3, 0.4, -1), Eigen::Vector3f(1, 1, 1));
   std::vector<Camera> cams;
-  const double pitch = 0.45;
-  for (int i = 0; i < 6; ++i) {
-    // five around (front first: the object's front faces world -y) and one from above
-    double yaw = -M_PI / 2 + i * 2 * M_PI / 5;
-    Eigen::Vector3d dir = i < 5 ? Eigen::Vector3d(std::cos(yaw) * std::cos(pitch),
-                                                  std::sin(yaw) * std::cos(pitch), std::sin(pitch))
-                                : Eigen::Vector3d(0.01, -0.3, 1.0).normalized();
+  // five views around from above (front first: the object's front faces world -y), four
+  // around from below (wheels, undersides), one from the top
+  std::vector<Eigen::Vector3d> dirs;
+  auto around = [&](int n, double pitch, double yaw0) {
+    for (int i = 0; i < n; ++i) {
+      double yaw = yaw0 + i * 2 * M_PI / n;
+      dirs.emplace_back(std::cos(yaw) * std::cos(pitch), std::sin(yaw) * std::cos(pitch),
+                        std::sin(pitch));
+    }
+  };
+  around(5, 0.45, -M_PI / 2);
+  around(4, -0.5, -M_PI / 4);
+  dirs.push_back(Eigen::Vector3d(0.01, -0.3, 1.0).normalized());
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    const Eigen::Vector3d& dir = dirs[i];
     Eigen::Vector3d eye = centre + distance * dir;
     // camera x forward (towards the centre), z up
     Eigen::Vector3d fwd = (centre - eye).normalized();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "assets/partnet_test_folder.h"
+#include "partsim/assets/generator.h"
 
 namespace partsim {
 namespace {
@@ -10,6 +11,7 @@ namespace {
 using testing::BoxObj;
 using testing::Folder;
 using testing::Write;
+namespace fs = std::filesystem;
 
 const QualityCheck* Find(const ObjectQualityReport& r, const std::string& name) {
   for (const QualityCheck& c : r.checks)
@@ -72,6 +74,25 @@ TEST(QualityTest, AnInconsistentFolderFailsToLoadWithTheReason) {
   ASSERT_FALSE(r.checks.empty());
   EXPECT_EQ(r.checks[0].name, "load");
   EXPECT_NE(r.checks[0].detail.find("semantics.txt"), std::string::npos);
+}
+
+TEST(QualityTest, AGeneratedObjectOfEveryCategoryPassesEveryCheck) {
+  fs::path root = fs::temp_directory_path() / "partsim_quality_generated";
+  fs::remove_all(root);
+  DatasetStatistics stats;
+  std::vector<std::string> failures;
+  for (const std::string& category : GeneratorCategories()) {
+    fs::path dir = root / category;
+    WriteObject(GenerateObject(category, 0, 2026), dir.string());
+    ObjectQualityReport r = CheckPartNetObject(dir.string());
+    EXPECT_EQ(r.category, category);
+    if (!r.Passed()) failures.push_back(r.ToString());
+    stats.Add(r.category, r.movable_parts);
+  }
+  EXPECT_TRUE(failures.empty()) << failures.size() << " failed, e.g.\n" << failures[0];
+  EXPECT_EQ(stats.per_category.size(), 46u);
+  EXPECT_GT(stats.parts, 46);
+  fs::remove_all(root);
 }
 
 TEST(QualityTest, StatisticsTableMatchesThePapersTotals) {

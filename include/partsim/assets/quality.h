@@ -41,7 +41,8 @@ struct ObjectQualityReport {
 /// and semantics.txt agree on labels and joint types); undriven with a fixed base, nothing moves
 /// more than rest_tolerance or blows up; each movable part, driven alone, reaches both ends of
 /// its range (continuous hinges: +-pi) without jamming; each movable part shows in the
-/// segmentation of at least one of six views around the object. Never throws for a bad object:
+/// segmentation of at least one of ten views around the object (five from above, four
+/// from below, one from the top). Never throws for a bad object:
 /// the failure is in the report.
 ObjectQualityReport CheckPartNetObject(const std::string& folder,
                                        const QualityOptions& options = QualityOptions());
