@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "partsim/assets/generator.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/physics/scene.h"
 #include "partsim/render/camera.h"
@@ -261,56 +262,13 @@ std::string DatasetStatistics::ToTable(bool with_paper) const {
 }
 
 const std::map<std::string, std::pair<int, int>>& PaperStatistics() {
-  // Table 1 of the SAPIEN paper (its "Cabinet" is StorageFurniture, "Monitor" Display,
-  // the second "Chair" FoldingChair)
-  static const std::map<std::string, std::pair<int, int>> table = {
-      {"Bottle", {57, 114}},
-      {"Box", {28, 94}},
-      {"Bucket", {36, 74}},
-      {"StorageFurniture", {345, 1174}},
-      {"Camera", {37, 341}},
-      {"Cart", {61, 232}},
-      {"Chair", {80, 1235}},
-      {"Clock", {31, 106}},
-      {"CoffeeMachine", {55, 374}},
-      {"Dishwasher", {48, 112}},
-      {"Dispenser", {57, 162}},
-      {"Door", {36, 103}},
-      {"Eyeglasses", {65, 195}},
-      {"Fan", {81, 172}},
-      {"Faucet", {84, 228}},
-      {"FoldingChair", {26, 58}},
-      {"Refrigerator", {44, 118}},
-      {"Globe", {61, 130}},
-      {"Kettle", {29, 66}},
-      {"Keyboard", {37, 3593}},
-      {"Knife", {44, 149}},
-      {"Lamp", {45, 165}},
-      {"Laptop", {56, 112}},
-      {"Lighter", {28, 86}},
-      {"Microwave", {16, 85}},
-      {"Display", {37, 93}},
-      {"Mouse", {14, 61}},
-      {"Oven", {30, 214}},
-      {"Pen", {48, 97}},
-      {"Phone", {17, 271}},
-      {"Pliers", {25, 59}},
-      {"KitchenPot", {25, 53}},
-      {"Printer", {29, 376}},
-      {"Remote", {49, 1490}},
-      {"Safe", {30, 202}},
-      {"Scissors", {47, 94}},
-      {"Stapler", {23, 69}},
-      {"Suitcase", {24, 101}},
-      {"Switch", {70, 195}},
-      {"Table", {101, 420}},
-      {"Toaster", {25, 116}},
-      {"Toilet", {69, 229}},
-      {"TrashCan", {70, 208}},
-      {"USB", {51, 103}},
-      {"WashingMachine", {17, 144}},
-      {"Window", {58, 195}},
-  };
+  // the generator's category table holds Table 1 of the SAPIEN paper
+  static const std::map<std::string, std::pair<int, int>> table = [] {
+    std::map<std::string, std::pair<int, int>> t;
+    for (const std::string& c : GeneratorCategories())
+      t[c] = {PaperModelCount(c), PaperPartCount(c)};
+    return t;
+  }();
   return table;
 }
 
