@@ -2,7 +2,6 @@
 // soft shadows and colour bleeding, built on hand-made render worlds; then through a scene and
 // its camera, and against the rasterizer.
 #include <gtest/gtest.h>
-#include <jpeglib.h>
 #include <png.h>
 
 #include <Eigen/Geometry>
@@ -19,6 +18,7 @@
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "render/jpeg_test_util.h"
 #include "render/render_test_util.h"
 
 namespace partsim {
@@ -493,31 +493,7 @@ TEST(PathTracerTest, DiffuseTexturesInAlbedoAndMissingFileNamed) {
 
   // a JPEG of one sRGB colour (200, 100, 50)
   path = ::testing::TempDir() + "/pt_texture_test.jpg";
-  {
-    jpeg_compress_struct cinfo;
-    jpeg_error_mgr err;
-    cinfo.err = jpeg_std_error(&err);
-    jpeg_create_compress(&cinfo);
-    FILE* f = std::fopen(path.c_str(), "wb");
-    ASSERT_NE(f, nullptr);
-    jpeg_stdio_dest(&cinfo, f);
-    cinfo.image_width = 16;
-    cinfo.image_height = 16;
-    cinfo.input_components = 3;
-    cinfo.in_color_space = JCS_RGB;
-    jpeg_set_defaults(&cinfo);
-    jpeg_set_quality(&cinfo, 100, TRUE);
-    jpeg_start_compress(&cinfo, TRUE);
-    std::vector<uint8_t> row;
-    for (int x = 0; x < 16; ++x) row.insert(row.end(), {200, 100, 50});
-    while (cinfo.next_scanline < 16) {
-      JSAMPROW r = row.data();
-      jpeg_write_scanlines(&cinfo, &r, 1);
-    }
-    jpeg_finish_compress(&cinfo);
-    jpeg_destroy_compress(&cinfo);
-    std::fclose(f);
-  }
+  ASSERT_TRUE(testing::WriteSolidJpeg(path, 16, 16, 200, 100, 50));
   world.instances[0].material.diffuse_texture = path;
   pic = Render(world, cam, 1, 1);
   auto linear = [](double c) { return std::pow((c / 255 + 0.055) / 1.055, 2.4); };

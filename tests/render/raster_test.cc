@@ -2,7 +2,6 @@
 // the true surface, normals, ids, shadows, spot cones, textures, custom shaders, errors). They run
 // on whatever EGL device there is, Mesa's llvmpipe included.
 #include <gtest/gtest.h>
-#include <jpeglib.h>
 #include <png.h>
 
 #include <Eigen/Geometry>
@@ -17,6 +16,7 @@
 #include "partsim/core/error.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera_math.h"
+#include "render/jpeg_test_util.h"
 
 namespace partsim {
 namespace {
@@ -580,31 +580,7 @@ TEST(RasterTest, TexturedQuadShowsTheTextureColours) {
 TEST(RasterTest, JpegTextureIsDecoded) {
   // 16 x 16 of one sRGB colour (200, 100, 50)
   std::string path = ::testing::TempDir() + "/partsim_raster_texture.jpg";
-  {
-    jpeg_compress_struct cinfo;
-    jpeg_error_mgr err;
-    cinfo.err = jpeg_std_error(&err);
-    jpeg_create_compress(&cinfo);
-    FILE* f = std::fopen(path.c_str(), "wb");
-    ASSERT_NE(f, nullptr);
-    jpeg_stdio_dest(&cinfo, f);
-    cinfo.image_width = 16;
-    cinfo.image_height = 16;
-    cinfo.input_components = 3;
-    cinfo.in_color_space = JCS_RGB;
-    jpeg_set_defaults(&cinfo);
-    jpeg_set_quality(&cinfo, 100, TRUE);
-    jpeg_start_compress(&cinfo, TRUE);
-    std::vector<uint8_t> row;
-    for (int x = 0; x < 16; ++x) row.insert(row.end(), {200, 100, 50});
-    while (cinfo.next_scanline < 16) {
-      JSAMPROW r = row.data();
-      jpeg_write_scanlines(&cinfo, &r, 1);
-    }
-    jpeg_finish_compress(&cinfo);
-    jpeg_destroy_compress(&cinfo);
-    std::fclose(f);
-  }
+  ASSERT_TRUE(testing::WriteSolidJpeg(path, 16, 16, 200, 100, 50));
   RenderWorld world;
   world.instances.push_back(Instance(Quad(0.2f), {1, 0, 0}, {1, 1, 1, 1}, 1, 1, FacingCamera()));
   world.instances[0].material.diffuse_texture = path;
