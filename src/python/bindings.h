@@ -19,6 +19,12 @@ void BindAssets(py::module_& m);
 /// Cameras, lights, backends and image / point cloud writers (render); after BindPhysics, whose
 /// Scene class it extends.
 void BindRender(py::module_& m);
+/// Robot models and URDF writing (robot_py.cc).
+void BindRobots(py::module_& m);
+/// Kinematics, IK, trajectories, controllers and the IMU (control_py.cc).
+void BindControl(py::module_& m);
+/// Door-opening and drawer-pulling tasks and their heuristic solvers (tasks_py.cc).
+void BindTasks(py::module_& m);
 
 /// Casts handles to a Python list whose items each keep `owner` alive (py::keep_alive cannot
 /// attach to a list, which holds no weak references).

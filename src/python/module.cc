@@ -10,4 +10,7 @@ PYBIND11_MODULE(_partsim, m) {
   partsim::python::BindPhysics(m);
   partsim::python::BindAssets(m);
   partsim::python::BindRender(m);
+  partsim::python::BindRobots(m);
+  partsim::python::BindControl(m);
+  partsim::python::BindTasks(m);
 }

@@ -1,0 +1,36 @@
+// Joint trajectories: timed waypoints followed with interpolation, and time parameterisation of a
+// path under velocity and acceleration limits.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace partsim {
+
+/// A trajectory_msgs/JointTrajectory: waypoints with times from its start. Velocities and
+/// accelerations may be empty (then they are derived: cubic spline through the positions).
+struct JointTrajectory {
+  std::vector<double> times;                   ///< s, strictly increasing, times[0] >= 0
+  std::vector<Eigen::VectorXd> positions;      ///< one per time
+  std::vector<Eigen::VectorXd> velocities;     ///< empty or one per time
+  std::vector<Eigen::VectorXd> accelerations;  ///< empty or one per time
+
+  /// Throws partsim::Error naming the waypoint at fault (sizes, times, NaN).
+  void Validate(int dof) const;
+  double Duration() const;
+  /// Interpolated position, velocity and acceleration at time t (clamped to [0, Duration()]):
+  /// quintic between waypoints with positions, velocities and accelerations; cubic when only
+  /// velocities are given; a C2 cubic spline when only positions are given.
+  void Sample(double t, Eigen::VectorXd* q, Eigen::VectorXd* qd = nullptr,
+              Eigen::VectorXd* qdd = nullptr) const;
+};
+
+/// Times a path of joint positions (no times) so that it starts and ends at rest and no joint
+/// exceeds its velocity or acceleration limit anywhere along the interpolated trajectory
+/// (checked by sampling). Throws partsim::Error on fewer than one waypoint, sizes that differ,
+/// or limits that are not positive.
+JointTrajectory TimeParameterize(const std::vector<Eigen::VectorXd>& path,
+                                 const Eigen::VectorXd& velocity_limits,
+                                 const Eigen::VectorXd& acceleration_limits);
+
+}  // namespace partsim
