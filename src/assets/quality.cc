@@ -12,6 +12,7 @@
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/physics/scene.h"
 #include "partsim/render/camera.h"
+#include "partsim/render/camera_math.h"
 
 namespace partsim {
 namespace {
@@ -141,15 +142,9 @@ QualityCheck VisibilityCheck(Scene& scene, Articulation& art, const QualityOptio
   for (size_t i = 0; i < dirs.size(); ++i) {
     const Eigen::Vector3d& dir = dirs[i];
     Eigen::Vector3d eye = centre + distance * dir;
-    // camera x forward (towards the centre), z up
-    Eigen::Vector3d fwd = (centre - eye).normalized();
-    Eigen::Vector3d left = Eigen::Vector3d::UnitZ().cross(fwd).normalized();
-    Eigen::Vector3d up = fwd.cross(left);
-    Eigen::Matrix3d R;
-    R << fwd, left, up;
     Camera cam = scene.AddCamera("quality_" + std::to_string(i), o.image_size, o.image_size, fovy,
                                  0.01, 10 * distance + 1);
-    cam.SetLocalPose(Pose(eye, Eigen::Quaterniond(R)));
+    cam.SetLocalPose(CameraLookAt(eye, centre));
     cams.push_back(cam);
   }
   scene.UpdateRender();

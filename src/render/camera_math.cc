@@ -64,4 +64,14 @@ CameraParams MakeCameraParams(int width, int height, const Eigen::Matrix3d& K, d
   return c;
 }
 
+Pose CameraLookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+  Eigen::Vector3d x = (target - eye).normalized();
+  Eigen::Vector3d y = Eigen::Vector3d::UnitZ().cross(x);
+  if (y.norm() < 1e-9) y = Eigen::Vector3d::UnitY();
+  y.normalize();
+  Eigen::Matrix3d R;
+  R << x, y, x.cross(y);
+  return Pose(eye, Eigen::Quaterniond(R));
+}
+
 }  // namespace partsim

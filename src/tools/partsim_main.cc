@@ -30,6 +30,7 @@
 #include "partsim/physics/scene.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
+#include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
 
 namespace {
@@ -511,18 +512,6 @@ int RunSimulate(const Args& args) {
 // ---------------------------------------------------------------------------------------------
 // render
 
-/// Camera pose (x forward, y left, z up) at `eye` looking at `target`.
-partsim::Pose LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  Eigen::Vector3d x = (target - eye).normalized();
-  Eigen::Vector3d y = Eigen::Vector3d::UnitZ().cross(x);
-  // looking straight down: any horizontal left axis will do
-  if (y.norm() < 1e-9) y = Eigen::Vector3d::UnitY();
-  y.normalize();
-  Eigen::Matrix3d R;
-  R << x, y, x.cross(y);
-  return partsim::Pose(eye, Eigen::Quaterniond(R));
-}
-
 /// World bounding box of the visuals of entities in `ids` (from the render world); false when
 /// they have none.
 bool VisualBounds(const partsim::RenderWorld& world, const std::vector<uint32_t>& ids,
@@ -609,7 +598,7 @@ int RunRender(const Args& args) {
     double azimuth = pi / 6 + 2 * pi * k / args.views, elevation = 25 * pi / 180;
     Eigen::Vector3d dir(std::cos(azimuth) * std::cos(elevation),
                         std::sin(azimuth) * std::cos(elevation), std::sin(elevation));
-    cam.SetLocalPose(LookAt(centre + distance * dir, centre));
+    cam.SetLocalPose(partsim::CameraLookAt(centre + distance * dir, centre));
     cameras.push_back(cam);
   }
   scene.UpdateRender();

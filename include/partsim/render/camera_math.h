@@ -18,6 +18,10 @@ Eigen::Matrix3d RotationCameraToGl();
 /// R_CO: the OpenCV camera frame's axes in partsim's camera frame.
 Eigen::Matrix3d RotationCameraToCv();
 
+/// Camera pose X_WC (x forward, y left, z up) at `eye` looking at `target`, with z as close to
+/// the world's up as possible (looking straight up or down: y is the world's y).
+Pose CameraLookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target);
+
 /// K for a vertical field of view (rad) with square pixels and a centred principal point
 /// (cx = (width - 1) / 2, cy = (height - 1) / 2).
 Eigen::Matrix3d IntrinsicsFromFovy(int width, int height, double fovy);
