@@ -20,7 +20,8 @@ struct JointTrajectory {
   double Duration() const;
   /// Interpolated position, velocity and acceleration at time t (clamped to [0, Duration()]):
   /// quintic between waypoints with positions, velocities and accelerations; cubic when only
-  /// velocities are given; a C2 cubic spline when only positions are given.
+  /// velocities are given; a C2 cubic spline, at rest at both ends, when only positions are
+  /// given. Before times[0] it holds positions[0].
   void Sample(double t, Eigen::VectorXd* q, Eigen::VectorXd* qd = nullptr,
               Eigen::VectorXd* qdd = nullptr) const;
 };
