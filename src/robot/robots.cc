@@ -252,14 +252,15 @@ RobotModel BuildPanda(const std::string& name) {
   const double armature[7] = {0.1, 0.1, 0.1, 0.1, 0.05, 0.05, 0.05};
 
   // capsules in each link frame (z = the link's joint axis), sized so that links that are not
-  // neighbours stay apart at home; the first capsule carries the link's mass
+  // neighbours stay apart at home (nor do link0, welded to the world, and link1 touch: MuJoCo
+  // filters no contacts with the world's bodies); the first capsule carries the link's mass
   struct Segment {
     Vector3d from, to;
     double radius;
   };
   const std::vector<std::vector<Segment>> shapes = {
-      {{{0, 0, 0.05}, {0, 0, 0.2}, 0.06}},                                          // link0 (base)
-      {{{0, 0, -0.19}, {0, 0, -0.06}, 0.06}},                                       // link1
+      {{{0, 0, 0.05}, {0, 0, 0.12}, 0.06}},                                         // link0 (base)
+      {{{0, 0, -0.09}, {0, 0, -0.05}, 0.06}},                                       // link1
       {{{0, 0, -0.06}, {0, 0, 0.06}, 0.06}, {{0, -0.07, 0}, {0, -0.13, 0}, 0.05}},  // link2
       {{{0, 0, -0.17}, {0, 0, -0.04}, 0.05}},                                       // link3
       {{{0, 0, -0.04}, {0, 0, 0.04}, 0.055}, {{0, 0, 0}, {-0.0825, 0.17, 0}, 0.05}},  // link4

@@ -212,5 +212,134 @@ TEST(RobotsFlyingGripperTest, GraspsAndLiftsABox) {
   RecordProperty("box_lift_m", testing::PrintToString(cube.GetPose().p.z() - 0.03));
 }
 
+// ---------------------------------------------------------------- Panda
+
+// Craig's modified DH transform: RotX(alpha) TransX(a) RotZ(theta) TransZ(d), as a 4x4 matrix.
+Eigen::Matrix4d Dh(double a, double d, double alpha, double theta) {
+  auto rot_x = [](double t) {
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    m.block<3, 3>(0, 0) = AngleAxisd(t, Vector3d::UnitX()).toRotationMatrix();
+    return m;
+  };
+  auto rot_z = [](double t) {
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    m.block<3, 3>(0, 0) = AngleAxisd(t, Vector3d::UnitZ()).toRotationMatrix();
+    return m;
+  };
+  auto trans = [](double x, double y, double z) {
+    Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+    m.block<3, 1>(0, 3) = Vector3d(x, y, z);
+    return m;
+  };
+  return rot_x(alpha) * trans(a, 0, 0) * rot_z(theta) * trans(0, 0, d);
+}
+
+// Frames of panda_link1..7, the flange and the TCP in the base frame, by the DH product.
+std::vector<Eigen::Matrix4d> PandaDhFrames(const VectorXd& q) {
+  const double a[7] = {0, 0, 0, 0.0825, -0.0825, 0, 0.088};
+  const double d[7] = {0.333, 0, 0.316, 0, 0.384, 0, 0};
+  const double alpha[7] = {0, -M_PI / 2, M_PI / 2, M_PI / 2, -M_PI / 2, M_PI / 2, M_PI / 2};
+  std::vector<Eigen::Matrix4d> frames;
+  Eigen::Matrix4d t = Eigen::Matrix4d::Identity();
+  for (int i = 0; i < 7; ++i) {
+    t = t * Dh(a[i], d[i], alpha[i], q[i]);
+    frames.push_back(t);
+  }
+  const Eigen::Matrix4d flange = t * Dh(0, 0.107, 0, 0);
+  frames.push_back(flange);
+  frames.push_back(flange * Dh(0, 0.1034, 0, -M_PI / 4));
+  return frames;
+}
+
+// Largest position and rotation differences between a pose and a 4x4 frame.
+void ExpectPoseNear(const Pose& pose, const Eigen::Matrix4d& frame, double tol,
+                    const std::string& what) {
+  const Pose expected = Pose::FromMatrix(frame);
+  EXPECT_LT((pose.p - expected.p).norm(), tol) << what;
+  EXPECT_LT(AngleBetween(pose.q, expected.q), tol) << what;
+}
+
+TEST(RobotsPandaTest, ForwardKinematicsIsTheDhProduct) {
+  RobotModel robot = BuildPanda();
+  EXPECT_EQ(robot.arm_joints.size(), 7u);
+  EXPECT_EQ(robot.gripper_joints.size(), 2u);
+  EXPECT_EQ(robot.ee_link, "panda_hand");
+  robot.articulation.root_pose =
+      Pose(Vector3d(0.3, -0.1, 0.2), Quaterniond(AngleAxisd(0.5, Vector3d::UnitZ())));
+  Scene scene;
+  Articulation art = scene.AddArticulation(robot.articulation);
+  ASSERT_EQ(art.Dof(), 9);
+  const Pose base = robot.articulation.root_pose;
+
+  // the flange at q = 0 is at (0.088, 0, 0.926) in the base, the TCP 0.1034 m below it
+  art.SetQpos(VectorXd::Zero(9));
+  const Pose hand0 = base.Inverse() * art.FindLinkByName("panda_hand").GetPose();
+  EXPECT_LT((hand0.p - Vector3d(0.088, 0, 0.926)).norm(), 1e-12);
+  const Pose tcp0 = hand0 * robot.tcp_in_ee;
+  EXPECT_LT((tcp0.p - Vector3d(0.088, 0, 0.926 - 0.1034)).norm(), 1e-12);
+
+  std::mt19937 rng(7);
+  std::vector<VectorXd> configs = {VectorXd::Zero(7),
+                                   Eigen::Map<const VectorXd>(robot.home.data(), 7)};
+  const Eigen::MatrixX2d limits = art.GetQlimits();
+  for (int k = 0; k < 5; ++k) {
+    VectorXd q(7);
+    for (int i = 0; i < 7; ++i)
+      q[i] = std::uniform_real_distribution<double>(limits(i, 0), limits(i, 1))(rng);
+    configs.push_back(q);
+  }
+  for (const VectorXd& q7 : configs) {
+    VectorXd q = VectorXd::Zero(9);
+    for (int i = 0; i < 7; ++i) q[Dof(art, robot.arm_joints[i])] = q7[i];
+    art.SetQpos(q);
+    std::vector<Eigen::Matrix4d> dh = PandaDhFrames(q7);
+    for (int i = 0; i < 7; ++i) {
+      const std::string link = "panda_link" + std::to_string(i + 1);
+      ExpectPoseNear(base.Inverse() * art.FindLinkByName(link).GetPose(), dh[i], 1e-9, link);
+    }
+    const Pose hand = base.Inverse() * art.FindLinkByName("panda_hand").GetPose();
+    ExpectPoseNear(
+        hand * Pose(Vector3d::Zero(), Quaterniond(AngleAxisd(M_PI / 4, Vector3d::UnitZ()))), dh[7],
+        1e-9, "flange");
+    ExpectPoseNear(hand * robot.tcp_in_ee, dh[8], 1e-9, "tcp");
+  }
+}
+
+TEST(RobotsPandaTest, HoldsHomeUnderGravityAndMovesItsFingers) {
+  RobotModel robot = BuildPanda();
+  Scene scene;
+  scene.AddGround(0.0);
+  Articulation art = scene.AddArticulation(robot.articulation);
+  VectorXd home = VectorXd::Zero(9);
+  for (int i = 0; i < 7; ++i) home[Dof(art, robot.arm_joints[i])] = robot.home[i];
+  home[Dof(art, "panda_finger_joint1")] = home[Dof(art, "panda_finger_joint2")] = 0.04;
+  art.SetQpos(home);
+  const Pose tcp0 = TcpPose(art, robot);
+  // start 0.1 rad away on every arm joint, drive back to home
+  VectorXd start = home;
+  for (int i = 0; i < 7; ++i) start[Dof(art, robot.arm_joints[i])] += i % 2 ? 0.1 : -0.1;
+  art.SetQpos(start);
+  art.SetDriveTarget(home);
+  StepCompensated(&scene, &art, 1000);  // 2 s
+  // no link touches another at home
+  for (const Contact& c : scene.GetContacts()) {
+    EXPECT_FALSE(c.body0.kind == ContactBody::Kind::kLink &&
+                 c.body1.kind == ContactBody::Kind::kLink)
+        << c.body0.name << " touches " << c.body1.name;
+  }
+  const VectorXd q = art.GetQpos();
+  EXPECT_LT((q - home).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_LT((TcpPose(art, robot).p - tcp0.p).norm(), 1e-3);
+  RecordProperty("home_error_rad", testing::PrintToString((q - home).cwiseAbs().maxCoeff()));
+
+  // the fingers close
+  VectorXd target = home;
+  target[Dof(art, "panda_finger_joint1")] = target[Dof(art, "panda_finger_joint2")] = 0.0;
+  art.SetDriveTarget(target);
+  StepCompensated(&scene, &art, 500);
+  EXPECT_NEAR(art.GetQpos()[Dof(art, "panda_finger_joint1")], 0.0, 1e-3);
+  EXPECT_NEAR(art.GetQpos()[Dof(art, "panda_finger_joint2")], 0.0, 1e-3);
+}
+
 }  // namespace
 }  // namespace partsim
