@@ -7,4 +7,8 @@ namespace partsim::tools {
 /// arguments after "assets". Returns the exit code (0 success, 1 failure, 2 bad command line).
 int RunAssetsCommand(int argc, char** argv);
 
+/// `partsim tasks ...`: the drawer and door tasks with the heuristic solvers (arguments after
+/// "tasks"). Returns the exit code (0 success, 1 failure, 2 bad command line).
+int RunTasksCommand(int argc, char** argv);
+
 }  // namespace partsim::tools

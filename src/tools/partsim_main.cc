@@ -44,6 +44,7 @@ usage:
   partsim simulate [FILE.urdf] --steps N [options]
   partsim render [FILE.urdf] --out DIR [options]
   partsim assets generate --out DIR [options]   (see partsim assets --help)
+  partsim tasks demo|evaluate [options]         (see partsim tasks --help)
   partsim --help | --version
 
 info       prints the links (name, parent, mass), the joints (name, type, parent -> child,
@@ -690,11 +691,13 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (command == "assets") return partsim::tools::RunAssetsCommand(argc - 2, argv + 2);
+  if (command == "tasks") return partsim::tools::RunTasksCommand(argc - 2, argv + 2);
   if (command != "info" && command != "simulate" && command != "render") {
-    std::fprintf(stderr,
-                 "partsim: unknown %s '%s' (expected info, simulate or render; see partsim "
-                 "--help)\n",
-                 command[0] == '-' ? "option" : "command", command.c_str());
+    std::fprintf(
+        stderr,
+        "partsim: unknown %s '%s' (expected info, simulate, render, assets or tasks; see partsim "
+        "--help)\n",
+        command[0] == '-' ? "option" : "command", command.c_str());
     return 2;
   }
   try {

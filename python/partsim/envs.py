@@ -1,0 +1,474 @@
+"""Gymnasium-style environments of partsim's drawer-pulling and door-opening tasks.
+
+The classes follow the Gymnasium API (``reset(seed=..., options=...)`` returns ``(obs, info)``;
+``step(action)`` returns ``(obs, reward, terminated, truncated, info)``; ``observation_space``,
+``action_space``, ``render()``, ``close()``) without importing the gymnasium package, which is
+not installable everywhere: the spaces here (``Box``, ``Dict``) have the same attributes and
+methods as Gymnasium's. A gymnasium user can wrap an instance with ``gymnasium.Env`` conventions
+directly.
+
+Example::
+
+    import partsim.envs as envs
+    env = envs.OpenCabinetEnv(task="drawer", obs_mode="mobility")
+    obs, info = env.reset(seed=0)
+    obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+from typing import Any
+
+import numpy as np
+
+from . import _partsim as _ps
+
+__all__ = ["Box", "Dict", "OpenCabinetEnv", "VectorOpenCabinetEnv"]
+
+
+class Box:
+    """A box in R^n: ``low <= x <= high`` elementwise, with a shape and dtype (Gymnasium's
+    ``spaces.Box``)."""
+
+    def __init__(self, low, high, shape=None, dtype=np.float32, seed=None):
+        self.dtype = np.dtype(dtype)
+        if shape is None:
+            shape = np.shape(low) if np.ndim(low) else np.shape(high)
+        self.shape = tuple(int(s) for s in shape)
+        self.low = np.broadcast_to(np.asarray(low, dtype=self.dtype), self.shape).copy()
+        self.high = np.broadcast_to(np.asarray(high, dtype=self.dtype), self.shape).copy()
+        if np.any(self.low > self.high):
+            raise ValueError("Box: low exceeds high")
+        self._rng = np.random.default_rng(seed)
+
+    def seed(self, seed=None):
+        self._rng = np.random.default_rng(seed)
+        return [seed]
+
+    @property
+    def np_random(self):
+        return self._rng
+
+    def sample(self, mask=None):
+        """A uniform sample (bounded dimensions), normal (unbounded), exponential (half-bounded),
+        as Gymnasium does."""
+        if np.issubdtype(self.dtype, np.integer):
+            return self._rng.integers(self.low, self.high, endpoint=True).astype(self.dtype)
+        low, high = self.low.astype(np.float64), self.high.astype(np.float64)
+        out = np.empty(self.shape)
+        bounded = np.isfinite(low) & np.isfinite(high)
+        lower_only = np.isfinite(low) & ~np.isfinite(high)
+        upper_only = ~np.isfinite(low) & np.isfinite(high)
+        free = ~np.isfinite(low) & ~np.isfinite(high)
+        out[bounded] = self._rng.uniform(low[bounded], high[bounded])
+        out[lower_only] = low[lower_only] + self._rng.exponential(size=lower_only.sum())
+        out[upper_only] = high[upper_only] - self._rng.exponential(size=upper_only.sum())
+        out[free] = self._rng.normal(size=free.sum())
+        return out.astype(self.dtype)
+
+    def contains(self, x) -> bool:
+        if not isinstance(x, np.ndarray):
+            try:
+                x = np.asarray(x, dtype=self.dtype)
+            except (ValueError, TypeError):
+                return False
+        return bool(
+            np.can_cast(x.dtype, self.dtype)
+            and x.shape == self.shape
+            and np.all(x >= self.low)
+            and np.all(x <= self.high)
+        )
+
+    def __contains__(self, x) -> bool:
+        return self.contains(x)
+
+    def __repr__(self):
+        return f"Box({self.low.min()}, {self.high.max()}, {self.shape}, {self.dtype})"
+
+    def __eq__(self, other):
+        return (
+            isinstance(other, Box)
+            and self.shape == other.shape
+            and self.dtype == other.dtype
+            and np.array_equal(self.low, other.low)
+            and np.array_equal(self.high, other.high)
+        )
+
+
+class Dict:
+    """A dictionary of spaces (Gymnasium's ``spaces.Dict``)."""
+
+    def __init__(self, spaces: dict, seed=None):
+        self.spaces = dict(spaces)
+        self.shape = None
+        self.dtype = None
+        self.seed(seed)
+
+    def seed(self, seed=None):
+        ss = np.random.SeedSequence(seed)
+        for space, child in zip(self.spaces.values(), ss.spawn(len(self.spaces))):
+            space.seed(int(child.generate_state(1)[0]))
+        return [seed]
+
+    def sample(self, mask=None):
+        return {k: s.sample() for k, s in self.spaces.items()}
+
+    def contains(self, x) -> bool:
+        return (
+            isinstance(x, dict)
+            and x.keys() == self.spaces.keys()
+            and all(s.contains(x[k]) for k, s in self.spaces.items())
+        )
+
+    def __contains__(self, x) -> bool:
+        return self.contains(x)
+
+    def __getitem__(self, key):
+        return self.spaces[key]
+
+    def keys(self):
+        return self.spaces.keys()
+
+    def __repr__(self):
+        return "Dict(" + ", ".join(f"{k!r}: {s}" for k, s in self.spaces.items()) + ")"
+
+
+# Scale of the normalised action: a unit action is this TCP speed.
+MAX_LINEAR_SPEED = 0.5  # m/s
+MAX_ANGULAR_SPEED = 1.5  # rad/s
+# Raw observations hold the cabinet's joint positions and velocities padded to this many dof.
+RAW_MAX_DOF = 16
+ROBOT_STATE_SIZE = 14
+OBS_MODES = ("raw", "mobility", "visual")
+
+
+class OpenCabinetEnv:
+    """Drawer pulling (``task="drawer"``) or door opening (``task="door"``) on generated cabinets
+    with the flying gripper.
+
+    Action: 7 values in [-1, 1]: the gripper's TCP twist in the world frame, scaled by 0.5 m/s
+    (linear) and 1.5 rad/s (angular), then the gripper command (-1 close, 1 open). Actions outside
+    [-1, 1] are clipped (a documented clamp); NaN or infinite actions, or a wrong shape, raise
+    ``ValueError`` and leave the simulation untouched.
+
+    Observation modes (the SAPIEN paper's):
+
+    * ``raw``: the cabinet's joint positions and velocities (each padded with zeros to 16 dof),
+      then the robot state (TCP position 3, quaternion wxyz 4, twist 6, gripper opening 1): 46.
+    * ``mobility``: the target joint's axis origin (3) and direction (3), the target part's
+      average outward normal (3), its joint position and velocity (2), then the robot state: 25.
+    * ``visual``: a dict of the front camera's ``rgb`` (h, w, 3) uint8, ``depth`` (h, w) float32
+      metres, the target part's ``mask`` (h, w) uint8 and the robot ``state`` (14).
+
+    Reward (dense, as in the paper): 10 x the fraction of the range opened in the step, +1 per
+    step once 90% is reached, -0.1 when a held grasp is lost, and -0.5 x the TCP's distance to
+    the handle until the target is first touched. ``terminated`` on success (90% of the range) or
+    failure (the part pushed the wrong way); ``truncated`` after ``max_episode_steps``.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 25}
+
+    def __init__(
+        self,
+        task: str = "drawer",
+        obs_mode: str = "mobility",
+        objects=None,
+        dataset_seed: int = 0,
+        max_episode_steps: int = 250,
+        control_rate: float = 25.0,
+        init_on_handle: bool = True,
+        render_mode: str | None = None,
+        camera_size=(128, 96),
+        render_backend: str = "rasterizer",
+    ):
+        if obs_mode not in OBS_MODES:
+            raise ValueError(f"obs_mode must be one of {OBS_MODES}, got {obs_mode!r}")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        if max_episode_steps < 1:
+            raise ValueError("max_episode_steps must be at least 1")
+        self.task_type = _ps.parse_task_type(task)
+        self.obs_mode = obs_mode
+        self.render_mode = render_mode
+        self.max_episode_steps = int(max_episode_steps)
+        if objects is None:
+            objects = _ps.find_task_objects(self.task_type, 1, dataset_seed)
+        elif isinstance(objects, int):
+            objects = [objects]
+        self.objects = [int(o) for o in objects]
+        if not self.objects:
+            raise ValueError("objects must name at least one StorageFurniture index")
+        self._options = []
+        for index in self.objects:
+            o = _ps.TaskOptions()
+            o.type = self.task_type
+            o.object_index = index
+            o.dataset_seed = dataset_seed
+            o.control_rate = control_rate
+            o.max_seconds = max_episode_steps / control_rate + 1.0
+            o.init_on_handle = init_on_handle
+            o.cameras = obs_mode == "visual" or render_mode == "rgb_array"
+            o.camera_width, o.camera_height = int(camera_size[0]), int(camera_size[1])
+            o.render_backend = render_backend
+            self._options.append(o)
+        self._tasks: dict[int, Any] = {}
+        self._task = None
+        self._steps = 0
+        self._np_random = np.random.default_rng()
+        self._closed = False
+
+        self.action_space = Box(-1.0, 1.0, (7,), np.float32)
+        state = Box(-np.inf, np.inf, (ROBOT_STATE_SIZE,), np.float32)
+        if obs_mode == "raw":
+            self.observation_space = Box(
+                -np.inf, np.inf, (2 * RAW_MAX_DOF + ROBOT_STATE_SIZE,), np.float32
+            )
+        elif obs_mode == "mobility":
+            self.observation_space = Box(-np.inf, np.inf, (11 + ROBOT_STATE_SIZE,), np.float32)
+        else:
+            w, h = int(camera_size[0]), int(camera_size[1])
+            self.observation_space = Dict(
+                {
+                    "rgb": Box(0, 255, (h, w, 3), np.uint8),
+                    "depth": Box(0.0, np.inf, (h, w), np.float32),
+                    "mask": Box(0, 1, (h, w), np.uint8),
+                    "state": state,
+                }
+            )
+
+    # --- Gymnasium API ---------------------------------------------------------------------
+
+    @property
+    def np_random(self) -> np.random.Generator:
+        return self._np_random
+
+    @property
+    def unwrapped(self):
+        return self
+
+    @property
+    def task(self):
+        """The current ``ArticulationTask`` (after reset)."""
+        return self._task
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Starts an episode. ``seed`` reseeds the environment's generator (same seed, same
+        episode); ``options`` may hold ``object`` (an index into ``objects``) and ``target`` (a
+        drawer or door of that object)."""
+        self._check_open()
+        if seed is not None:
+            self._np_random = np.random.default_rng(seed)
+            self.action_space.seed(seed)
+            self.observation_space.seed(seed)
+        options = dict(options or {})
+        unknown = set(options) - {"object", "target"}
+        if unknown:
+            raise ValueError(f"reset: unknown options {sorted(unknown)} (known: object, target)")
+        k = options.get("object")
+        if k is None:
+            k = int(self._np_random.integers(len(self.objects)))
+        if not 0 <= k < len(self.objects):
+            raise ValueError(f"reset: options['object'] = {k} is not in [0, {len(self.objects)})")
+        if k not in self._tasks:
+            opts = self._options[k]
+            if "target" in options:
+                opts.target = int(options["target"])
+            self._tasks[k] = _ps.ArticulationTask(opts)
+        elif "target" in options:
+            opts = self._options[k]
+            opts.target = int(options["target"])
+            self._tasks[k] = _ps.ArticulationTask(opts)
+        self._task = self._tasks[k]
+        self._task.reset(int(self._np_random.integers(0, 2**62)))
+        self._steps = 0
+        return self._observation(), self._info()
+
+    def step(self, action):
+        self._check_open()
+        if self._task is None:
+            raise RuntimeError("step called before reset")
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != (7,):
+            raise ValueError(f"action must have shape (7,), got {a.shape}")
+        if not np.all(np.isfinite(a)):
+            bad = int(np.flatnonzero(~np.isfinite(a))[0])
+            raise ValueError(f"action entry {bad} is not finite ({a[bad]})")
+        a = np.clip(a, -1.0, 1.0)
+        scaled = np.concatenate(
+            [a[:3] * MAX_LINEAR_SPEED, a[3:6] * MAX_ANGULAR_SPEED, a[6:7]]
+        )
+        self._task.apply_action(scaled)
+        self._task.step()
+        self._steps += 1
+        reward = float(self._task.get_reward())
+        terminated = bool(self._task.is_success() or self._task.is_failure())
+        truncated = bool(not terminated and self._steps >= self.max_episode_steps)
+        return self._observation(), reward, terminated, truncated, self._info()
+
+    def render(self):
+        """The front camera's colour as (h, w, 3) uint8 (render_mode 'rgb_array')."""
+        if self.render_mode != "rgb_array":
+            return None
+        self._check_open()
+        if self._task is None:
+            raise RuntimeError("render called before reset")
+        if self.obs_mode != "visual" or self._last_picture_step != self._steps:
+            self._task.take_pictures()
+        return np.ascontiguousarray(self._task.get_camera("front").get_color_rgba8()[:, :, :3])
+
+    def close(self):
+        self._tasks.clear()
+        self._task = None
+        self._closed = True
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    # --- internals ---------------------------------------------------------------------------
+
+    _last_picture_step = -1
+
+    def _check_open(self):
+        if self._closed:
+            raise RuntimeError("the environment is closed")
+
+    def _info(self) -> dict:
+        t = self._task
+        return {
+            "success": bool(t.is_success()),
+            "progress": float(t.get_progress()),
+            "object": int(t.options.object_index),
+            "target": t.target_link.get_name(),
+            "touching": bool(t.gripper_touches_target()),
+            "elapsed": float(t.get_elapsed()),
+        }
+
+    def _observation(self):
+        t = self._task
+        if self.obs_mode == "raw":
+            qpos, qvel = t.object.get_qpos(), t.object.get_qvel()
+            n = len(qpos)
+            if n > RAW_MAX_DOF:
+                raise RuntimeError(
+                    f"cabinet has {n} dof, more than the raw observation's {RAW_MAX_DOF}"
+                )
+            out = np.zeros(2 * RAW_MAX_DOF + ROBOT_STATE_SIZE, dtype=np.float32)
+            out[:n] = qpos
+            out[RAW_MAX_DOF : RAW_MAX_DOF + n] = qvel
+            out[2 * RAW_MAX_DOF :] = t.get_raw_observation()[2 * n :]
+            return out
+        if self.obs_mode == "mobility":
+            return np.asarray(t.get_mobility_observation(), dtype=np.float32)
+        t.take_pictures()
+        self._last_picture_step = self._steps
+        cam = t.get_camera("front")
+        seg = cam.get_picture("Segmentation")
+        depth = np.asarray(cam.get_depth(), dtype=np.float32)
+        return {
+            "rgb": np.ascontiguousarray(cam.get_color_rgba8()[:, :, :3]),
+            "depth": np.ascontiguousarray(depth),
+            "mask": (seg[:, :, 1] == t.get_target_entity_id()).astype(np.uint8),
+            "state": np.asarray(t.get_raw_observation()[-ROBOT_STATE_SIZE:], dtype=np.float32),
+        }
+
+
+def _stack(items):
+    if isinstance(items[0], dict):
+        return {k: np.stack([x[k] for x in items]) for k in items[0]}
+    return np.stack(items)
+
+
+class VectorOpenCabinetEnv:
+    """``num_envs`` copies of :class:`OpenCabinetEnv` stepped together on a thread pool (the
+    simulation releases the GIL, so the copies run in parallel on several cores).
+
+    Follows Gymnasium's vector API: ``reset`` returns batched observations and an info dict of
+    arrays; ``step(actions)`` with actions of shape (num_envs, 7) returns batched
+    ``(obs, rewards, terminations, truncations, infos)``. Autoreset is Gymnasium 1.x's
+    "next-step" mode: after a sub-environment's episode ends, its next ``step`` ignores the
+    action and returns the first observation of a new episode (reward 0, not terminated).
+    """
+
+    metadata = OpenCabinetEnv.metadata
+
+    def __init__(self, num_envs: int, workers: int | None = None, **kwargs):
+        if num_envs < 1:
+            raise ValueError("num_envs must be at least 1")
+        self.num_envs = int(num_envs)
+        self.envs = [OpenCabinetEnv(**kwargs) for _ in range(self.num_envs)]
+        self.single_action_space = self.envs[0].action_space
+        self.single_observation_space = self.envs[0].observation_space
+        a = self.single_action_space
+        self.action_space = Box(
+            np.broadcast_to(a.low, (num_envs,) + a.shape),
+            np.broadcast_to(a.high, (num_envs,) + a.shape),
+            (num_envs,) + a.shape,
+            a.dtype,
+        )
+        self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=workers or num_envs)
+        self._needs_reset = np.zeros(self.num_envs, dtype=bool)
+
+    def reset(self, *, seed=None, options=None):
+        if seed is None:
+            seeds = [None] * self.num_envs
+        elif isinstance(seed, int):
+            seeds = [seed + i for i in range(self.num_envs)]
+        else:
+            seeds = list(seed)
+        results = list(
+            self._pool.map(lambda ie: ie[1].reset(seed=seeds[ie[0]], options=options),
+                           enumerate(self.envs))
+        )
+        self._needs_reset[:] = False
+        return _stack([r[0] for r in results]), self._infos([r[1] for r in results])
+
+    def step(self, actions):
+        actions = np.asarray(actions, dtype=np.float64)
+        if actions.shape != (self.num_envs, 7):
+            raise ValueError(f"actions must have shape ({self.num_envs}, 7), got {actions.shape}")
+        if not np.all(np.isfinite(actions)):
+            raise ValueError("actions hold NaN or infinite values")
+
+        def one(i):
+            env = self.envs[i]
+            if self._needs_reset[i]:
+                obs, info = env.reset()
+                return obs, 0.0, False, False, info
+            return env.step(actions[i])
+
+        results = list(self._pool.map(one, range(self.num_envs)))
+        terminated = np.array([r[2] for r in results], dtype=bool)
+        truncated = np.array([r[3] for r in results], dtype=bool)
+        self._needs_reset = terminated | truncated
+        return (
+            _stack([r[0] for r in results]),
+            np.array([r[1] for r in results], dtype=np.float64),
+            terminated,
+            truncated,
+            self._infos([r[4] for r in results]),
+        )
+
+    def close(self):
+        self._pool.shutdown(wait=True)
+        for e in self.envs:
+            e.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    @staticmethod
+    def _infos(items):
+        out = {}
+        for k in items[0]:
+            out[k] = np.array([x[k] for x in items])
+            out["_" + k] = np.ones(len(items), dtype=bool)
+        return out

@@ -1,0 +1,477 @@
+// ArticulationTask: a generated cabinet, the flying gripper and three cameras.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include "partsim/assets/generator.h"
+#include "partsim/assets/partnet_mobility.h"
+#include "partsim/core/error.h"
+#include "partsim/render/camera_math.h"
+#include "partsim/tasks/tasks.h"
+#include "tasks/task_internal.h"
+
+namespace fs = std::filesystem;
+
+namespace partsim {
+
+const char* TaskTypeName(TaskType t) { return t == TaskType::kPullDrawer ? "drawer" : "door"; }
+
+TaskType ParseTaskType(const std::string& name) {
+  if (name == "drawer") return TaskType::kPullDrawer;
+  if (name == "door") return TaskType::kOpenDoor;
+  throw Error("task type '" + name + "' is unknown (expected 'drawer' or 'door')");
+}
+
+namespace internal {
+
+std::vector<int> TargetLinks(const GeneratedObject& object, TaskType type) {
+  const std::string label = TaskTypeName(type);
+  std::vector<int> out;
+  for (const GeneratedLink& l : object.links) {
+    if (l.name != label) continue;
+    bool handle = false;
+    for (const GeneratedPart& p : l.parts) handle = handle || p.name == "handle";
+    if (handle) out.push_back(l.id);
+  }
+  return out;
+}
+
+std::string EnsureObjectFolder(const GeneratedObject& object, const std::string& asset_dir) {
+  fs::path root =
+      asset_dir.empty() ? fs::temp_directory_path() / "partsim-assets" : fs::path(asset_dir);
+  fs::path dir = root / (object.category + "_s" + std::to_string(object.seed)) / object.model_id;
+  if (fs::exists(dir / "mobility_v2.json")) return dir.string();
+  // write beside, then rename: tasks on several threads may ask for the same object
+  static std::atomic<int> counter{0};
+  fs::path tmp = dir;
+  tmp += ".tmp" + std::to_string(std::hash<std::thread::id>()(std::this_thread::get_id())) + "_" +
+         std::to_string(counter++);
+  WriteObject(object, tmp.string());
+  std::error_code ec;
+  fs::rename(tmp, dir, ec);
+  if (ec) fs::remove_all(tmp, ec);  // another writer won the race: its folder is identical
+  if (!fs::exists(dir / "mobility_v2.json"))
+    throw Error("task: cannot write the object folder '" + dir.string() + "'");
+  return dir.string();
+}
+
+// --- flying gripper kinematics in closed form -------------------------------------------------
+
+Eigen::Vector3d EulerZyx(const Eigen::Matrix3d& R, const Eigen::Vector3d& near) {
+  // R = Rz(a) Ry(b) Rx(c); two solutions away from b = +-pi/2: pick the one nearest `near`
+  double b = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  double a = std::atan2(R(1, 0), R(0, 0));
+  double c = std::atan2(R(2, 1), R(2, 2));
+  auto wrap_near = [](double x, double ref) {
+    return x + 2 * M_PI * std::round((ref - x) / (2 * M_PI));
+  };
+  Eigen::Vector3d s1(wrap_near(a, near[0]), wrap_near(b, near[1]), wrap_near(c, near[2]));
+  Eigen::Vector3d s2(wrap_near(a + M_PI, near[0]), wrap_near(M_PI - b, near[1]),
+                     wrap_near(c + M_PI, near[2]));
+  return (s1 - near).squaredNorm() <= (s2 - near).squaredNorm() ? s1 : s2;
+}
+
+Eigen::Matrix3d EulerRateMatrix(const Eigen::Vector3d& ypr) {
+  // angular velocity (root frame) = E * (yaw', pitch', roll')
+  Eigen::Matrix3d Rz = Eigen::AngleAxisd(ypr[0], Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  Eigen::Matrix3d Ry = Eigen::AngleAxisd(ypr[1], Eigen::Vector3d::UnitY()).toRotationMatrix();
+  Eigen::Matrix3d E;
+  E.col(0) = Eigen::Vector3d::UnitZ();
+  E.col(1) = Rz * Eigen::Vector3d::UnitY();
+  E.col(2) = Rz * Ry * Eigen::Vector3d::UnitX();
+  return E;
+}
+
+}  // namespace internal
+
+using internal::TaskImpl;
+
+std::vector<int> FindTaskObjects(TaskType type, int count, std::uint64_t dataset_seed) {
+  std::vector<int> out;
+  for (int i = 0; static_cast<int>(out.size()) < count; ++i) {
+    if (i > 100 * count + 100)
+      throw Error("FindTaskObjects: too few StorageFurniture objects with a " +
+                  std::string(TaskTypeName(type)));
+    GeneratedObject o = GenerateObject("StorageFurniture", i, dataset_seed);
+    if (!internal::TargetLinks(o, type).empty()) out.push_back(i);
+  }
+  return out;
+}
+
+ArticulationTask::ArticulationTask(const TaskOptions& options) : impl_(new Impl(options)) {}
+ArticulationTask::~ArticulationTask() = default;
+
+void ArticulationTask::Reset(std::uint64_t seed) { impl_->Reset(seed); }
+const TaskOptions& ArticulationTask::GetOptions() const { return impl_->options; }
+Scene& ArticulationTask::GetScene() { return *impl_->scene; }
+std::shared_ptr<Scene> ArticulationTask::GetSharedScene() const { return impl_->scene; }
+const RobotModel& ArticulationTask::GetRobotModel() const { return impl_->robot_model; }
+Articulation ArticulationTask::GetRobot() const { return impl_->robot; }
+Articulation ArticulationTask::GetObject() const { return impl_->object; }
+Link ArticulationTask::GetTargetLink() const { return impl_->object.GetLink(impl_->target_link); }
+Joint ArticulationTask::GetTargetJoint() const {
+  return impl_->object.GetJoint(impl_->target_link);
+}
+std::vector<std::string> ArticulationTask::GetTargetCandidates() const {
+  std::vector<std::string> out;
+  for (int i : impl_->candidates) out.push_back(impl_->object.GetLink(i).GetName());
+  return out;
+}
+std::vector<uint32_t> ArticulationTask::GetHandleVisualIds() const {
+  return impl_->handle_visuals.at(impl_->target_link);
+}
+uint32_t ArticulationTask::GetTargetEntityId() const {
+  return impl_->entity_ids.at(impl_->target_link);
+}
+double ArticulationTask::GetProgress() const { return impl_->Progress(); }
+bool ArticulationTask::IsSuccess() const {
+  return impl_->Progress() >= impl_->options.success_fraction;
+}
+bool ArticulationTask::IsFailure() const { return impl_->Progress() < -0.02; }
+double ArticulationTask::GetElapsed() const { return impl_->scene->GetTime() - impl_->start_time; }
+bool ArticulationTask::IsTruncated() const {
+  return GetElapsed() >= impl_->options.max_seconds - 1e-9;
+}
+Pose ArticulationTask::GetTcpPose() const { return impl_->TcpPose(); }
+Eigen::Matrix<double, 6, 1> ArticulationTask::GetTcpVelocity() const {
+  return impl_->TcpVelocity();
+}
+void ArticulationTask::SetTcpTarget(const Pose& target) { impl_->SetTcpTarget(target); }
+void ArticulationTask::SetTcpVelocity(const Eigen::Matrix<double, 6, 1>& twist) {
+  impl_->SetTcpVelocity(twist);
+}
+void ArticulationTask::SetGripper(double fraction) { impl_->SetGripper(fraction); }
+double ArticulationTask::GetGripperOpening() const { return impl_->GripperOpening(); }
+bool ArticulationTask::GripperTouchesTarget() const { return impl_->TouchesTarget(); }
+void ArticulationTask::ApplyAction(const Eigen::VectorXd& action) { impl_->ApplyAction(action); }
+void ArticulationTask::Step() { impl_->StepControl(); }
+void ArticulationTask::TakePictures() { impl_->TakePictures(); }
+std::vector<Camera> ArticulationTask::GetCameras() const { return impl_->cameras; }
+Camera ArticulationTask::GetCamera(const std::string& name) const {
+  for (const Camera& c : impl_->cameras)
+    if (c.GetName() == name) return c;
+  throw Error("task: no camera named '" + name + "' (cameras: left, right, front" +
+              std::string(impl_->cameras.empty() ? "; this task was made without cameras" : "") +
+              ")");
+}
+Eigen::VectorXd ArticulationTask::GetRawObservation() const { return impl_->RawObservation(); }
+Eigen::VectorXd ArticulationTask::GetMobilityObservation() const {
+  return impl_->MobilityObservation();
+}
+double ArticulationTask::GetReward() const { return impl_->last_reward; }
+
+// --- Impl ----------------------------------------------------------------------------------
+
+namespace internal {
+
+TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
+  if (!(o.timestep > 0) || !(o.control_rate > 0) || o.control_rate * o.timestep > 1.0 + 1e-9)
+    throw Error("task: the control rate (" + std::to_string(o.control_rate) +
+                " Hz) must be positive and at most the physics rate (1 / timestep)");
+  if (o.cameras && (o.camera_width <= 0 || o.camera_height <= 0))
+    throw Error("task: camera size must be positive");
+  if (!(o.success_fraction > 0 && o.success_fraction <= 1))
+    throw Error("task: success_fraction must be in (0, 1]");
+  substeps = std::max(1, static_cast<int>(std::lround(1.0 / (o.control_rate * o.timestep))));
+
+  GeneratedObject gen = GenerateObject("StorageFurniture", o.object_index, o.dataset_seed);
+  std::vector<int> targets = TargetLinks(gen, o.type);
+  if (targets.empty())
+    throw Error("task: StorageFurniture object " + std::to_string(o.object_index) + " (seed " +
+                std::to_string(o.dataset_seed) + ") has no " + TaskTypeName(o.type) +
+                " with a handle; FindTaskObjects lists those that do");
+  if (o.target >= static_cast<int>(targets.size()))
+    throw Error("task: target " + std::to_string(o.target) + " is out of range: object " +
+                std::to_string(o.object_index) + " has " + std::to_string(targets.size()) + " " +
+                TaskTypeName(o.type) + (targets.size() == 1 ? "" : "s"));
+  std::string folder = EnsureObjectFolder(gen, o.asset_dir);
+
+  SceneConfig cfg;
+  cfg.timestep = o.timestep;
+  scene = std::make_shared<Scene>(cfg);
+  PartNetMobilityLoader loader;
+  PartNetMobilityObject obj = loader.Parse(folder);
+  // the loader turns the file's y-up into z-up with the front facing -y; face +x instead
+  obj.articulation.root_pose =
+      Pose(Eigen::Vector3d::Zero(),
+           Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())));
+  object = scene->AddArticulation(obj.articulation);
+  for (int id : targets) candidates.push_back(obj.LinkIndex(id));
+  // cabinet size from its bounding box (file frame: x width, y height, z depth)
+  cabinet_half_depth = 0.5 * (obj.bbox_max.z() - obj.bbox_min.z());
+  cabinet_height = obj.bbox_max.y();
+  cabinet_half_width = 0.5 * (obj.bbox_max.x() - obj.bbox_min.x());
+
+  robot_model = BuildFlyingGripper();
+  // at q = 0 the TCP is at the root, approaching along -x with the fingers opening along y
+  robot_model.articulation.root_pose =
+      Pose(Eigen::Vector3d::Zero(),
+           Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY())));
+  robot = scene->AddArticulation(robot_model.articulation);
+  for (const std::string& n : robot_model.arm_joints)
+    arm_dofs.push_back(robot.FindJointByName(n).GetDofIndex());
+  for (const std::string& n : robot_model.gripper_joints)
+    finger_dofs.push_back(robot.FindJointByName(n).GetDofIndex());
+  ee_link = robot.FindLinkByName(robot_model.ee_link).GetIndex();
+  for (const Link& l : robot.GetLinks())
+    if (l.GetName().find("finger") != std::string::npos) finger_links.push_back(l.GetIndex());
+
+  // render ids of the candidates and their handles
+  for (const RenderEntityInfo& e : scene->GetRenderEntities())
+    if (e.is_link && e.articulation_id == object.GetId()) entity_ids[e.link_index] = e.id;
+  for (const RenderVisualInfo& v : scene->GetRenderVisuals()) {
+    if (v.name.rfind("handle-", 0) != 0) continue;
+    for (int li : candidates)
+      if (entity_ids.count(li) && entity_ids[li] == v.entity_id) handle_visuals[li].push_back(v.id);
+  }
+  if (o.cameras) {
+    scene->SetRenderBackend(o.render_backend);
+    scene->SetAmbientLight(Eigen::Vector3f(0.35f, 0.35f, 0.35f));
+    scene->AddDirectionalLight(Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+    Eigen::Vector3d centre(0, 0, 0.5 * cabinet_height);
+    double d = 0.6 + 1.3 * std::max({cabinet_height, 2 * cabinet_half_width, 0.6});
+    double fovy = 50.0 * M_PI / 180.0;
+    struct View {
+      const char* name;
+      Eigen::Vector3d dir;
+    };
+    for (const View& v : {View{"left", Eigen::Vector3d(1.0, 0.8, 0.45)},
+                          View{"right", Eigen::Vector3d(1.0, -0.8, 0.45)},
+                          View{"front", Eigen::Vector3d(1.0, 0.0, 0.3)}}) {
+      Camera cam = scene->AddCamera(v.name, o.camera_width, o.camera_height, fovy, 0.05, 10.0);
+      cam.SetLocalPose(CameraLookAt(centre + d * v.dir.normalized(), centre));
+      cameras.push_back(cam);
+    }
+  }
+  initial_state = scene->Pack();
+  Reset(0);
+}
+
+void TaskImpl::Reset(std::uint64_t seed) {
+  scene->Unpack(initial_state);
+  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ULL + 12345);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  target_link =
+      options.target >= 0
+          ? candidates[options.target]
+          : candidates[std::uniform_int_distribution<size_t>(0, candidates.size() - 1)(rng)];
+  Joint j = object.GetJoint(target_link);
+  Eigen::Vector2d lim = j.GetLimits();
+  closed_at_lower = std::abs(lim[0]) <= std::abs(lim[1]);
+  range = lim[1] - lim[0];
+  start_time = scene->GetTime();
+  rest_orientation = object.GetLink(target_link).GetPose().q;
+  grasped_once = false;
+
+  // gripper open, in front of the target's handle and to one side
+  Eigen::Vector3d handle = HandleCentre();
+  // beside the line of sight of the front camera, so that it does not hide the handle
+  const double side = U(rng) < 0 ? -1.0 : 1.0;
+  Eigen::Vector3d p =
+      handle + Eigen::Vector3d(0.3 + 0.05 * U(rng), side * (0.3 + 0.05 * U(rng)), 0.05 * U(rng));
+  Eigen::Quaterniond q(Eigen::AngleAxisd(0.1 * U(rng), Eigen::Vector3d::UnitZ()) *
+                       Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()));
+  Eigen::VectorXd qpos = robot.GetQpos();
+  qpos.setZero();
+  robot.SetQpos(qpos);
+  PlaceGripper(Pose(p, q), 1.0);
+  if (options.init_on_handle) {
+    Pose grasp = GroundTruthGrasp();
+    PlaceGripper(grasp, 1.0);
+    SetGripper(0.0);
+    for (int i = 0; i < 25; ++i) StepControl();
+    start_time = scene->GetTime();
+  }
+  last_progress = Progress();
+  had_grasp = TouchesTarget();
+  last_reward = 0.0;
+}
+
+double TaskImpl::Progress() const {
+  double q = object.GetJoint(target_link).GetQpos();
+  Eigen::Vector2d lim = object.GetJoint(target_link).GetLimits();
+  if (!(range > 0) || !std::isfinite(range)) return 0.0;
+  return closed_at_lower ? (q - lim[0]) / range : (lim[1] - q) / range;
+}
+
+Pose TaskImpl::TcpPose() const { return robot.GetLink(ee_link).GetPose() * robot_model.tcp_in_ee; }
+
+Eigen::Matrix<double, 6, 1> TaskImpl::TcpVelocity() const {
+  Link l = robot.GetLink(ee_link);
+  Eigen::Vector3d w = l.GetAngularVelocity();
+  Eigen::Vector3d r = l.GetPose().q * robot_model.tcp_in_ee.p;
+  Eigen::Matrix<double, 6, 1> out;
+  out << l.GetVelocity() + w.cross(r), w;
+  return out;
+}
+
+Eigen::VectorXd TaskImpl::ArmJointsFor(const Pose& tcp) const {
+  const Pose rel = robot_model.articulation.root_pose.Inverse() * tcp;
+  Eigen::VectorXd q = robot.GetQpos();
+  Eigen::Vector3d near(q[arm_dofs[3]], q[arm_dofs[4]], q[arm_dofs[5]]);
+  Eigen::Vector3d ypr = EulerZyx(rel.q.toRotationMatrix(), near);
+  Eigen::VectorXd out(6);
+  out << rel.p, ypr;
+  return out;
+}
+
+void TaskImpl::PlaceGripper(const Pose& tcp, double opening) {
+  Eigen::VectorXd arm = ArmJointsFor(tcp);
+  Eigen::VectorXd qpos = robot.GetQpos();
+  for (int k = 0; k < 6; ++k) qpos[arm_dofs[k]] = arm[k];
+  for (int d : finger_dofs) qpos[d] = FingerPosition(opening);
+  robot.SetQpos(qpos);
+  robot.SetQvel(Eigen::VectorXd::Zero(robot.Dof()));
+  tcp_target = tcp;
+  twist.setZero();
+  velocity_mode = false;
+  Eigen::VectorXd target = robot.GetDriveTarget();
+  for (int k = 0; k < 6; ++k) target[arm_dofs[k]] = arm[k];
+  for (int d : finger_dofs) target[d] = FingerPosition(opening);
+  robot.SetDriveTarget(target);
+  robot.SetDriveVelocityTarget(Eigen::VectorXd::Zero(robot.Dof()));
+  gripper_fraction = opening;
+}
+
+double TaskImpl::FingerPosition(double fraction) const {
+  return robot_model.gripper_closed +
+         std::clamp(fraction, 0.0, 1.0) * (robot_model.gripper_open - robot_model.gripper_closed);
+}
+
+void TaskImpl::SetTcpTarget(const Pose& target) {
+  if (!target.p.allFinite() || !target.q.coeffs().allFinite())
+    throw Error("task: SetTcpTarget: the target pose is not finite");
+  tcp_target = Pose(target.p, target.q.normalized());
+  velocity_mode = false;
+  twist.setZero();
+}
+
+void TaskImpl::SetTcpVelocity(const Eigen::Matrix<double, 6, 1>& t) {
+  if (!t.allFinite()) throw Error("task: SetTcpVelocity: the twist is not finite");
+  Eigen::Matrix<double, 6, 1> c = t;
+  double v = c.head<3>().norm(), w = c.tail<3>().norm();
+  if (v > kMaxLinearSpeed) c.head<3>() *= kMaxLinearSpeed / v;
+  if (w > kMaxAngularSpeed) c.tail<3>() *= kMaxAngularSpeed / w;
+  if (!velocity_mode) tcp_target = TcpPose();
+  twist = c;
+  velocity_mode = true;
+}
+
+void TaskImpl::SetGripper(double fraction) {
+  if (!std::isfinite(fraction)) throw Error("task: SetGripper: the opening is not finite");
+  gripper_fraction = std::clamp(fraction, 0.0, 1.0);
+}
+
+double TaskImpl::GripperOpening() const {
+  Eigen::VectorXd q = robot.GetQpos();
+  double s = 0;
+  for (int d : finger_dofs) s += q[d];
+  double span = robot_model.gripper_open - robot_model.gripper_closed;
+  return std::clamp((s / finger_dofs.size() - robot_model.gripper_closed) / span, 0.0, 1.0);
+}
+
+bool TaskImpl::TouchesTarget() const {
+  for (const Contact& c : scene->GetContacts()) {
+    const ContactBody* a = &c.body0;
+    const ContactBody* b = &c.body1;
+    for (int k = 0; k < 2; ++k, std::swap(a, b)) {
+      if (a->kind != ContactBody::Kind::kLink || b->kind != ContactBody::Kind::kLink) continue;
+      if (a->articulation_id != robot.GetId() || b->articulation_id != object.GetId()) continue;
+      if (b->link_index != target_link) continue;
+      if (std::find(finger_links.begin(), finger_links.end(), a->link_index) != finger_links.end())
+        return true;
+    }
+  }
+  return false;
+}
+
+void TaskImpl::ApplyAction(const Eigen::VectorXd& action) {
+  if (action.size() != 7)
+    throw Error("task: action has " + std::to_string(action.size()) +
+                " entries; expected 7 (TCP twist: vx, vy, vz, wx, wy, wz; gripper)");
+  for (int i = 0; i < 7; ++i)
+    if (!std::isfinite(action[i]))
+      throw Error("task: action entry " + std::to_string(i) + " is not finite");
+  SetTcpVelocity(action.head<6>());
+  SetGripper(0.5 * (std::clamp(action[6], -1.0, 1.0) + 1.0));
+}
+
+void TaskImpl::StepControl() {
+  const double dt = scene->GetTimestep();
+  const double before = Progress();
+  for (int s = 0; s < substeps; ++s) {
+    Eigen::VectorXd target = robot.GetDriveTarget();
+    Eigen::VectorXd vtarget = Eigen::VectorXd::Zero(robot.Dof());
+    if (velocity_mode) {
+      // integrate the commanded twist into the target pose
+      tcp_target.p += twist.head<3>() * dt;
+      Eigen::Vector3d w = twist.tail<3>() * dt;
+      if (w.norm() > 0)
+        tcp_target.q =
+            Eigen::Quaterniond(Eigen::AngleAxisd(w.norm(), w.normalized())) * tcp_target.q;
+      tcp_target.q.normalize();
+    }
+    Eigen::VectorXd arm = ArmJointsFor(tcp_target);
+    for (int k = 0; k < 6; ++k) target[arm_dofs[k]] = arm[k];
+    if (velocity_mode) {
+      const Eigen::Matrix3d Rr = robot_model.articulation.root_pose.q.toRotationMatrix();
+      Eigen::Vector3d v_root = Rr.transpose() * twist.head<3>();
+      Eigen::Vector3d w_root = Rr.transpose() * twist.tail<3>();
+      Eigen::Vector3d rates = EulerRateMatrix(arm.tail<3>()).colPivHouseholderQr().solve(w_root);
+      for (int k = 0; k < 3; ++k) vtarget[arm_dofs[k]] = v_root[k];
+      for (int k = 0; k < 3; ++k) vtarget[arm_dofs[3 + k]] = rates[k];
+    }
+    for (int d : finger_dofs) target[d] = FingerPosition(gripper_fraction);
+    robot.SetDriveTarget(target);
+    robot.SetDriveVelocityTarget(vtarget);
+    // gravity compensation of the hand (the paper's flying gripper ignores gravity)
+    robot.SetQf(robot.ComputePassiveForce(true, false));
+    scene->Step();
+  }
+  // reward
+  const double p = Progress();
+  const bool touching = TouchesTarget();
+  double r = 10.0 * (p - before);
+  if (p >= options.success_fraction) r += 1.0;
+  if (had_grasp && !touching) r -= 0.1;
+  if (!grasped_once) r -= 0.5 * (TcpPose().p - HandleCentre()).norm();
+  grasped_once = grasped_once || touching;
+  had_grasp = touching;
+  last_progress = p;
+  last_reward = r;
+}
+
+void TaskImpl::TakePictures() {
+  if (cameras.empty()) throw Error("task: TakePictures: this task was made without cameras");
+  scene->UpdateRender();
+  for (Camera& c : cameras) c.TakePicture();
+}
+
+Eigen::VectorXd TaskImpl::RobotState() const {
+  Pose tcp = TcpPose();
+  Eigen::VectorXd out(14);
+  out << tcp.p, tcp.Wxyz(), TcpVelocity(), GripperOpening();
+  return out;
+}
+
+Eigen::VectorXd TaskImpl::RawObservation() const {
+  Eigen::VectorXd q = object.GetQpos(), qd = object.GetQvel(), r = RobotState();
+  Eigen::VectorXd out(q.size() + qd.size() + r.size());
+  out << q, qd, r;
+  return out;
+}
+
+Eigen::VectorXd TaskImpl::MobilityObservation() const {
+  Joint j = object.GetJoint(target_link);
+  Eigen::VectorXd r = RobotState();
+  Eigen::VectorXd out(11 + r.size());
+  out << j.GetGlobalPose().p, j.GetGlobalAxis(), AverageNormal(), j.GetQpos(), j.GetQvel(), r;
+  return out;
+}
+
+}  // namespace internal
+}  // namespace partsim

@@ -1,0 +1,106 @@
+// Internals of the tasks: the episode state behind ArticulationTask, and grasp geometry shared by
+// the task (ground truth) and the heuristic solvers (perception).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "partsim/assets/generator.h"
+#include "partsim/tasks/tasks.h"
+
+namespace partsim::internal {
+
+constexpr double kMaxLinearSpeed = 1.0;   // m/s
+constexpr double kMaxAngularSpeed = 3.0;  // rad/s
+
+/// Ids of the object's links that are task targets (label and a handle).
+std::vector<int> TargetLinks(const GeneratedObject& object, TaskType type);
+/// The object's PartNet-Mobility folder under asset_dir, written if missing.
+std::string EnsureObjectFolder(const GeneratedObject& object, const std::string& asset_dir);
+/// Z-Y-X Euler angles (yaw, pitch, roll) of R nearest to `near`.
+Eigen::Vector3d EulerZyx(const Eigen::Matrix3d& R, const Eigen::Vector3d& near);
+/// Matrix mapping Euler angle rates to angular velocity.
+Eigen::Matrix3d EulerRateMatrix(const Eigen::Vector3d& ypr);
+
+/// A grasp of a handle seen as points: TCP pose with z along -front_normal (approach) and the
+/// fingers closing across the handle's long axis; `depth` is how far the handle stands out.
+struct HandleGrasp {
+  Pose tcp;
+  Eigen::Vector3d centre;
+  Eigen::Vector3d long_axis;
+  double depth = 0.0;
+  bool knob = false;
+};
+/// Grasp of a handle from its points (world), the outward normal of the panel it sits on and a
+/// point of that panel's front face. `fingers_vertical_if_round`: for knobs, close the fingers
+/// along world z (drawers) or horizontally (doors).
+HandleGrasp GraspFromHandlePoints(const std::vector<Eigen::Vector3d>& points,
+                                  const Eigen::Vector3d& front_normal, double face_offset,
+                                  bool fingers_vertical_if_round);
+
+struct TaskImpl {
+  explicit TaskImpl(const TaskOptions& o);
+  void Reset(std::uint64_t seed);
+  double Progress() const;
+  Pose TcpPose() const;
+  Eigen::Matrix<double, 6, 1> TcpVelocity() const;
+  Eigen::VectorXd ArmJointsFor(const Pose& tcp) const;
+  void PlaceGripper(const Pose& tcp, double opening);
+  double FingerPosition(double fraction) const;
+  void SetTcpTarget(const Pose& target);
+  void SetTcpVelocity(const Eigen::Matrix<double, 6, 1>& twist);
+  void SetGripper(double fraction);
+  double GripperOpening() const;
+  bool TouchesTarget() const;
+  void ApplyAction(const Eigen::VectorXd& action);
+  void StepControl();
+  void TakePictures();
+  Eigen::VectorXd RobotState() const;
+  Eigen::VectorXd RawObservation() const;
+  Eigen::VectorXd MobilityObservation() const;
+  /// World points of the target's handle meshes (ground truth).
+  std::vector<Eigen::Vector3d> HandlePoints() const;
+  Eigen::Vector3d HandleCentre() const;
+  /// Outward normal of the target's front (it faces +x at rest).
+  Eigen::Vector3d AverageNormal() const;
+  /// Signed distance of the target's front face along AverageNormal (a point on the face, dotted
+  /// with the normal).
+  double FrontFaceOffset() const;
+  Pose GroundTruthGrasp() const;
+
+  TaskOptions options;
+  std::shared_ptr<Scene> scene;
+  RobotModel robot_model;
+  Articulation robot, object;
+  std::vector<int> candidates;  // link indices of the object
+  std::map<int, uint32_t> entity_ids;
+  std::map<int, std::vector<uint32_t>> handle_visuals;
+  std::vector<int> arm_dofs, finger_dofs, finger_links;
+  int ee_link = -1;
+  std::vector<Camera> cameras;
+  std::vector<char> initial_state;
+  int substeps = 1;
+  double cabinet_half_depth = 0, cabinet_half_width = 0, cabinet_height = 0;
+
+  // episode
+  int target_link = -1;
+  bool closed_at_lower = true;
+  double range = 0.0;
+  double start_time = 0.0;
+  Eigen::Quaterniond rest_orientation = Eigen::Quaterniond::Identity();  // target link at rest
+  Pose tcp_target;
+  Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
+  bool velocity_mode = false;
+  double gripper_fraction = 1.0;
+  double last_progress = 0.0, last_reward = 0.0;
+  bool had_grasp = false, grasped_once = false;
+};
+
+}  // namespace partsim::internal
+
+namespace partsim {
+struct ArticulationTask::Impl : internal::TaskImpl {
+  using internal::TaskImpl::TaskImpl;
+};
+}  // namespace partsim

@@ -1,0 +1,176 @@
+// The drawer and door tasks on generated cabinets: set-up, determinism, bad actions, cameras,
+// a scripted grasp-and-pull and the heuristic solvers.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "partsim/core/error.h"
+#include "partsim/tasks/tasks.h"
+
+namespace partsim {
+namespace {
+
+TaskOptions Options(TaskType type, bool cameras = false) {
+  TaskOptions o;
+  o.type = type;
+  o.object_index = FindTaskObjects(type, 1).front();
+  o.cameras = cameras;
+  return o;
+}
+
+TEST(TaskTest, FindsObjectsWithTargets) {
+  std::vector<int> drawers = FindTaskObjects(TaskType::kPullDrawer, 3);
+  std::vector<int> doors = FindTaskObjects(TaskType::kOpenDoor, 3);
+  ASSERT_EQ(drawers.size(), 3u);
+  ASSERT_EQ(doors.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(drawers.begin(), drawers.end()));
+  for (int i : drawers) {
+    TaskOptions o = Options(TaskType::kPullDrawer);
+    o.object_index = i;
+    ArticulationTask task(o);
+    EXPECT_FALSE(task.GetTargetCandidates().empty());
+    EXPECT_EQ(task.GetTargetLink().GetDesc().semantic_label, "drawer");
+    EXPECT_FALSE(task.GetHandleVisualIds().empty());
+  }
+}
+
+TEST(TaskTest, RejectsObjectsWithoutTargetsAndBadOptions) {
+  // an object with doors only has no drawer target
+  std::vector<int> drawers = FindTaskObjects(TaskType::kPullDrawer, 30);
+  int no_drawer = 0;
+  while (std::find(drawers.begin(), drawers.end(), no_drawer) != drawers.end()) ++no_drawer;
+  ASSERT_LT(no_drawer, drawers.back());
+  TaskOptions o = Options(TaskType::kPullDrawer);
+  o.object_index = no_drawer;
+  try {
+    ArticulationTask task(o);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("has no drawer"), std::string::npos) << e.what();
+  }
+  o = Options(TaskType::kPullDrawer);
+  o.target = 99;
+  EXPECT_THROW(ArticulationTask{o}, Error);
+  o = Options(TaskType::kPullDrawer);
+  o.control_rate = 1000.0;  // above the physics rate
+  EXPECT_THROW(ArticulationTask{o}, Error);
+  EXPECT_THROW(ParseTaskType("window"), Error);
+}
+
+TEST(TaskTest, ResetIsDeterministicAndClosed) {
+  ArticulationTask task(Options(TaskType::kPullDrawer));
+  task.Reset(7);
+  Pose a = task.GetTcpPose();
+  std::string target = task.GetTargetLink().GetName();
+  EXPECT_NEAR(task.GetProgress(), 0.0, 1e-6);
+  EXPECT_FALSE(task.IsSuccess());
+  EXPECT_NEAR(task.GetGripperOpening(), 1.0, 1e-6);
+  for (int i = 0; i < 10; ++i) task.Step();
+  task.Reset(8);
+  Pose b = task.GetTcpPose();
+  task.Reset(7);
+  Pose c = task.GetTcpPose();
+  EXPECT_EQ(task.GetTargetLink().GetName(), target);
+  EXPECT_LT((a.p - c.p).norm(), 1e-12);
+  EXPECT_GT((a.p - b.p).norm(), 1e-4);
+  EXPECT_NEAR(task.GetElapsed(), 0.0, 1e-12);
+  // the gripper floats where it is (gravity compensation): 1 s with no command
+  for (int i = 0; i < 50; ++i) task.Step();
+  EXPECT_LT((task.GetTcpPose().p - c.p).norm(), 2e-3);
+  EXPECT_NEAR(task.GetElapsed(), 1.0, 1e-9);
+}
+
+TEST(TaskTest, VelocityControlMovesTheTcp) {
+  ArticulationTask task(Options(TaskType::kPullDrawer));
+  task.Reset(1);
+  Pose start = task.GetTcpPose();
+  Eigen::Matrix<double, 6, 1> twist;
+  twist << 0, 0.1, 0, 0, 0, 0.5;
+  task.SetTcpVelocity(twist);
+  for (int i = 0; i < 50; ++i) task.Step();  // 1 s
+  Pose end = task.GetTcpPose();
+  EXPECT_NEAR(end.p.y() - start.p.y(), 0.1, 5e-3);
+  EXPECT_NEAR(end.p.x() - start.p.x(), 0.0, 3e-3);
+  EXPECT_NEAR(start.q.angularDistance(end.q), 0.5, 0.02);
+  // a speed above the documented clamp is clamped to 1 m/s
+  twist << 5, 0, 0, 0, 0, 0;
+  task.SetTcpVelocity(twist);
+  Pose p0 = task.GetTcpPose();
+  for (int i = 0; i < 10; ++i) task.Step();  // 0.2 s
+  EXPECT_NEAR((task.GetTcpPose().p - p0.p).norm(), 0.2, 0.02);
+}
+
+TEST(TaskTest, BadActionsThrowAndChangeNothing) {
+  ArticulationTask task(Options(TaskType::kPullDrawer));
+  task.Reset(3);
+  std::vector<char> before = task.GetScene().Pack();
+  EXPECT_THROW(task.ApplyAction(Eigen::VectorXd::Zero(6)), Error);
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(7);
+  a[2] = std::nan("");
+  EXPECT_THROW(task.ApplyAction(a), Error);
+  a[2] = INFINITY;
+  EXPECT_THROW(task.ApplyAction(a), Error);
+  EXPECT_THROW(task.SetTcpTarget(Pose(Eigen::Vector3d(NAN, 0, 0))), Error);
+  EXPECT_EQ(task.GetScene().Pack(), before);
+  task.Step();  // still steps normally
+  EXPECT_LT((task.GetTcpPose().p).norm(), 10.0);
+}
+
+TEST(TaskTest, CamerasSeeTheTargetAndItsHandle) {
+  ArticulationTask task(Options(TaskType::kPullDrawer, true));
+  task.Reset(0);
+  task.TakePictures();
+  ASSERT_EQ(task.GetCameras().size(), 3u);
+  std::vector<uint32_t> handles = task.GetHandleVisualIds();
+  for (const char* name : {"left", "right", "front"}) {
+    const Picture& pic = task.GetCamera(name).GetPictureData();
+    int target = 0, handle = 0;
+    for (size_t i = 0; i < pic.segmentation.size() / 2; ++i) {
+      target += pic.segmentation[2 * i + 1] == task.GetTargetEntityId();
+      handle += std::count(handles.begin(), handles.end(), pic.segmentation[2 * i]) > 0;
+    }
+    EXPECT_GT(target, 50) << name;
+    EXPECT_GT(handle, 3) << name;
+  }
+  EXPECT_THROW(task.GetCamera("top"), Error);
+}
+
+TEST(TaskTest, ScriptedGraspAndPullOpensADrawer) {
+  TaskOptions o = Options(TaskType::kPullDrawer);
+  o.init_on_handle = true;
+  ArticulationTask task(o);
+  task.Reset(0);
+  EXPECT_TRUE(task.GripperTouchesTarget());
+  Eigen::Vector3d axis = task.GetTargetJoint().GetGlobalAxis();
+  Eigen::VectorXd action = Eigen::VectorXd::Zero(7);
+  action.head<3>() = 0.15 * axis;
+  action[6] = -1.0;  // keep closed
+  double reward = 0.0;
+  for (int i = 0; i < 200 && !task.IsSuccess(); ++i) {
+    task.ApplyAction(action);
+    task.Step();
+    reward += task.GetReward();
+  }
+  EXPECT_TRUE(task.IsSuccess()) << "progress " << task.GetProgress();
+  EXPECT_GT(reward, 8.0);  // 10 x 0.9 of the range, minus nothing: the grasp held
+  EXPECT_TRUE(task.GripperTouchesTarget());
+}
+
+TEST(TaskTest, HeuristicSolverPullsADrawerFromItsPointCloud) {
+  ArticulationTask task(Options(TaskType::kPullDrawer, true));
+  task.Reset(0);
+  SolverResult r = SolvePullDrawer(task);
+  EXPECT_TRUE(r.success) << r.stage << ": " << r.message << " progress " << r.progress;
+  EXPECT_THROW(SolveOpenDoor(task), Error);
+}
+
+TEST(TaskTest, HeuristicSolverOpensADoorFromItsPointCloud) {
+  ArticulationTask task(Options(TaskType::kOpenDoor, true));
+  task.Reset(0);
+  SolverResult r = SolveOpenDoor(task);
+  EXPECT_TRUE(r.success) << r.stage << ": " << r.message << " progress " << r.progress;
+}
+
+}  // namespace
+}  // namespace partsim
