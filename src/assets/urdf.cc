@@ -308,6 +308,21 @@ void Parser::ReadCollision(const XMLElement* c, const std::string& link, LinkDes
   // density and material: per-link override, else the loader's defaults
   shape.density = loader_.density;
   shape.material = loader_.material;
+  // partsim's density and contact material (written by WriteUrdf) replace the defaults
+  if (const XMLElement* p = c->FirstChildElement("partsim:collision")) {
+    const std::string at = where + " <partsim:collision>";
+    shape.density = Number(p, "density", shape.density, where);
+    if (!(shape.density > 0)) Fail(at + " density must be > 0");
+    if (p->Attribute("static_friction") != nullptr) {
+      PhysicalMaterial m;
+      m.static_friction = Number(p, "static_friction", std::nullopt, where);
+      m.dynamic_friction = Number(p, "dynamic_friction", m.static_friction, where);
+      m.restitution = Number(p, "restitution", 0.0, where);
+      if (m.static_friction < 0 || m.dynamic_friction < 0) Fail(at + " friction is negative");
+      if (m.restitution < 0 || m.restitution > 1) Fail(at + " restitution is not in [0, 1]");
+      shape.material = m;
+    }
+  }
   auto ov = loader_.link_overrides.find(link);
   if (ov != loader_.link_overrides.end()) {
     if (ov->second.density) shape.density = *ov->second.density;
@@ -493,6 +508,24 @@ JointDesc Parser::ReadJoint(const RawJoint& raw, ArticulationDesc* desc) {
     j.friction = Number(d, "friction", 0.0, where);
     if (j.damping < 0) Fail(where + " <dynamics damping> is negative");
     if (j.friction < 0) Fail(where + " <dynamics friction> is negative");
+  }
+
+  // partsim's drive (written by WriteUrdf): gains, force limit, targets and rotor inertia;
+  // prismatic targets scale with the robot
+  if (const XMLElement* d = e->FirstChildElement("partsim:drive")) {
+    if (j.type == JointType::kFixed) Fail(where + " is fixed and cannot have <partsim:drive>");
+    const std::string at = where + " <partsim:drive>";
+    j.drive.stiffness = Number(d, "stiffness", 0.0, where);
+    j.drive.damping = Number(d, "damping", 0.0, where);
+    j.drive.force_limit = Number(d, "force_limit", j.drive.force_limit, where);
+    const double s = j.type == JointType::kPrismatic ? loader_.scale : 1.0;
+    j.drive.target = Number(d, "target", 0.0, where) * s;
+    j.drive.velocity_target = Number(d, "velocity_target", 0.0, where) * s;
+    j.armature = Number(d, "armature", 0.0, where);
+    if (j.drive.stiffness < 0) Fail(at + " stiffness is negative");
+    if (j.drive.damping < 0) Fail(at + " damping is negative");
+    if (!(j.drive.force_limit > 0)) Fail(at + " force_limit must be > 0");
+    if (j.armature < 0) Fail(at + " armature is negative");
   }
 
   // mimic: a coupling; prismatic lengths scale with the robot

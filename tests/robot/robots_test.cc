@@ -3,10 +3,14 @@
 #include "partsim/robot/robots.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
 
+#include "partsim/assets/urdf.h"
 #include "partsim/physics/scene.h"
 
 namespace partsim {
@@ -339,6 +343,288 @@ TEST(RobotsPandaTest, HoldsHomeUnderGravityAndMovesItsFingers) {
   StepCompensated(&scene, &art, 500);
   EXPECT_NEAR(art.GetQpos()[Dof(art, "panda_finger_joint1")], 0.0, 1e-3);
   EXPECT_NEAR(art.GetQpos()[Dof(art, "panda_finger_joint2")], 0.0, 1e-3);
+}
+
+// ---------------------------------------------------------------- URDF writing
+
+// A fresh folder under the system's temporary folder, removed at the end of the test.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() /
+              ("partsim_robots_test_" + name + "_" + std::to_string(::getpid()))) {
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  std::string operator/(const std::string& file) const { return (path_ / file).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Compares an articulation read back from URDF with the one written: joints (types, limits,
+// damping, friction, armature, drives), couplings, link masses and link poses at random q.
+void ExpectSameArticulation(Scene* scene, const Articulation& original,
+                            const Articulation& loaded) {
+  ASSERT_EQ(original.Dof(), loaded.Dof());
+  ASSERT_EQ(original.GetLinks().size(), loaded.GetLinks().size());
+  EXPECT_EQ(original.HasFixedRoot(), loaded.HasFixedRoot());
+  for (const Link& l : original.GetLinks()) {
+    const Link m = loaded.FindLinkByName(l.GetName());
+    EXPECT_NEAR(m.GetMass(), l.GetMass(), 1e-6 * l.GetMass()) << l.GetName();
+  }
+  std::vector<Joint> a = original.GetActiveJoints(), b = loaded.GetActiveJoints();
+  for (size_t k = 0; k < a.size(); ++k) {
+    const std::string& name = a[k].GetName();
+    EXPECT_EQ(b[k].GetName(), name);
+    EXPECT_EQ(b[k].GetType(), a[k].GetType()) << name;
+    EXPECT_EQ(b[k].GetLimits(), a[k].GetLimits()) << name;
+    EXPECT_EQ(b[k].GetDamping(), a[k].GetDamping()) << name;
+    EXPECT_EQ(b[k].GetFriction(), a[k].GetFriction()) << name;
+    EXPECT_EQ(b[k].GetArmature(), a[k].GetArmature()) << name;
+    EXPECT_EQ(b[k].GetDriveStiffness(), a[k].GetDriveStiffness()) << name;
+    EXPECT_EQ(b[k].GetDriveDamping(), a[k].GetDriveDamping()) << name;
+    EXPECT_EQ(b[k].GetDriveForceLimit(), a[k].GetDriveForceLimit()) << name;
+  }
+  EXPECT_EQ(loaded.GetDesc().couplings.size(), original.GetDesc().couplings.size());
+  std::mt19937 rng(11);
+  const Eigen::MatrixX2d limits = original.GetQlimits();
+  double worst = 0;
+  for (int trial = 0; trial < 5; ++trial) {
+    VectorXd q(original.Dof());
+    for (int i = 0; i < q.size(); ++i) {
+      const double lo = std::max(limits(i, 0), -3.0), hi = std::min(limits(i, 1), 3.0);
+      q[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
+    }
+    Articulation o = original, m = loaded;
+    o.SetQpos(q);
+    m.SetQpos(q);
+    for (const Link& l : original.GetLinks()) {
+      const Pose x = l.GetPose(), y = loaded.FindLinkByName(l.GetName()).GetPose();
+      EXPECT_LT((x.p - y.p).norm(), 1e-9) << l.GetName();
+      EXPECT_LT(AngleBetween(x.q, y.q), 1e-9) << l.GetName();
+      worst = std::max({worst, (x.p - y.p).norm(), AngleBetween(x.q, y.q)});
+    }
+  }
+  testing::Test::RecordProperty("worst_pose_difference_" + original.GetName(),
+                                testing::PrintToString(worst));
+}
+
+TEST(RobotsUrdfTest, RoundTripKeepsKinematicsMassesLimitsAndDrives) {
+  TempDir dir("roundtrip");
+  RobotModel gripper = BuildFlyingGripper();
+  gripper.articulation.root_pose =
+      Pose(Vector3d(0.1, 0.2, 0.5), Quaterniond(AngleAxisd(0.3, Vector3d(1, 1, 0).normalized())));
+  for (const RobotModel& robot : {BuildPanda(), gripper}) {
+    const std::string path = dir / (robot.articulation.name + ".urdf");
+    WriteUrdf(robot.articulation, path);
+    Scene scene;
+    Articulation original = scene.AddArticulation(robot.articulation);
+    Articulation loaded = scene.CreateUrdfLoader().Load(path);
+    EXPECT_EQ(loaded.GetName(), robot.articulation.name);
+    ExpectSameArticulation(&scene, original, loaded);
+    // the pads keep their friction
+    const LinkDesc& finger = loaded.FindLinkByName(robot.articulation.links.back().name).GetDesc();
+    ASSERT_TRUE(finger.collisions.back().material.has_value());
+    EXPECT_EQ(finger.collisions.back().material->static_friction,
+              robot.articulation.links.back().collisions.back().material->static_friction);
+  }
+}
+
+TEST(RobotsUrdfTest, FlyingGripperFromUrdfReachesAPoseTarget) {
+  TempDir dir("gripper");
+  RobotModel robot = BuildFlyingGripper();
+  WriteUrdf(robot.articulation, dir / "gripper.urdf");
+  Scene scene;
+  Articulation art = scene.CreateUrdfLoader().Load(dir / "gripper.urdf");
+  const Pose target(Vector3d(-0.2, 0.1, 0.3), Quaterniond(AngleAxisd(-0.5, Vector3d::UnitZ()) *
+                                                          AngleAxisd(0.3, Vector3d::UnitY()) *
+                                                          AngleAxisd(-0.8, Vector3d::UnitX())));
+  std::vector<double> arm = FlyingGripperIk(target);
+  VectorXd q = VectorXd::Zero(art.Dof());
+  for (int k = 0; k < 6; ++k) q[Dof(art, robot.arm_joints[k])] = arm[k];
+  art.SetDriveTarget(q);
+  StepCompensated(&scene, &art, 1000);
+  const Pose tcp = TcpPose(art, robot);
+  EXPECT_LT((tcp.p - target.p).norm(), 0.002);
+  EXPECT_LT(AngleBetween(tcp.q, target.q), M_PI / 180);
+}
+
+TEST(RobotsUrdfTest, MeshesOffsetJointsAndFreeRootsRoundTrip) {
+  // a free root with a convex mesh, a revolute joint whose axis misses the child's origin, and
+  // a coupled prismatic joint
+  auto mesh = std::make_shared<MeshData>();
+  mesh->vertices = {{0, 0, 0}, {0.1f, 0, 0}, {0, 0.1f, 0}, {0, 0, 0.1f}};
+  mesh->faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  ArticulationDesc art;
+  art.name = "odd";
+  art.fix_root = false;
+  art.root_pose = Pose(Vector3d(0, 0, 1));
+  LinkDesc base;
+  base.name = "base";
+  CollisionShape hull;
+  hull.type = ShapeType::kConvexMesh;
+  hull.mesh = mesh;
+  base.collisions.push_back(hull);
+  base.inertial = Inertial();
+  art.links.push_back(base);
+  LinkDesc arm;
+  arm.name = "arm";
+  arm.parent = 0;
+  arm.joint.name = "hinge";
+  arm.joint.type = JointType::kRevolute;
+  arm.joint.lower = -1;
+  arm.joint.upper = 2;
+  arm.joint.pose_in_parent =
+      Pose(Vector3d(0.2, 0, 0), Quaterniond(AngleAxisd(0.4, Vector3d(0, 1, 1).normalized())));
+  arm.joint.pose_in_child =
+      Pose(Vector3d(-0.1, 0.05, 0.02), Quaterniond(AngleAxisd(1.0, Vector3d::UnitZ())));
+  arm.joint.damping = 0.3;
+  arm.joint.friction = 0.1;
+  CollisionShape rod;
+  rod.type = ShapeType::kCylinder;
+  rod.radius = 0.02;
+  rod.half_length = 0.1;
+  rod.pose = Pose(Vector3d(0.1, 0, 0));
+  arm.collisions.push_back(rod);
+  art.links.push_back(arm);
+  for (const char* name : {"slide_a", "slide_b"}) {
+    LinkDesc s;
+    s.name = std::string(name) + "_link";
+    s.parent = 1;
+    s.joint.name = name;
+    s.joint.type = JointType::kPrismatic;
+    s.joint.lower = 0;
+    s.joint.upper = 0.1;
+    s.joint.pose_in_parent = Pose(Vector3d(0.1, 0, 0));
+    CollisionShape ball;
+    ball.type = ShapeType::kSphere;
+    ball.radius = 0.01;
+    s.collisions.push_back(ball);
+    art.links.push_back(s);
+  }
+  art.couplings.push_back({"slide_b", "slide_a", -1.0, 0.05});
+
+  TempDir dir("odd");
+  WriteUrdf(art, dir / "odd.urdf");
+  EXPECT_TRUE(std::filesystem::exists(dir / "odd_meshes"));
+  Scene scene;
+  scene.SetGravity(Vector3d::Zero());
+  Articulation original = scene.AddArticulation(art);
+  Articulation loaded = scene.CreateUrdfLoader().Load(dir / "odd.urdf");
+  EXPECT_FALSE(loaded.HasFixedRoot());
+  const LinkDesc& b = loaded.FindLinkByName("base").GetDesc();
+  ASSERT_EQ(b.collisions.size(), 1u);
+  EXPECT_EQ(b.collisions[0].type, ShapeType::kConvexMesh);
+  // the same points (the OBJ reader may repeat a vertex per face)
+  for (const Eigen::Vector3f& v : b.collisions[0].mesh->vertices) {
+    double nearest = 1;
+    for (const Eigen::Vector3f& w : mesh->vertices)
+      nearest = std::min(nearest, double((v - w).norm()));
+    EXPECT_LT(nearest, 1e-7);
+  }
+  for (const Eigen::Vector3f& w : mesh->vertices) {
+    double nearest = 1;
+    for (const Eigen::Vector3f& v : b.collisions[0].mesh->vertices)
+      nearest = std::min(nearest, double((v - w).norm()));
+    EXPECT_LT(nearest, 1e-7);
+  }
+  EXPECT_EQ(loaded.Dof(), 2);
+  // the hinge's URDF link frame sits on the joint axis: compare the arm's joint frame, and the
+  // links whose frames did not move
+  Articulation o = original, m = loaded;
+  for (double angle : {0.0, 0.7, -0.9}) {
+    VectorXd q(2);
+    q << angle, 0.03;
+    o.SetQpos(q);
+    m.SetQpos(q);
+    for (const char* link : {"base", "slide_a_link", "slide_b_link"}) {
+      const Pose x = original.FindLinkByName(link).GetPose(),
+                 y = loaded.FindLinkByName(link).GetPose();
+      EXPECT_LT((x.p - y.p).norm(), 1e-9) << link;
+      EXPECT_LT(AngleBetween(x.q, y.q), 1e-9) << link;
+    }
+    const Pose x = original.FindJointByName("hinge").GetGlobalPose();
+    const Pose y = loaded.FindJointByName("hinge").GetGlobalPose();
+    EXPECT_LT((x.p - y.p).norm(), 1e-9);
+    EXPECT_LT((x.q * Vector3d::UnitX() - y.q * Vector3d::UnitX()).norm(), 1e-9);
+  }
+}
+
+TEST(RobotsUrdfTest, ErrorsNameTheFileOrElement) {
+  RobotModel robot = BuildFlyingGripper();
+  try {
+    WriteUrdf(robot.articulation, "/nonexistent_folder/sub/gripper.urdf");
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent_folder/sub/gripper.urdf"), std::string::npos)
+        << e.what();
+  }
+  // a mesh needs a folder to go to
+  ArticulationDesc art;
+  art.name = "m";
+  LinkDesc l;
+  l.name = "only";
+  CollisionShape hull;
+  hull.type = ShapeType::kConvexMesh;
+  auto mesh = std::make_shared<MeshData>();
+  mesh->vertices = {{0, 0, 0}, {0.1f, 0, 0}, {0, 0.1f, 0}, {0, 0, 0.1f}};
+  mesh->faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  hull.mesh = mesh;
+  l.collisions.push_back(hull);
+  art.links.push_back(l);
+  EXPECT_THROW(ArticulationToUrdf(art), Error);
+}
+
+// The loader reads <partsim:drive> on joints and <partsim:collision> on collisions.
+TEST(RobotsUrdfTest, LoaderReadsPartsimDriveAndCollisionElements) {
+  const std::string urdf = R"(<?xml version="1.0"?>
+<robot name="r" xmlns:partsim="https://partsim.dev/urdf">
+  <link name="a"><collision><geometry><box size="0.1 0.1 0.1"/></geometry>
+    <partsim:collision density="500" static_friction="1.7" dynamic_friction="1.1" restitution="0.2"/>
+  </collision></link>
+  <link name="b"><collision><geometry><sphere radius="0.05"/></geometry></collision></link>
+  <joint name="j" type="prismatic"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+    <limit lower="0" upper="0.2" effort="30" velocity="1"/>
+    <partsim:drive stiffness="800" damping="40" force_limit="25" target="0.1" armature="0.02"/>
+  </joint>
+</robot>)";
+  UrdfLoader loader;
+  ArticulationDesc desc = loader.Parse(urdf, ".", "drive.urdf");
+  const JointDesc& j = desc.links[1].joint;
+  EXPECT_EQ(j.drive.stiffness, 800);
+  EXPECT_EQ(j.drive.damping, 40);
+  EXPECT_EQ(j.drive.force_limit, 25);
+  EXPECT_EQ(j.drive.target, 0.1);
+  EXPECT_EQ(j.armature, 0.02);
+  const CollisionShape& c = desc.links[0].collisions[0];
+  EXPECT_EQ(c.density, 500);
+  ASSERT_TRUE(c.material.has_value());
+  EXPECT_EQ(c.material->static_friction, 1.7);
+  EXPECT_EQ(c.material->dynamic_friction, 1.1);
+  EXPECT_EQ(c.material->restitution, 0.2);
+  // without the element: the loader's defaults, the effort limit as force limit
+  std::string plain = urdf;
+  plain.erase(plain.find("<partsim:drive"),
+              plain.find("/>", plain.find("<partsim:drive")) + 2 - plain.find("<partsim:drive"));
+  EXPECT_EQ(loader.Parse(plain, ".").links[1].joint.drive.force_limit, 30);
+  EXPECT_EQ(loader.Parse(plain, ".").links[1].joint.drive.stiffness, 0);
+
+  std::string bad = urdf;
+  bad.replace(bad.find("stiffness=\"800\""), 15, "stiffness=\"-1\"");
+  try {
+    loader.Parse(bad, ".", "drive.urdf");
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("drive.urdf"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("joint 'j'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("stiffness"), std::string::npos) << msg;
+  }
 }
 
 }  // namespace
