@@ -18,7 +18,9 @@ inline Eigen::Quaterniond XToY() {
 }
 
 /// A fixed-base 7-dof arm standing up along z at `root`: joints z, y, z, prismatic z (0 to
-/// 0.15 m), y, z, y, then a fixed "hand" link 0.1 m beyond the last joint. Reach about 1.3 m.
+/// 0.15 m), y, z, y, then a fixed "hand" link 0.1 m beyond the last joint: 1.26 m from the shoulder
+/// (j2, 0.3 m above the root) to the hand. The base box stays clear of link1 (a link welded to
+/// the world collides with its child).
 /// The last joint has a pose_in_child with an offset and a rotation.
 inline Articulation AddArm7(Scene& scene, const Pose& root = Pose(),
                             const std::string& name = "arm7") {
@@ -27,8 +29,8 @@ inline Articulation AddArm7(Scene& scene, const Pose& root = Pose(),
   b.SetInitialPose(root);
   const Eigen::Quaterniond z = XToZ(), y = XToY();
   LinkBuilder* base = b.CreateLinkBuilder();
-  base->SetName("base").AddBoxCollision(Pose(Eigen::Vector3d(0, 0, 0.05)),
-                                        Eigen::Vector3d(0.08, 0.08, 0.05));
+  base->SetName("base").AddBoxCollision(Pose(Eigen::Vector3d(0, 0, 0.025)),
+                                        Eigen::Vector3d(0.08, 0.08, 0.025));
   struct J {
     const char* name;
     JointType type;
@@ -40,8 +42,8 @@ inline Articulation AddArm7(Scene& scene, const Pose& root = Pose(),
                       {"j3", JointType::kRevolute, z, -2.9, 2.9, 0.3, 0.1},
                       {"j4", JointType::kPrismatic, z, 0.0, 0.15, 0.1, 0.25},
                       {"j5", JointType::kRevolute, y, -2.5, 2.5, 0.25, 0.2},
-                      {"j6", JointType::kRevolute, z, -2.9, 2.9, 0.2, 0.1},
-                      {"j7", JointType::kRevolute, y, -2.0, 2.0, 0.1, 0.1}};
+                      {"j6", JointType::kRevolute, z, -2.9, 2.9, 0.2, 0.16},
+                      {"j7", JointType::kRevolute, y, -2.0, 2.0, 0.16, 0.1}};
   LinkBuilder* parent = base;
   for (int i = 0; i < 7; ++i) {
     const J& j = joints[i];
@@ -78,7 +80,7 @@ inline Articulation AddPlanar2(Scene& scene, double l1 = 0.5, double l2 = 0.4, d
   b.SetName("planar");
   const Eigen::Quaterniond z = XToZ();
   LinkBuilder* base = b.CreateLinkBuilder();
-  base->SetName("base").AddSphereCollision(Pose(), 0.03);
+  base->SetName("base");  // no shape: it would collide with the upper arm
   LinkBuilder* a = b.CreateLinkBuilder(base);
   a->SetName("upper")
       .SetJointName("shoulder")

@@ -85,10 +85,13 @@ class Controller {
 };
 
 /// Applies joint efforts (N m or N), clamped to +-force_limit (documented clamp: the status
-/// message says which were clamped), plus gravity compensation if enabled.
+/// message says which were clamped), plus gravity compensation if enabled. The controlled
+/// joints' drives are switched off. With no target yet it applies only the compensation; once
+/// a target is set the status is kReached (there is nothing to wait for).
 class JointEffortController : public Controller {
  public:
-  using Controller::Controller;
+  JointEffortController(const Articulation& robot, const std::vector<std::string>& joints,
+                        const JointControllerOptions& options);
   void SetTarget(const Eigen::VectorXd& effort);
   void Update() override;
 
@@ -97,7 +100,8 @@ class JointEffortController : public Controller {
 };
 
 /// PD position control through the joints' drives. A target outside the joint limits is clamped
-/// to them and the status is kFailed (naming the joint): the robot goes as far as it can.
+/// to them and the status is kFailed (naming the joint): the robot goes as far as it can. Until
+/// the first target it holds the position it had when constructed.
 class JointPositionController : public Controller {
  public:
   JointPositionController(const Articulation& robot, const std::vector<std::string>& joints,
@@ -108,7 +112,7 @@ class JointPositionController : public Controller {
 
  private:
   Eigen::VectorXd target_;
-  double elapsed_ = 0.0;
+  double set_time_ = 0.0;  ///< scene time of the target (or of returning to it)
 };
 
 /// Velocity control through the joints' drives (stiffness 0, the given damping as gain). A
@@ -122,7 +126,7 @@ class JointVelocityController : public Controller {
 
  private:
   Eigen::VectorXd target_;
-  double elapsed_ = 0.0;
+  double ok_time_ = 0.0;  ///< last scene time the velocity was within tolerance (or set)
 };
 
 /// Follows a JointTrajectory (times from the moment it is set) with the drives' PD on the
@@ -152,16 +156,23 @@ enum class ControlFrame { kWorld, kBase };
 
 /// End-effector control: a target pose or twist of a frame on a link, turned into joint position
 /// targets by damped least-squares IK each update. A pose target that InverseKinematics cannot
-/// reach sets kFailed and leaves the robot where it is.
+/// reach sets kFailed and leaves the robot where it is. A pose target is approached along a
+/// commanded pose that moves at most max_linear_speed / max_angular_speed; kReached when the
+/// measured frame is within position_tolerance and rotation_tolerance and the joints have
+/// settled, kFailed if that has not happened `timeout` after the commanded pose arrived. A twist
+/// beyond the speed limits is scaled down (said in the message); a twist that drives the frame
+/// out of reach stops it there with kFailed.
 class EndEffectorController : public Controller {
  public:
   /// `ee_link`: the link to move; `tcp`: the controlled frame on it.
   EndEffectorController(const Articulation& robot, const std::vector<std::string>& joints,
                         const std::string& ee_link, const Pose& tcp,
                         const JointControllerOptions& options);
-  IkOptions ik;                    ///< IK settings used for pose targets
-  double max_linear_speed = 0.5;   ///< m/s, pose targets are approached no faster
-  double max_angular_speed = 1.5;  ///< rad/s
+  IkOptions ik;                        ///< IK settings used for pose targets
+  double max_linear_speed = 0.5;       ///< m/s, pose targets are approached no faster
+  double max_angular_speed = 1.5;      ///< rad/s
+  double position_tolerance = 2e-3;    ///< m, of the measured frame, for kReached
+  double rotation_tolerance = 1.5e-2;  ///< rad, of the measured frame, for kReached
   void SetTargetPose(const Pose& target, ControlFrame frame = ControlFrame::kWorld);
   /// Linear (m/s) and angular (rad/s) velocity, stacked; held until changed.
   void SetTargetTwist(const Eigen::Matrix<double, 6, 1>& twist,
@@ -183,14 +194,18 @@ class ControlLoop {
   void Add(std::shared_ptr<Controller> controller);
   void Remove(const std::shared_ptr<Controller>& controller);
   void Step(int n = 1);
-  /// Steps until all controllers are kReached or kFailed, or `max_seconds` pass; returns
-  /// whether all reached.
+  /// Steps until all controllers are kReached, kFailed or kIdle, or `max_seconds` pass;
+  /// returns whether they all are and none failed.
   bool RunUntilDone(double max_seconds);
   Scene* GetScene() const { return scene_; }
 
  private:
+  struct Entry {
+    std::shared_ptr<Controller> controller;
+    long long next_update;  ///< step count of its next update
+  };
   Scene* scene_;
-  std::vector<std::shared_ptr<Controller>> controllers_;
+  std::vector<Entry> entries_;
   long long step_count_ = 0;
 };
 
