@@ -18,6 +18,7 @@ Example::
 from __future__ import annotations
 
 import concurrent.futures
+import numbers
 from typing import Any
 
 import numpy as np
@@ -71,7 +72,7 @@ class Box:
         if not isinstance(x, np.ndarray):
             try:
                 x = np.asarray(x, dtype=self.dtype)
-            except (ValueError, TypeError):
+            except (ValueError, TypeError, OverflowError):
                 return False
         return bool(
             np.can_cast(x.dtype, self.dtype)
@@ -127,8 +128,23 @@ class Dict:
     def __getitem__(self, key):
         return self.spaces[key]
 
+    def __iter__(self):
+        return iter(self.spaces)
+
+    def __len__(self):
+        return len(self.spaces)
+
     def keys(self):
         return self.spaces.keys()
+
+    def values(self):
+        return self.spaces.values()
+
+    def items(self):
+        return self.spaces.items()
+
+    def __eq__(self, other):
+        return isinstance(other, Dict) and self.spaces == other.spaces
 
     def __repr__(self):
         return "Dict(" + ", ".join(f"{k!r}: {s}" for k, s in self.spaces.items()) + ")"
@@ -194,7 +210,7 @@ class OpenCabinetEnv:
         self.max_episode_steps = int(max_episode_steps)
         if objects is None:
             objects = _ps.find_task_objects(self.task_type, 1, dataset_seed)
-        elif isinstance(objects, int):
+        elif isinstance(objects, numbers.Integral):
             objects = [objects]
         self.objects = [int(o) for o in objects]
         if not self.objects:
@@ -212,7 +228,8 @@ class OpenCabinetEnv:
             o.camera_width, o.camera_height = int(camera_size[0]), int(camera_size[1])
             o.render_backend = render_backend
             self._options.append(o)
-        self._tasks: dict[int, Any] = {}
+        # one task per (object, target), target -1 meaning "drawn by reset's seed"
+        self._tasks: dict[tuple[int, int], Any] = {}
         self._task = None
         self._steps = 0
         self._np_random = np.random.default_rng()
@@ -255,7 +272,8 @@ class OpenCabinetEnv:
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         """Starts an episode. ``seed`` reseeds the environment's generator (same seed, same
         episode); ``options`` may hold ``object`` (an index into ``objects``) and ``target`` (a
-        drawer or door of that object)."""
+        drawer or door of that object). Options apply to this episode only: a later reset
+        without them draws the object and the target from the generator again."""
         self._check_open()
         if seed is not None:
             self._np_random = np.random.default_rng(seed)
@@ -268,18 +286,21 @@ class OpenCabinetEnv:
         k = options.get("object")
         if k is None:
             k = int(self._np_random.integers(len(self.objects)))
-        if not 0 <= k < len(self.objects):
+        if not isinstance(k, numbers.Integral) or not 0 <= k < len(self.objects):
             raise ValueError(f"reset: options['object'] = {k} is not in [0, {len(self.objects)})")
-        if k not in self._tasks:
+        k = int(k)
+        target = options.get("target", -1)
+        if not isinstance(target, numbers.Integral) or target < -1:
+            raise ValueError(f"reset: options['target'] = {target} is not a target index")
+        key = (k, int(target))
+        if key not in self._tasks:
             opts = self._options[k]
-            if "target" in options:
-                opts.target = int(options["target"])
-            self._tasks[k] = _ps.ArticulationTask(opts)
-        elif "target" in options:
-            opts = self._options[k]
-            opts.target = int(options["target"])
-            self._tasks[k] = _ps.ArticulationTask(opts)
-        self._task = self._tasks[k]
+            opts.target = key[1]
+            try:  # an out-of-range target raises PartsimError, a ValueError
+                self._tasks[key] = _ps.ArticulationTask(opts)
+            finally:
+                opts.target = -1
+        self._task = self._tasks[key]
         self._task.reset(int(self._np_random.integers(0, 2**62)))
         self._steps = 0
         return self._observation(), self._info()
@@ -308,13 +329,13 @@ class OpenCabinetEnv:
 
     def render(self):
         """The front camera's colour as (h, w, 3) uint8 (render_mode 'rgb_array')."""
+        self._check_open()
         if self.render_mode != "rgb_array":
             return None
-        self._check_open()
         if self._task is None:
             raise RuntimeError("render called before reset")
         if self.obs_mode != "visual" or self._last_picture_step != self._steps:
-            self._task.take_pictures()
+            self._front_picture()
         return np.ascontiguousarray(self._task.get_camera("front").get_color_rgba8()[:, :, :3])
 
     def close(self):
@@ -336,6 +357,14 @@ class OpenCabinetEnv:
     def _check_open(self):
         if self._closed:
             raise RuntimeError("the environment is closed")
+
+    def _front_picture(self):
+        """Renders the front camera only (the task's take_pictures renders all three, four
+        times the work) and returns that camera."""
+        self._task.scene.update_render()
+        cam = self._task.get_camera("front")
+        cam.take_picture()
+        return cam
 
     def _info(self) -> dict:
         t = self._task
@@ -364,9 +393,8 @@ class OpenCabinetEnv:
             return out
         if self.obs_mode == "mobility":
             return np.asarray(t.get_mobility_observation(), dtype=np.float32)
-        t.take_pictures()
+        cam = self._front_picture()
         self._last_picture_step = self._steps
-        cam = t.get_camera("front")
         seg = cam.get_picture("Segmentation")
         depth = np.asarray(cam.get_depth(), dtype=np.float32)
         return {
@@ -377,6 +405,18 @@ class OpenCabinetEnv:
         }
 
 
+def _batch_space(space, n):
+    """The space of ``n`` stacked samples of ``space`` (Gymnasium's ``batch_space``)."""
+    if isinstance(space, Dict):
+        return Dict({k: _batch_space(s, n) for k, s in space.items()})
+    return Box(
+        np.broadcast_to(space.low, (n,) + space.shape),
+        np.broadcast_to(space.high, (n,) + space.shape),
+        (n,) + space.shape,
+        space.dtype,
+    )
+
+
 def _stack(items):
     if isinstance(items[0], dict):
         return {k: np.stack([x[k] for x in items]) for k in items[0]}
@@ -384,8 +424,11 @@ def _stack(items):
 
 
 class VectorOpenCabinetEnv:
-    """``num_envs`` copies of :class:`OpenCabinetEnv` stepped together on a thread pool (the
-    simulation releases the GIL, so the copies run in parallel on several cores).
+    """``num_envs`` copies of :class:`OpenCabinetEnv` stepped together on ``workers`` threads
+    (default: one per copy; the simulation releases the GIL, so the copies run in parallel on
+    several cores). Copy i always runs on thread ``i % workers``: the rasterizer's OpenGL context
+    stays current on the thread that last rendered with it, so a scene cannot move between
+    threads.
 
     Follows Gymnasium's vector API: ``reset`` returns batched observations and an info dict of
     arrays; ``step(actions)`` with actions of shape (num_envs, 7) returns batched
@@ -403,31 +446,46 @@ class VectorOpenCabinetEnv:
         self.envs = [OpenCabinetEnv(**kwargs) for _ in range(self.num_envs)]
         self.single_action_space = self.envs[0].action_space
         self.single_observation_space = self.envs[0].observation_space
-        a = self.single_action_space
-        self.action_space = Box(
-            np.broadcast_to(a.low, (num_envs,) + a.shape),
-            np.broadcast_to(a.high, (num_envs,) + a.shape),
-            (num_envs,) + a.shape,
-            a.dtype,
-        )
-        self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=workers or num_envs)
+        self.action_space = _batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = _batch_space(self.single_observation_space, self.num_envs)
+        workers = min(int(workers or self.num_envs), self.num_envs)
+        if workers < 1:
+            raise ValueError("workers must be at least 1")
+        self._threads = [
+            concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="partsim-env")
+            for _ in range(workers)
+        ]
         self._needs_reset = np.zeros(self.num_envs, dtype=bool)
+        self._closed = False
+
+    def _check_open(self):
+        if self._closed:
+            raise RuntimeError("the vector environment is closed")
+
+    def _map(self, fn):
+        """[fn(i) for each sub-environment i], each on its own thread."""
+        n = len(self._threads)
+        futures = [self._threads[i % n].submit(fn, i) for i in range(self.num_envs)]
+        return [f.result() for f in futures]
 
     def reset(self, *, seed=None, options=None):
+        """Resets every sub-environment: ``seed`` None, an int (sub-environment i gets
+        ``seed + i``) or a sequence of ``num_envs`` seeds (None entries allowed)."""
+        self._check_open()
         if seed is None:
             seeds = [None] * self.num_envs
-        elif isinstance(seed, int):
-            seeds = [seed + i for i in range(self.num_envs)]
+        elif isinstance(seed, numbers.Integral):
+            seeds = [int(seed) + i for i in range(self.num_envs)]
         else:
             seeds = list(seed)
-        results = list(
-            self._pool.map(lambda ie: ie[1].reset(seed=seeds[ie[0]], options=options),
-                           enumerate(self.envs))
-        )
+            if len(seeds) != self.num_envs:
+                raise ValueError(f"reset: {len(seeds)} seeds for {self.num_envs} environments")
+        results = self._map(lambda i: self.envs[i].reset(seed=seeds[i], options=options))
         self._needs_reset[:] = False
         return _stack([r[0] for r in results]), self._infos([r[1] for r in results])
 
     def step(self, actions):
+        self._check_open()
         actions = np.asarray(actions, dtype=np.float64)
         if actions.shape != (self.num_envs, 7):
             raise ValueError(f"actions must have shape ({self.num_envs}, 7), got {actions.shape}")
@@ -441,7 +499,7 @@ class VectorOpenCabinetEnv:
                 return obs, 0.0, False, False, info
             return env.step(actions[i])
 
-        results = list(self._pool.map(one, range(self.num_envs)))
+        results = self._map(one)
         terminated = np.array([r[2] for r in results], dtype=bool)
         truncated = np.array([r[3] for r in results], dtype=bool)
         self._needs_reset = terminated | truncated
@@ -454,9 +512,12 @@ class VectorOpenCabinetEnv:
         )
 
     def close(self):
-        self._pool.shutdown(wait=True)
-        for e in self.envs:
-            e.close()
+        if self._closed:
+            return
+        self._map(lambda i: self.envs[i].close())  # frees the GL objects on their thread
+        for t in self._threads:
+            t.shutdown(wait=True)
+        self._closed = True
 
     def __enter__(self):
         return self

@@ -1,0 +1,502 @@
+"""Conformance of partsim.envs with the Gymnasium API rules (written from Gymnasium's
+documentation, without the gymnasium package): reset/step signatures and return types,
+observations inside observation_space, seeding and determinism, termination and truncation,
+render and close, the Box and Dict spaces, bad actions, clipping, and the vector environment
+(batched spaces, next-step autoreset, the same results as the single environments).
+
+Environments are slow to build (the cabinet is generated and compiled), so a few module-scoped
+ones are shared; every test starts by resetting the environment it uses with a seed.
+"""
+
+import inspect
+
+import numpy as np
+import pytest
+
+import partsim.envs as envs
+
+SMALL = (32, 24)  # camera width, height
+SEED = 7
+
+
+def make(**kwargs):
+    kw = dict(task="drawer", obs_mode="mobility", max_episode_steps=4, camera_size=SMALL)
+    kw.update(kwargs)
+    return envs.OpenCabinetEnv(**kw)
+
+
+def flat(obs):
+    """An observation (array or dict of arrays) as one float64 vector."""
+    if isinstance(obs, dict):
+        return np.concatenate([np.asarray(obs[k], dtype=np.float64).ravel() for k in sorted(obs)])
+    return np.asarray(obs, dtype=np.float64).ravel()
+
+
+def rollout(env, seed, actions):
+    """reset(seed) then the actions; everything returned, flattened to one vector."""
+    obs, _ = env.reset(seed=seed)
+    parts = [flat(obs)]
+    for a in actions:
+        obs, reward, terminated, truncated, _ = env.step(a)
+        parts += [flat(obs), [reward, terminated, truncated]]
+    return np.concatenate(parts)
+
+
+def random_actions(n, seed=0):
+    return np.random.default_rng(seed).uniform(-1, 1, (n, 7)).astype(np.float32)
+
+
+@pytest.fixture(scope="module")
+def env():
+    """Drawer, mobility observations, gripper drawn in front of the cabinet, 4 steps."""
+    e = make(init_on_handle=False)
+    yield e
+    e.close()
+
+
+@pytest.fixture(scope="module")
+def twin():
+    """A second environment like `env`, for comparisons from the same state."""
+    e = make(init_on_handle=False)
+    yield e
+    e.close()
+
+
+@pytest.fixture(
+    scope="module",
+    params=[("drawer", "raw"), ("drawer", "mobility"), ("drawer", "visual"), ("door", "mobility")],
+    ids=lambda p: f"{p[0]}-{p[1]}",
+)
+def mode_env(request):
+    task, obs_mode = request.param
+    e = make(task=task, obs_mode=obs_mode, init_on_handle=False)
+    yield e
+    e.close()
+
+
+def check_obs(space, obs):
+    assert space.contains(obs), (space, obs)
+    assert obs in space
+    if isinstance(obs, dict):
+        for k, v in obs.items():
+            assert isinstance(v, np.ndarray) and v.dtype == space[k].dtype, k
+    else:
+        assert isinstance(obs, np.ndarray) and obs.dtype == space.dtype
+
+
+# --- the Env API ---------------------------------------------------------------------------
+
+
+def test_class_attributes_and_spaces():
+    assert "rgb_array" in envs.OpenCabinetEnv.metadata["render_modes"]
+    assert envs.OpenCabinetEnv.metadata["render_fps"] > 0
+    sig = inspect.signature(envs.OpenCabinetEnv.reset)
+    for name in ("seed", "options"):
+        assert sig.parameters[name].kind is inspect.Parameter.KEYWORD_ONLY
+        assert sig.parameters[name].default is None
+
+
+def test_spaces_of_the_modes(mode_env):
+    e = mode_env
+    assert e.action_space == envs.Box(-1.0, 1.0, (7,), np.float32)
+    if e.obs_mode == "raw":
+        assert e.observation_space.shape == (46,)
+    elif e.obs_mode == "mobility":
+        assert e.observation_space.shape == (25,)
+    else:
+        sp = e.observation_space
+        assert set(sp.keys()) == {"rgb", "depth", "mask", "state"}
+        w, h = SMALL
+        assert sp["rgb"].shape == (h, w, 3) and sp["rgb"].dtype == np.uint8
+        assert sp["depth"].shape == (h, w) and sp["depth"].dtype == np.float32
+        assert sp["mask"].shape == (h, w) and sp["mask"].dtype == np.uint8
+        assert sp["state"].shape == (14,)
+
+
+def test_reset_and_step_return_types_and_observations_in_space(mode_env):
+    e = mode_env
+    out = e.reset(seed=SEED)
+    assert isinstance(out, tuple) and len(out) == 2
+    obs, info = out
+    assert isinstance(info, dict)
+    check_obs(e.observation_space, obs)
+    e.action_space.seed(0)
+    first = None
+    for i in range(3):
+        out = e.step(e.action_space.sample())
+        assert isinstance(out, tuple) and len(out) == 5
+        obs, reward, terminated, truncated, info = out
+        assert type(reward) is float and np.isfinite(reward)
+        assert type(terminated) is bool and type(truncated) is bool
+        assert isinstance(info, dict) and type(info["success"]) is bool
+        check_obs(e.observation_space, obs)
+        if first is None:
+            first = (obs, flat(obs).copy())
+    # returned observations are the caller's: later steps do not change them
+    assert np.array_equal(flat(first[0]), first[1])
+    obs, info = e.reset()  # no seed: continues the generator
+    check_obs(e.observation_space, obs)
+    obs, info = e.reset(seed=SEED + 1, options={})
+    check_obs(e.observation_space, obs)
+
+
+def test_visual_mask_marks_the_target():
+    e = make(obs_mode="visual", init_on_handle=False)
+    obs, _ = e.reset(seed=SEED)
+    assert set(np.unique(obs["mask"])) <= {0, 1}
+    assert obs["mask"].sum() > 0  # the front camera sees the target part
+    assert obs["depth"].max() > 0
+    e.close()
+
+
+def test_same_seed_same_trajectory_and_different_seeds_differ(env, twin):
+    actions = random_actions(4)
+    a = rollout(env, SEED, actions)
+    b = rollout(env, SEED, actions)  # the same env, after an episode
+    c = rollout(twin, SEED, actions)  # another environment
+    assert np.array_equal(a, b)
+    assert np.array_equal(a, c)
+    d = rollout(env, SEED + 1, actions)
+    assert not np.array_equal(a, d)
+    # reset() without a seed continues the seeded generator, the same way in both
+    env.reset(seed=3)
+    twin.reset(seed=3)
+    assert np.array_equal(flat(env.reset()[0]), flat(twin.reset()[0]))
+
+
+def test_seeding_seeds_the_action_space(env):
+    env.reset(seed=11)
+    x = env.action_space.sample()
+    env.reset(seed=11)
+    assert np.array_equal(x, env.action_space.sample())
+    assert isinstance(env.np_random, np.random.Generator)
+    assert env.unwrapped is env
+
+
+def test_truncated_after_max_episode_steps(env):
+    env.reset(seed=SEED)
+    zero = np.zeros(7, dtype=np.float32)
+    for i in range(env.max_episode_steps):
+        obs, reward, terminated, truncated, info = env.step(zero)
+        assert not terminated
+        assert truncated == (i == env.max_episode_steps - 1)
+        assert not info["success"]
+
+
+def test_terminated_on_success():
+    e = make(init_on_handle=True, max_episode_steps=80)
+    obs, info = e.reset(seed=SEED)
+    assert info["touching"] and not info["success"]
+    lo, hi = e.task.target_joint.get_limits()
+    opening = 1.0 if abs(lo) <= abs(hi) else -1.0  # opens towards the far limit
+    action = np.zeros(7, dtype=np.float32)
+    action[:3] = 0.5 * opening * obs[3:6]  # mobility obs: the joint axis direction
+    action[6] = -1.0  # keep the gripper closed on the handle
+    for i in range(e.max_episode_steps):
+        obs, reward, terminated, truncated, info = e.step(action)
+        if terminated or truncated:
+            break
+    assert terminated and not truncated, info
+    assert info["success"] and info["progress"] >= 0.9
+    assert reward >= 1.0  # the success bonus
+    e.close()
+
+
+def test_reset_options():
+    e = make(init_on_handle=False)
+    with pytest.raises(ValueError):
+        e.reset(seed=0, options={"colour": "red"})
+    with pytest.raises(ValueError):
+        e.reset(seed=0, options={"object": 5})
+    names = e.reset(seed=0)[1]["target"], e.reset(seed=1)[1]["target"]
+    candidates = None
+    for t in range(3):
+        _, info = e.reset(seed=0, options={"target": t})
+        candidates = e.task.get_target_candidates()
+        assert info["target"] == candidates[t]
+    with pytest.raises(ValueError):
+        e.reset(seed=0, options={"target": len(candidates)})
+    # an option holds for its episode only: the seed draws the target again afterwards
+    assert (e.reset(seed=0)[1]["target"], e.reset(seed=1)[1]["target"]) == names
+    e.close()
+
+
+def test_render():
+    e = make(render_mode="rgb_array", init_on_handle=False)
+    with pytest.raises(RuntimeError):
+        e.render()  # before reset
+    e.reset(seed=SEED)
+    frame = e.render()
+    w, h = SMALL
+    assert isinstance(frame, np.ndarray) and frame.shape == (h, w, 3) and frame.dtype == np.uint8
+    assert frame.max() > 0
+    e.step(np.ones(7, dtype=np.float32))
+    assert e.render().shape == (h, w, 3)
+    e.close()
+    # in visual mode render() shows the state of the last observation
+    v = make(obs_mode="visual", render_mode="rgb_array", init_on_handle=False)
+    obs, _ = v.reset(seed=SEED)
+    assert np.array_equal(v.render(), obs["rgb"])
+    obs, *_ = v.step(np.ones(7, dtype=np.float32))
+    assert np.array_equal(v.render(), obs["rgb"])
+    obs, _ = v.reset(seed=SEED + 1)
+    assert np.array_equal(v.render(), obs["rgb"])
+    v.close()
+
+
+def test_render_mode_none_and_bad_arguments(env):
+    env.reset(seed=SEED)
+    assert env.render_mode is None and env.render() is None
+    with pytest.raises(ValueError):
+        make(render_mode="human")
+    with pytest.raises(ValueError):
+        make(obs_mode="pixels")
+    with pytest.raises(ValueError):
+        make(max_episode_steps=0)
+
+
+def test_close():
+    e = make(init_on_handle=False)
+    e.reset(seed=SEED)
+    e.step(np.zeros(7))
+    e.close()
+    e.close()  # closing twice is allowed
+    with pytest.raises(RuntimeError):
+        e.step(np.zeros(7))
+    with pytest.raises(RuntimeError):
+        e.reset(seed=SEED)
+    with envs.OpenCabinetEnv(max_episode_steps=2, init_on_handle=False) as ctx:
+        ctx.reset(seed=0)
+    with pytest.raises(RuntimeError):
+        ctx.reset(seed=0)
+
+
+def test_step_before_reset():
+    e = make(init_on_handle=False)
+    with pytest.raises(RuntimeError):
+        e.step(np.zeros(7))
+    e.close()
+
+
+# --- bad actions and clipping -----------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        np.zeros(6),
+        np.zeros(8),
+        np.zeros((1, 7)),
+        np.zeros((7, 1)),
+        0.0,
+        [],
+        [0, 0, 0, np.nan, 0, 0, 0],
+        [0, 0, 0, 0, 0, 0, np.inf],
+        [-np.inf, 0, 0, 0, 0, 0, 0],
+        np.full(7, np.nan, dtype=np.float32),
+        ["a", 0, 0, 0, 0, 0, 0],
+    ],
+    ids=["6", "8", "1x7", "7x1", "scalar", "empty", "nan", "inf", "-inf", "nan32", "str"],
+)
+def test_bad_actions_raise_and_change_nothing(env, twin, bad):
+    good = np.array([0.8, -0.3, 0.2, 0.1, 0.0, -0.2, -1.0], dtype=np.float32)
+    env.reset(seed=SEED)
+    twin.reset(seed=SEED)
+    env.step(good)
+    twin.step(good)
+    before = env.task.get_raw_observation().copy()
+    with pytest.raises(ValueError):
+        env.step(bad)
+    assert np.array_equal(env.task.get_raw_observation(), before)
+    assert env.task.get_elapsed() == twin.task.get_elapsed()
+    # the next step goes on as if the bad call had not happened
+    a = env.step(good)
+    b = twin.step(good)
+    assert np.array_equal(a[0], b[0]) and a[1:4] == b[1:4]
+
+
+def test_out_of_range_actions_are_clipped(env, twin):
+    big = np.array([5.0, -5.0, 0.3, 2.0, -3.0, 0.0, 7.0])
+    clipped = np.clip(big, -1.0, 1.0)
+    env.reset(seed=SEED)
+    twin.reset(seed=SEED)
+    for _ in range(2):
+        a = env.step(big)
+        b = twin.step(clipped)
+        assert np.array_equal(a[0], b[0]) and a[1:4] == b[1:4]
+    # float32, float64 and lists are the same action
+    env.reset(seed=SEED)
+    twin.reset(seed=SEED)
+    a = env.step([0.5, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0])
+    b = twin.step(np.array([0.5, 0, 0, 0, 0, 0, -1], dtype=np.float32))
+    assert np.array_equal(a[0], b[0])
+
+
+# --- spaces ------------------------------------------------------------------------------
+
+
+def test_box_sample_and_contains():
+    box = envs.Box(-1.0, 2.0, (3, 4), np.float32, seed=0)
+    assert box.shape == (3, 4) and box.dtype == np.float32
+    for _ in range(50):
+        x = box.sample()
+        assert x.shape == (3, 4) and x.dtype == np.float32
+        assert np.all(x >= -1.0) and np.all(x <= 2.0)
+        assert box.contains(x) and x in box
+    a = envs.Box(-1.0, 2.0, (3, 4), seed=5).sample()
+    assert np.array_equal(a, envs.Box(-1.0, 2.0, (3, 4), seed=5).sample())
+    # rejections: shape, dtype, range, NaN, other types
+    assert not box.contains(np.zeros((4, 3), np.float32))
+    assert not box.contains(np.zeros(12, np.float32))
+    assert not box.contains(np.zeros((3, 4), np.float64))  # not safely castable to float32
+    assert not box.contains(np.full((3, 4), 2.5, np.float32))
+    assert not box.contains(np.full((3, 4), -1.5, np.float32))
+    x = np.zeros((3, 4), np.float32)
+    x[1, 2] = np.nan
+    assert not box.contains(x)
+    assert not box.contains("a string")
+    assert not box.contains(None)
+    assert box.contains(np.zeros((3, 4), np.float16))  # safe cast
+    assert box.contains([[0.0] * 4] * 3)  # a nested list is converted
+
+
+def test_box_bounds_kinds():
+    with pytest.raises(ValueError):
+        envs.Box(1.0, 0.0, (2,))
+    low, high = np.array([0.0, -np.inf, -np.inf, 1.0]), np.array([1.0, np.inf, 0.0, np.inf])
+    b = envs.Box(low, high, seed=1)
+    assert b.shape == (4,)
+    for _ in range(50):
+        x = b.sample()
+        assert np.all(np.isfinite(x)) and b.contains(x)
+    u = envs.Box(0, 255, (5, 6, 3), np.uint8, seed=2)
+    x = u.sample()
+    assert x.dtype == np.uint8 and u.contains(x)
+    assert not u.contains(x.astype(np.int64))
+    assert not u.contains(np.zeros((5, 6, 3), np.float32))
+
+
+def test_dict_space():
+    d = envs.Dict({"a": envs.Box(-1, 1, (2,)), "b": envs.Box(0, 255, (2, 2), np.uint8)}, seed=3)
+    assert set(d.keys()) == {"a", "b"} and len(d) == 2 and list(d) == ["a", "b"]
+    assert d["b"].dtype == np.uint8
+    s = d.sample()
+    assert isinstance(s, dict) and d.contains(s) and s in d
+    d2 = envs.Dict({"a": envs.Box(-1, 1, (2,)), "b": envs.Box(0, 255, (2, 2), np.uint8)}, seed=3)
+    s2 = d2.sample()
+    assert all(np.array_equal(s[k], s2[k]) for k in s)
+    assert d == d2
+    assert not d.contains({"a": s["a"]})  # a key missing
+    assert not d.contains({**s, "c": 0})  # an extra key
+    assert not d.contains({"a": np.array([2.0, 0.0], np.float32), "b": s["b"]})
+    assert not d.contains([s["a"], s["b"]])
+
+
+# --- the vector environment ----------------------------------------------------------------
+
+
+def test_vector_env_spaces_shapes_autoreset_and_determinism():
+    n, steps = 2, 3
+    vec = envs.VectorOpenCabinetEnv(
+        n, obs_mode="mobility", max_episode_steps=steps, init_on_handle=False
+    )
+    assert vec.num_envs == n
+    assert vec.single_action_space == envs.Box(-1, 1, (7,), np.float32)
+    assert vec.action_space.shape == (n, 7)
+    assert vec.single_observation_space.shape == (25,)
+    assert vec.observation_space.shape == (n, 25)
+    assert "rgb_array" in vec.metadata["render_modes"]
+
+    obs, infos = vec.reset(seed=SEED)
+    assert vec.observation_space.contains(obs)
+    assert infos["progress"].shape == (n,) and infos["_progress"].all()
+    actions = random_actions(steps + 2, seed=1)
+    batched = [np.stack([a, -a]) for a in actions]  # env i gets action (-1)^i a
+    vec_traj = [obs]
+    for k in range(steps + 2):
+        obs, rewards, terms, truncs, infos = vec.step(batched[k])
+        assert obs.shape == (n, 25) and vec.observation_space.contains(obs)
+        assert rewards.shape == (n,) and rewards.dtype == np.float64
+        assert terms.shape == (n,) and terms.dtype == bool
+        assert truncs.shape == (n,) and truncs.dtype == bool
+        assert isinstance(infos, dict) and infos["success"].shape == (n,)
+        if k == steps - 1:
+            assert truncs.all() and not terms.any()
+        if k == steps:  # next-step autoreset: a new episode's first observation
+            assert not truncs.any() and not terms.any() and np.all(rewards == 0.0)
+            assert np.all(infos["elapsed"] == 0.0)
+        vec_traj.append(obs)
+        vec_traj.append(rewards)
+    # the same as each environment run alone, with the same seeds
+    for i in range(n):
+        single = make(obs_mode="mobility", max_episode_steps=steps, init_on_handle=False)
+        obs, _ = single.reset(seed=SEED + i)
+        ref = [obs]
+        for k in range(steps + 2):
+            if k == steps:
+                obs, _ = single.reset()
+                reward = 0.0
+            else:
+                obs, reward, *_ = single.step(batched[k][i])
+            ref.append(obs)
+            ref.append(reward)
+        single.close()
+        got = [x[i] for x in vec_traj]
+        assert all(np.array_equal(g, r) for g, r in zip(got, ref)), f"env {i}"
+
+    # bad input
+    with pytest.raises(ValueError):
+        vec.step(np.zeros((n + 1, 7)))
+    with pytest.raises(ValueError):
+        vec.step(np.full((n, 7), np.nan))
+    with pytest.raises(ValueError):
+        vec.reset(seed=[1, 2, 3])
+    seeded = vec.reset(seed=[SEED, SEED + 1])[0]
+    assert np.array_equal(seeded, vec.reset(seed=SEED)[0])
+    vec.close()
+    vec.close()
+    with pytest.raises(RuntimeError):
+        vec.step(np.zeros((n, 7)))
+
+
+def test_vector_env_visual_observations():
+    # rendered on two threads: every sub-environment keeps to its thread, since a scene's GL
+    # context stays current on the thread that last rendered with it
+    n, steps = 2, 2
+    vec = envs.VectorOpenCabinetEnv(
+        n, obs_mode="visual", max_episode_steps=steps, camera_size=SMALL, init_on_handle=False
+    )
+    w, h = SMALL
+    obs, _ = vec.reset(seed=SEED)
+    assert obs["rgb"].shape == (n, h, w, 3) and obs["rgb"].dtype == np.uint8
+    assert obs["depth"].shape == (n, h, w) and obs["mask"].shape == (n, h, w)
+    assert vec.observation_space.contains(obs)
+    traj = [obs]
+    for k in range(2 * steps + 2):  # through two autoresets
+        obs, *_ = vec.step(np.full((n, 7), 0.5))
+        assert vec.observation_space.contains(obs)
+        traj.append(obs)
+    vec.close()
+    # the pictures are those of each environment alone
+    single = make(obs_mode="visual", max_episode_steps=steps, init_on_handle=False)
+    ref = [single.reset(seed=SEED + 1)[0]]
+    for k in range(2 * steps + 2):
+        done = k % (steps + 1) == steps
+        ref.append(single.reset()[0] if done else single.step(np.full(7, 0.5))[0])
+    single.close()
+    for k, (got, want) in enumerate(zip(traj, ref)):
+        assert all(np.array_equal(got[key][1], want[key]) for key in want), f"step {k}"
+
+
+def test_vector_env_fewer_workers_than_envs():
+    kw = dict(obs_mode="mobility", max_episode_steps=3, init_on_handle=False)
+    a = envs.VectorOpenCabinetEnv(3, workers=1, **kw)
+    b = envs.VectorOpenCabinetEnv(3, workers=2, **kw)
+    xa, xb = a.reset(seed=SEED)[0], b.reset(seed=SEED)[0]
+    assert np.array_equal(xa, xb)
+    for act in random_actions(4, seed=2):
+        batch = np.stack([act, 0.5 * act, -act])
+        ra, rb = a.step(batch), b.step(batch)
+        assert np.array_equal(ra[0], rb[0]) and np.array_equal(ra[1], rb[1])
+    a.close()
+    b.close()
