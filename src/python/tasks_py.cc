@@ -50,7 +50,9 @@ void BindTasks(py::module_& m) {
            py::call_guard<py::gil_scoped_release>())
       .def("reset", &ArticulationTask::Reset, py::arg("seed") = 0,
            py::call_guard<py::gil_scoped_release>(), "Starts a new episode.")
-      .def_property_readonly("options", &ArticulationTask::GetOptions)
+      .def_property_readonly(
+          "options", [](const ArticulationTask& t) { return t.GetOptions(); },
+          "A copy of the task's options (they are fixed when the task is made).")
       .def_property_readonly("scene", &ArticulationTask::GetSharedScene,
                              "The task's scene (shared).")
       .def_property_readonly("robot_model", &ArticulationTask::GetRobotModel)

@@ -42,6 +42,20 @@ class EglContext {
   std::string renderer_;
 };
 
+/// Makes a context current on this thread for a scope and releases it at the end, so that the
+/// scene that owns it can render from another thread next time (a context may be current on one
+/// thread at a time).
+class CurrentContextScope {
+ public:
+  explicit CurrentContextScope(EglContext& context) : context_(context) { context_.MakeCurrent(); }
+  ~CurrentContextScope() { context_.Release(); }
+  CurrentContextScope(const CurrentContextScope&) = delete;
+  CurrentContextScope& operator=(const CurrentContextScope&) = delete;
+
+ private:
+  EglContext& context_;
+};
+
 /// Compiles and links a program from vertex and fragment sources (fragment may be empty for a
 /// depth-only pass). On failure throws partsim::Error naming `pass` and quoting the GL info log.
 GLuint BuildProgram(const std::string& pass, const std::string& vertex_source,

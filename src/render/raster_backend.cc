@@ -288,6 +288,7 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
                   std::to_string(options_.shadow_map_size));
     }
     context_ = std::make_unique<internal::EglContext>();
+    internal::CurrentContextScope current(*context_);
     static std::once_flag logged;
     std::call_once(logged, [&] {
       std::fprintf(stderr, "partsim: rasterizer on %s\n", context_->Renderer().c_str());
@@ -308,7 +309,7 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
 
   ~RasterBackend() override {
     try {
-      context_->MakeCurrent();
+      internal::CurrentContextScope current(*context_);
       DeleteGlObjects();
     } catch (...) {
       // the context cannot be made current here: its objects die with it
@@ -320,7 +321,7 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
   void SetReadbackMask(unsigned mask) override { readback_mask_ = mask; }
 
   void Render(const RenderWorld& world, const CameraParams& camera, Picture* out) override {
-    context_->MakeCurrent();
+    internal::CurrentContextScope current(*context_);
     EnsureTargets(camera.width, camera.height);
     SyncResources(world);
 

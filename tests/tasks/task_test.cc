@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "partsim/core/error.h"
 #include "partsim/tasks/tasks.h"
@@ -134,6 +135,23 @@ TEST(TaskTest, CamerasSeeTheTargetAndItsHandle) {
     EXPECT_GT(handle, 3) << name;
   }
   EXPECT_THROW(task.GetCamera("top"), Error);
+}
+
+TEST(TaskTest, RendersFromAnotherThread) {
+  // a vectorised environment steps (and renders) each task on a worker thread
+  ArticulationTask task(Options(TaskType::kPullDrawer, true));
+  task.TakePictures();
+  std::string error;
+  std::thread worker([&] {
+    try {
+      task.TakePictures();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  });
+  worker.join();
+  EXPECT_EQ(error, "");
+  task.TakePictures();  // and back on this thread
 }
 
 TEST(TaskTest, ScriptedGraspAndPullOpensADrawer) {
