@@ -405,5 +405,27 @@ TEST_F(CliTest, AssetsDecomposeWritesConvexPieces) {
   EXPECT_TRUE(fs::exists(dir_ / "pieces" / "l_collision.urdf.xml")) << r.output;
 }
 
+TEST_F(CliTest, TasksDemoOpensADrawerAndWritesFrames) {
+  fs::path out = dir_ / "demo";
+  RunResult r = RunCli("tasks demo --task drawer --every 20 --out '" + out.string() + "'");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Contains(r.output, "SUCCESS")) << r.output;
+  int frames = 0;
+  for (const auto& e : fs::directory_iterator(out)) frames += e.path().extension() == ".png";
+  EXPECT_GT(frames, 3) << r.output;
+}
+
+TEST_F(CliTest, TasksRejectsBadArguments) {
+  RunResult r = RunCli("tasks evaluate --task window");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(Contains(r.output, "--task expects drawer or door, got 'window'")) << r.output;
+  EXPECT_EQ(RunCli("tasks evaluate --count 0").code, 2);
+  EXPECT_EQ(RunCli("tasks fly").code, 2);
+  // object 0 of the generator is a cabinet without drawers
+  r = RunCli("tasks demo --task drawer --object 0 --out '" + (dir_ / "d").string() + "'");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(Contains(r.output, "has no drawer")) << r.output;
+}
+
 }  // namespace
 }  // namespace partsim
