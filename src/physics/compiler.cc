@@ -5,6 +5,7 @@
 #include <map>
 #include <sstream>
 
+#include "core/number_text.h"
 #include "physics/scene_internal.h"
 
 namespace partsim {
@@ -13,17 +14,6 @@ namespace {
 
 // MuJoCo capsules and cylinders lie along z; partsim's along x: rotate z onto x.
 const Eigen::Quaterniond kZToX(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()));
-
-// Shortest round-tripping text for a double.
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
-
-std::string Vec(const Eigen::Vector3d& v) {
-  return Num(v.x()) + " " + Num(v.y()) + " " + Num(v.z());
-}
 
 std::string Quat(const Eigen::Quaterniond& q) {
   Eigen::Quaterniond n = q.normalized();

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/number_text.h"
 #include "partsim/core/error.h"
 #include "partsim/robot/robots.h"
 
@@ -16,16 +17,8 @@ namespace partsim {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
-
-std::string Vec(const Eigen::Vector3d& v) {
-  return Num(v.x()) + " " + Num(v.y()) + " " + Num(v.z());
-}
+using internal::Num;
+using internal::Vec;
 
 // XML attribute text with the five special characters escaped.
 std::string Escape(const std::string& s) {

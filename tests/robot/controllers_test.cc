@@ -12,12 +12,7 @@
 namespace partsim {
 namespace {
 
-Eigen::VectorXd V(std::initializer_list<double> v) {
-  Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
-  int i = 0;
-  for (double x : v) out[i++] = x;
-  return out;
-}
+using testing::V;
 
 const Eigen::VectorXd kHome = V({0.2, 0.4, -0.3, 0.05, 0.8, 0.3, 0.5});
 

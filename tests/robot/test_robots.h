@@ -4,10 +4,19 @@
 #pragma once
 
 #include <cmath>
+#include <initializer_list>
 
 #include "partsim/physics/scene.h"
 
 namespace partsim::testing {
+
+/// A vector from a list: V({1, 2, 3}).
+inline Eigen::VectorXd V(std::initializer_list<double> v) {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
+  int i = 0;
+  for (double x : v) out[i++] = x;
+  return out;
+}
 
 /// Rotations that carry a joint's x axis onto z and onto y.
 inline Eigen::Quaterniond XToZ() {

@@ -8,16 +8,12 @@
 #include <random>
 
 #include "partsim/core/error.h"
+#include "robot/test_robots.h"
 
 namespace partsim {
 namespace {
 
-Eigen::VectorXd V(std::initializer_list<double> v) {
-  Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
-  int i = 0;
-  for (double x : v) out[i++] = x;
-  return out;
-}
+using testing::V;
 
 TEST(TrajectorySample, QuinticMatchesWaypointsAndIsSmooth) {
   JointTrajectory t;
