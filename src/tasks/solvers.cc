@@ -198,31 +198,42 @@ SolverResult SolvePullDrawer(ArticulationTask& task, const SolverOptions& option
   if (options.use_cameras && task.GetCameras().empty())
     throw Error("SolvePullDrawer: use_cameras needs a task made with cameras");
   Runner run(task, options);
-  HandleGrasp g;
-  std::string msg;
-  if (!run.FindGrasp(Eigen::Vector3d::UnitX(), true, &g, &msg))
-    return Finish(task, "perceive", msg);
-  if (!run.Grasp(g, &msg)) return Finish(task, "grasp", msg);
-  // pull along the drawer's axis (its front normal) until it stops at its limit
   Joint joint = task.GetTargetJoint();
-  Eigen::Vector3d axis = joint.GetGlobalAxis() * OpeningSign(joint);
+  const Eigen::Vector3d axis = joint.GetGlobalAxis() * OpeningSign(joint);
   const double speed = 0.15, dt = 1.0 / task.GetOptions().control_rate;
-  Eigen::Matrix<double, 6, 1> twist;
-  twist << speed * axis, Eigen::Vector3d::Zero();
-  task.SetTcpVelocity(twist);
-  // stop when the drawer stops (its limit) or the fingers lose it
-  double stalled = 0.0, pulled = 0.0, lost = 0.0;
-  while (!task.IsTruncated()) {
-    run.Step();
-    pulled += dt;
-    double v = task.GetTcpVelocity().head<3>().dot(axis);
-    stalled = v < 0.2 * speed ? stalled + dt : 0.0;
-    lost = task.GripperTouchesTarget() ? 0.0 : lost + dt;
-    if ((pulled > 0.5 && stalled > 0.4) || lost > 0.2) break;
+  std::string msg = "the drawer stopped short of 90% of its range", stage = "grasp";
+  // grasp and pull; when the fingers slip off the handle before the drawer stops, let go, back
+  // off, find the handle where it is now and pull again
+  for (int attempt = 0; attempt < 3 && !task.IsTruncated(); ++attempt) {
+    HandleGrasp g;
+    if (!run.FindGrasp(Eigen::Vector3d::UnitX(), true, &g, &msg))
+      return Finish(task, "perceive", msg);
+    if (!run.Grasp(g, &msg)) continue;
+    stage = "pull";
+    Eigen::Matrix<double, 6, 1> twist;
+    twist << speed * axis, Eigen::Vector3d::Zero();
+    task.SetTcpVelocity(twist);
+    // stop when the drawer stops (its limit) or the fingers lose it
+    double stalled = 0.0, pulled = 0.0, lost = 0.0;
+    while (!task.IsTruncated()) {
+      run.Step();
+      pulled += dt;
+      double v = task.GetTcpVelocity().head<3>().dot(axis);
+      stalled = v < 0.2 * speed ? stalled + dt : 0.0;
+      lost = task.GripperTouchesTarget() ? 0.0 : lost + dt;
+      if ((pulled > 0.5 && stalled > 0.4) || lost > 0.2) break;
+    }
+    task.SetTcpVelocity(Eigen::Matrix<double, 6, 1>::Zero());
+    if (lost <= 0.2) break;  // held to the end: the drawer is at its limit
+    msg = "the fingers slipped off the handle " + std::to_string(attempt + 1) + " times";
+    task.SetGripper(1.0);
+    run.Wait(0.2);
+    Pose back = task.GetTcpPose();
+    back.p += 0.08 * axis;
+    run.MoveTo(back, 0.3, 0.5);
   }
-  task.SetTcpVelocity(Eigen::Matrix<double, 6, 1>::Zero());
   run.Wait(0.2);
-  return Finish(task, "pull", "the drawer stopped short of 90% of its range");
+  return Finish(task, stage, msg);
 }
 
 SolverResult SolveOpenDoor(ArticulationTask& task, const SolverOptions& options) {

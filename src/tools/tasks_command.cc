@@ -109,8 +109,6 @@ int RunDemo(const TasksArgs& a) {
   TaskOptions o;
   o.type = a.type;
   o.object_index = a.object >= 0 ? a.object : FindTaskObjects(a.type, 1).front();
-  o.camera_width = 320;
-  o.camera_height = 240;
   std::filesystem::create_directories(a.out);
   ArticulationTask task(o);
   task.Reset(a.seed);

@@ -32,8 +32,8 @@ struct TaskOptions {
   int target = -1;  ///< which drawer (door) of the object, in link order; -1: drawn by Reset's seed
   std::string asset_dir;  ///< where the object's folder is written; "" = <tmp>/partsim-assets
   bool cameras = true;    ///< add the left, right and front cameras
-  int camera_width = 160;
-  int camera_height = 120;
+  int camera_width = 320;
+  int camera_height = 240;
   std::string render_backend = "rasterizer";
   double timestep = 1.0 / 500.0;  ///< physics step (s)
   double control_rate = 50.0;     ///< Hz; Step() advances one control period
