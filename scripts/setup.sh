@@ -11,7 +11,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev clang-format
   libegl-dev libegl-mesa0 libgl1-mesa-dri libopengl-dev libembree-dev libpng-dev
-  libbullet-extras-dev libjpeg-dev
+  libbullet-extras-dev libjpeg-dev libompl-dev
 )
 
 missing=()

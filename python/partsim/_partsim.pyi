@@ -2472,3 +2472,42 @@ def write_segmentation_png(path: str, ids: numpy.ndarray) -> None:
 def write_urdf(articulation: ArticulationDesc, path: str) -> None:
     """Writes articulation_to_urdf to path (meshes into <stem>_meshes/ beside it); raises PartsimError naming a file it cannot write."""
     ...
+
+class MotionPlanner:
+    """Collision-free joint paths for some joints of an articulation in the current scene (OMPL; collisions checked on a private copy)."""
+    def __init__(self, arm: Articulation, joints: typing.List[str] = ..., velocity_limits: numpy.ndarray = ..., acceleration_limits: numpy.ndarray = ...) -> None: ...
+    def get_current_positions(self) -> numpy.ndarray: ...
+    def get_joint_names(self) -> typing.List[str]: ...
+    def is_state_valid(self, q: numpy.ndarray, clearance: float = ...) -> tuple:
+        """(valid, reason) for planned-joint positions q in the last snapshot."""
+        ...
+    def plan_to_joints(self, goal: numpy.ndarray, options: PlannerOptions = ...) -> PlanResult:
+        """A path from the current positions to `goal` (one entry per planned joint)."""
+        ...
+    def plan_to_pose(self, link: str, tcp_offset: Pose, target: Pose, options: PlannerOptions = ...) -> PlanResult:
+        """A path that brings frame `tcp_offset` of `link` to world pose `target`."""
+        ...
+    def update_snapshot(self) -> None: ...
+
+
+class PlanResult:
+    """What a planning request produced."""
+    def __bool__(self) -> bool: ...
+    def __init__(self) -> None: ...
+    message: str
+    path: typing.List[numpy.ndarray]
+    planning_time: float
+    success: bool
+    trajectory: JointTrajectory
+
+
+class PlannerOptions:
+    """Settings of one planning request."""
+    def __init__(self) -> None: ...
+    algorithm: str
+    clearance: float
+    ik_attempts: int
+    resolution: float
+    seed: int
+    simplify: bool
+    time_limit: float

@@ -25,6 +25,8 @@ void BindRobots(py::module_& m);
 void BindControl(py::module_& m);
 /// Door-opening and drawer-pulling tasks and their heuristic solvers (tasks_py.cc).
 void BindTasks(py::module_& m);
+/// Motion planning (planning_py.cc).
+void BindPlanning(py::module_& m);
 
 /// Casts handles to a Python list whose items each keep `owner` alive (py::keep_alive cannot
 /// attach to a list, which holds no weak references).

@@ -13,4 +13,5 @@ PYBIND11_MODULE(_partsim, m) {
   partsim::python::BindRobots(m);
   partsim::python::BindControl(m);
   partsim::python::BindTasks(m);
+  partsim::python::BindPlanning(m);
 }

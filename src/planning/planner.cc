@@ -1,0 +1,418 @@
+// Motion planning with OMPL over a private clone of the scene; collisions from MuJoCo's own
+// collision pipeline (mj_kinematics + mj_collision) with the arm's geoms inflated by the
+// clearance.
+#include "partsim/planning/planner.h"
+
+#include <mujoco/mujoco.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/kpiece/KPIECE1.h>
+#include <ompl/geometric/planners/prm/PRM.h>
+#include <ompl/geometric/planners/rrt/RRT.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/geometric/planners/rrt/RRTstar.h>
+#include <ompl/util/Console.h>
+#include <ompl/util/RandomNumbers.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "partsim/core/error.h"
+#include "partsim/robot/kinematics.h"
+#include "physics/scene_internal.h"
+
+namespace partsim {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+struct MotionPlanner::Impl {
+  Articulation arm;
+  std::vector<std::string> names;
+  std::vector<int> dofs;  ///< articulation dof index per planned joint
+  Eigen::VectorXd velocity_limits, acceleration_limits;
+  Eigen::MatrixX2d limits;          ///< planned joints, (lower, upper)
+  std::vector<uint64_t> link_mask;  ///< per link: bit p set when planned joint p moves it
+
+  // snapshot
+  std::unique_ptr<Scene> world;
+  Articulation world_arm;
+  Eigen::VectorXd base_q;      ///< the arm's full qpos at the snapshot
+  std::vector<int> geom_link;  ///< per MuJoCo geom: arm link index, or -1
+  double margin = -1.0;        ///< clearance the arm geoms are inflated by now
+
+  void Snapshot() {
+    world = arm.GetScene()->Clone();
+    world_arm = Articulation(world.get(), arm.GetId());
+    base_q = arm.GetQpos();
+    internal::SceneImpl& s = world->impl();
+    s.EnsureCompiled();
+    geom_link.assign(s.m->ngeom, -1);
+    for (int g = 0; g < s.m->ngeom; ++g)
+      if (s.geom_owner[g].articulation_id == arm.GetId()) geom_link[g] = s.geom_owner[g].link_index;
+    margin = -1.0;
+  }
+
+  Eigen::VectorXd Full(const Eigen::VectorXd& q) const {
+    Eigen::VectorXd full = base_q;
+    for (size_t i = 0; i < dofs.size(); ++i) full[dofs[i]] = q[static_cast<Eigen::Index>(i)];
+    return full;
+  }
+
+  std::string LinkName(int link) const { return arm.GetLink(link).GetName(); }
+
+  bool Check(const Eigen::VectorXd& q, double clearance, std::string* reason) {
+    for (Eigen::Index i = 0; i < q.size(); ++i)
+      if (!(q[i] >= limits(i, 0) - 1e-9 && q[i] <= limits(i, 1) + 1e-9)) {
+        if (reason) {
+          std::ostringstream os;
+          os << "joint '" << names[i] << "' = " << q[i] << " is outside its limits ["
+             << limits(i, 0) << ", " << limits(i, 1) << "]";
+          *reason = os.str();
+        }
+        return false;
+      }
+    if (!world) Snapshot();
+    internal::SceneImpl& s = world->impl();
+    mjModel* m = s.m;
+    mjData* d = s.d;
+    // inflate the moving arm geoms so that contacts appear within the clearance
+    if (margin != clearance) {
+      for (int g = 0; g < m->ngeom; ++g)
+        if (geom_link[g] >= 0 && link_mask[geom_link[g]] != 0) m->geom_margin[g] = clearance;
+      margin = clearance;
+    }
+    world_arm.SetQpos(Full(q));
+    mj_kinematics(m, d);
+    mj_collision(m, d);
+    for (int i = 0; i < d->ncon; ++i) {
+      const mjContact& c = d->contact[i];
+      if (c.exclude != 0) continue;
+      int l1 = geom_link[c.geom1], l2 = geom_link[c.geom2];
+      if (l1 < 0 && l2 < 0) continue;
+      bool bad = false;
+      if (l1 >= 0 && l2 >= 0) {
+        // self: only pairs that move relative to each other, only when they penetrate
+        bad = link_mask[l1] != link_mask[l2] && c.dist < 0;
+      } else {
+        int l = l1 >= 0 ? l1 : l2;
+        bad = link_mask[l] != 0 && c.dist < clearance;
+      }
+      if (bad) {
+        if (reason) {
+          auto what = [&](int g, int l) {
+            if (l >= 0) return "link '" + LinkName(l) + "'";
+            const internal::GeomOwner& o = s.geom_owner[g];
+            if (o.actor_id >= 0) return "actor '" + s.GetActor(o.actor_id).desc.name + "'";
+            if (o.articulation_id >= 0)
+              return "link '" + s.GetArticulation(o.articulation_id).desc.links[o.link_index].name +
+                     "' of articulation '" + s.GetArticulation(o.articulation_id).desc.name + "'";
+            return std::string("geom ") + std::to_string(g);
+          };
+          std::ostringstream os;
+          os << what(c.geom1, l1) << " and " << what(c.geom2, l2) << " are " << c.dist
+             << " m apart (clearance " << clearance << " m)";
+          *reason = os.str();
+        }
+        return false;
+      }
+    }
+    return true;
+  }
+
+  void CheckVector(const Eigen::VectorXd& v, const char* what) const {
+    if (v.size() != static_cast<Eigen::Index>(dofs.size()))
+      throw Error(std::string("MotionPlanner: ") + what + " has " + std::to_string(v.size()) +
+                  " entries, expected " + std::to_string(dofs.size()) + " (one per planned joint)");
+    for (Eigen::Index i = 0; i < v.size(); ++i)
+      if (!std::isfinite(v[i]))
+        throw Error(std::string("MotionPlanner: ") + what + " entry " + std::to_string(i) + " ('" +
+                    names[i] + "') is not finite");
+  }
+
+  PlanResult Plan(const Eigen::VectorXd& goal, const PlannerOptions& opt,
+                  std::chrono::steady_clock::time_point t0);
+};
+
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void CheckOptions(const PlannerOptions& opt) {
+  if (!(opt.time_limit > 0) || !std::isfinite(opt.time_limit))
+    throw Error("PlannerOptions: time_limit must be finite and > 0");
+  if (!(opt.resolution > 0) || !std::isfinite(opt.resolution))
+    throw Error("PlannerOptions: resolution must be finite and > 0");
+  if (!(opt.clearance >= 0) || !std::isfinite(opt.clearance))
+    throw Error("PlannerOptions: clearance must be finite and >= 0");
+  static const char* known[] = {"RRTConnect", "RRT", "RRTstar", "PRM", "KPIECE1"};
+  if (std::find(std::begin(known), std::end(known), opt.algorithm) == std::end(known))
+    throw Error("PlannerOptions: unknown algorithm '" + opt.algorithm +
+                "' (RRTConnect, RRT, RRTstar, PRM or KPIECE1)");
+}
+
+ob::PlannerPtr MakePlanner(const std::string& name, const ob::SpaceInformationPtr& si) {
+  if (name == "RRT") return std::make_shared<og::RRT>(si);
+  if (name == "RRTstar") return std::make_shared<og::RRTstar>(si);
+  if (name == "PRM") return std::make_shared<og::PRM>(si);
+  if (name == "KPIECE1") return std::make_shared<og::KPIECE1>(si);
+  return std::make_shared<og::RRTConnect>(si);
+}
+
+/// Inserts waypoints so that no joint moves more than `step` between two of them.
+std::vector<Eigen::VectorXd> Densify(const std::vector<Eigen::VectorXd>& path, double step) {
+  std::vector<Eigen::VectorXd> out = {path.front()};
+  for (size_t i = 1; i < path.size(); ++i) {
+    double d = (path[i] - path[i - 1]).cwiseAbs().maxCoeff();
+    int n = std::max(1, static_cast<int>(std::ceil(d / step)));
+    for (int k = 1; k <= n; ++k)
+      out.push_back(path[i - 1] + (path[i] - path[i - 1]) * (static_cast<double>(k) / n));
+  }
+  return out;
+}
+
+/// TimeParameterize only ever slows a trajectory down from its rest-to-rest first guess; this
+/// scales time uniformly so that the fastest joint just meets its velocity or acceleration
+/// limit (2 % margin for the sampling). Positions along the path do not change.
+void SpeedUp(JointTrajectory* t, const Eigen::VectorXd& vmax, const Eigen::VectorXd& amax) {
+  const double duration = t->Duration();
+  if (!(duration > 0)) return;
+  double r = 0.0;
+  Eigen::VectorXd q, qd, qdd;
+  for (int k = 0; k <= 1000; ++k) {
+    t->Sample(duration * k / 1000.0, &q, &qd, &qdd);
+    r = std::max({r, qd.cwiseQuotient(vmax).cwiseAbs().maxCoeff(),
+                  std::sqrt(qdd.cwiseQuotient(amax).cwiseAbs().maxCoeff())});
+  }
+  const double s = r * 1.02;  // new time = s * old time
+  if (!(s > 0) || s >= 1.0) return;
+  for (double& time : t->times) time *= s;
+  for (Eigen::VectorXd& v : t->velocities) v /= s;
+  for (Eigen::VectorXd& a : t->accelerations) a /= s * s;
+}
+
+}  // namespace
+
+MotionPlanner::MotionPlanner(const Articulation& arm, const std::vector<std::string>& joints,
+                             const Eigen::VectorXd& velocity_limits,
+                             const Eigen::VectorXd& acceleration_limits)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& p = *impl_;
+  p.arm = arm;
+  if (joints.empty()) {
+    for (const Joint& j : arm.GetActiveJoints()) p.names.push_back(j.GetName());
+  } else {
+    p.names = joints;
+  }
+  if (p.names.empty())
+    throw Error("MotionPlanner: articulation '" + arm.GetName() + "' has no dof");
+  if (p.names.size() > 64) throw Error("MotionPlanner: at most 64 planned joints");
+  const int n = static_cast<int>(p.names.size());
+  Eigen::MatrixX2d all = arm.GetQlimits();
+  p.limits.resize(n, 2);
+  std::vector<int> planned_of_link(arm.GetLinks().size(), -1);
+  for (int i = 0; i < n; ++i) {
+    Joint j = arm.FindJointByName(p.names[i]);
+    if (j.GetDofIndex() < 0)
+      throw Error("MotionPlanner: joint '" + p.names[i] + "' has no dof of its own");
+    if (std::find(p.dofs.begin(), p.dofs.end(), j.GetDofIndex()) != p.dofs.end())
+      throw Error("MotionPlanner: joint '" + p.names[i] + "' is listed twice");
+    p.dofs.push_back(j.GetDofIndex());
+    planned_of_link[j.GetIndex()] = i;
+    p.limits.row(i) = all.row(j.GetDofIndex());
+    // unlimited joints are sampled over one turn either way
+    if (!std::isfinite(p.limits(i, 0))) p.limits(i, 0) = -2 * M_PI;
+    if (!std::isfinite(p.limits(i, 1))) p.limits(i, 1) = 2 * M_PI;
+  }
+  // which planned joints move each link: those on its path to the root
+  std::vector<Link> links = arm.GetLinks();
+  p.link_mask.assign(links.size(), 0);
+  for (size_t l = 0; l < links.size(); ++l) {
+    uint64_t mask = 0;
+    for (int k = static_cast<int>(l); k >= 0; k = links[k].GetParentIndex())
+      if (planned_of_link[k] >= 0) mask |= uint64_t{1} << planned_of_link[k];
+    p.link_mask[l] = mask;
+  }
+  p.velocity_limits =
+      velocity_limits.size() == 0 ? Eigen::VectorXd::Constant(n, 1.0) : velocity_limits;
+  p.acceleration_limits =
+      acceleration_limits.size() == 0 ? Eigen::VectorXd::Constant(n, 2.0) : acceleration_limits;
+  p.CheckVector(p.velocity_limits, "velocity_limits");
+  p.CheckVector(p.acceleration_limits, "acceleration_limits");
+  if (!(p.velocity_limits.minCoeff() > 0) || !(p.acceleration_limits.minCoeff() > 0))
+    throw Error("MotionPlanner: velocity and acceleration limits must be > 0");
+}
+
+MotionPlanner::~MotionPlanner() = default;
+
+const std::vector<std::string>& MotionPlanner::GetJointNames() const { return impl_->names; }
+
+Eigen::VectorXd MotionPlanner::GetCurrentPositions() const {
+  Eigen::VectorXd full = impl_->arm.GetQpos(), q(impl_->dofs.size());
+  for (size_t i = 0; i < impl_->dofs.size(); ++i)
+    q[static_cast<Eigen::Index>(i)] = full[impl_->dofs[i]];
+  return q;
+}
+
+void MotionPlanner::UpdateSnapshot() { impl_->Snapshot(); }
+
+bool MotionPlanner::IsStateValid(const Eigen::VectorXd& q, double clearance, std::string* reason) {
+  impl_->CheckVector(q, "q");
+  if (!(clearance >= 0) || !std::isfinite(clearance))
+    throw Error("MotionPlanner: clearance must be finite and >= 0");
+  return impl_->Check(q, clearance, reason);
+}
+
+PlanResult MotionPlanner::PlanToJoints(const Eigen::VectorXd& goal, const PlannerOptions& options) {
+  auto t0 = std::chrono::steady_clock::now();
+  impl_->CheckVector(goal, "goal");
+  CheckOptions(options);
+  impl_->Snapshot();
+  return impl_->Plan(goal, options, t0);
+}
+
+PlanResult MotionPlanner::Impl::Plan(const Eigen::VectorXd& goal, const PlannerOptions& opt,
+                                     std::chrono::steady_clock::time_point t0) {
+  PlanResult r;
+  auto fail = [&](const std::string& msg) {
+    r.success = false;
+    r.message = msg;
+    r.planning_time = Seconds(t0);
+    return r;
+  };
+  const int n = static_cast<int>(dofs.size());
+  Eigen::VectorXd start(n);
+  for (int i = 0; i < n; ++i) start[i] = base_q[dofs[i]];
+  // a start a hair outside the limits (physics) is pulled in
+  for (int i = 0; i < n; ++i)
+    if (start[i] >= limits(i, 0) - 1e-3 && start[i] <= limits(i, 1) + 1e-3)
+      start[i] = std::clamp(start[i], limits(i, 0), limits(i, 1));
+  std::string why;
+  if (!Check(goal, opt.clearance, &why)) return fail("the goal is not valid: " + why);
+  if (!Check(start, opt.clearance, &why)) return fail("the start is not valid: " + why);
+
+  // OMPL problem over the planned joints
+  ompl::msg::setLogLevel(ompl::msg::LOG_ERROR);
+  auto space = std::make_shared<ob::RealVectorStateSpace>(n);
+  ob::RealVectorBounds bounds(n);
+  for (int i = 0; i < n; ++i) {
+    bounds.setLow(i, limits(i, 0));
+    bounds.setHigh(i, std::max(limits(i, 1), limits(i, 0) + 1e-9));
+  }
+  space->setBounds(bounds);
+  og::SimpleSetup ss(space);
+  const double clearance = opt.clearance;
+  ss.setStateValidityChecker([this, n, clearance](const ob::State* s) {
+    const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
+    Eigen::VectorXd q(n);
+    for (int i = 0; i < n; ++i) q[i] = v->values[i];
+    return Check(q, clearance, nullptr);
+  });
+  ss.getSpaceInformation()->setStateValidityCheckingResolution(
+      std::min(1.0, opt.resolution / std::max(1e-9, space->getMaximumExtent())));
+  ss.setPlanner(MakePlanner(opt.algorithm, ss.getSpaceInformation()));
+  ob::ScopedState<> s0(space), s1(space);
+  for (int i = 0; i < n; ++i) {
+    s0[i] = start[i];
+    s1[i] = goal[i];
+  }
+  ss.setStartAndGoalStates(s0, s1, 1e-4);
+  ob::PlannerStatus status = ss.solve(opt.time_limit);
+  if (!status || !ss.haveExactSolutionPath())
+    return fail("no collision-free path found in " + std::to_string(opt.time_limit) + " s (" +
+                opt.algorithm + ")");
+  if (opt.simplify) ss.simplifySolution(1.0);
+  const og::PathGeometric& path = ss.getSolutionPath();
+  std::vector<Eigen::VectorXd> waypoints;
+  for (std::size_t k = 0; k < path.getStateCount(); ++k) {
+    const auto* v = path.getState(k)->as<ob::RealVectorStateSpace::StateType>();
+    Eigen::VectorXd q(n);
+    for (int i = 0; i < n; ++i) q[i] = v->values[i];
+    waypoints.push_back(q);
+  }
+  waypoints.front() = start;
+  if ((waypoints.back() - goal).cwiseAbs().maxCoeff() > 0) waypoints.push_back(goal);
+  r.path = waypoints;
+
+  // time it: the spline through the waypoints must stay collision-free too; densify until it does
+  const double dt = opt.resolution / velocity_limits.maxCoeff();
+  double step = 0.8;
+  for (int attempt = 0; attempt < 7; ++attempt, step /= 2) {
+    JointTrajectory t =
+        TimeParameterize(Densify(waypoints, step), velocity_limits, acceleration_limits);
+    SpeedUp(&t, velocity_limits, acceleration_limits);
+    bool ok = true;
+    Eigen::VectorXd q;
+    for (double time = 0; ok && time < t.Duration() + dt; time += dt) {
+      t.Sample(std::min(time, t.Duration()), &q);
+      ok = Check(q, clearance, &why);
+    }
+    if (ok) {
+      r.trajectory = std::move(t);
+      r.success = true;
+      r.planning_time = Seconds(t0);
+      return r;
+    }
+  }
+  return fail("the timed trajectory leaves the collision-free path: " + why);
+}
+
+PlanResult MotionPlanner::PlanToPose(const std::string& link, const Pose& tcp_offset,
+                                     const Pose& target, const PlannerOptions& options) {
+  auto t0 = std::chrono::steady_clock::now();
+  Impl& p = *impl_;
+  CheckOptions(options);
+  if (!target.p.allFinite() || !target.q.coeffs().allFinite())
+    throw Error("MotionPlanner::PlanToPose: target is not finite");
+  KinematicModel model = KinematicModel::FromArticulation(p.arm);
+  const int link_index = model.LinkIndex(link);
+  p.Snapshot();
+  IkOptions ik;
+  ik.offset = tcp_offset;
+  ik.active.assign(model.Dof(), false);
+  for (int d : p.dofs) ik.active[d] = true;
+  ik.restarts = 0;
+  const int n = static_cast<int>(p.dofs.size());
+  Eigen::VectorXd start(n);
+  for (int i = 0; i < n; ++i) start[i] = p.base_q[p.dofs[i]];
+  std::mt19937 rng(options.seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  bool found = false;
+  Eigen::VectorXd best;
+  std::string last = "IK found no solution";
+  for (int a = 0; a < std::max(1, options.ik_attempts); ++a) {
+    Eigen::VectorXd init = p.base_q;
+    if (a > 0)
+      for (int i = 0; i < n; ++i)
+        init[p.dofs[i]] = p.limits(i, 0) + u(rng) * (p.limits(i, 1) - p.limits(i, 0));
+    IkResult res = InverseKinematics(model, link_index, target, init, ik);
+    if (!res.success) {
+      last = "IK: " + res.message;
+      continue;
+    }
+    Eigen::VectorXd q(n);
+    for (int i = 0; i < n; ++i) q[i] = res.q[p.dofs[i]];
+    std::string why;
+    if (!p.Check(q, options.clearance, &why)) {
+      last = "IK solution in collision: " + why;
+      continue;
+    }
+    if (!found || (q - start).norm() < (best - start).norm()) best = q;
+    found = true;
+  }
+  if (!found) {
+    PlanResult r;
+    r.message = "no valid joint goal for the pose (" + std::to_string(options.ik_attempts) +
+                " IK attempts; last: " + last + ")";
+    r.planning_time = Seconds(t0);
+    return r;
+  }
+  return p.Plan(best, options, t0);
+}
+
+}  // namespace partsim
