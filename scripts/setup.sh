@@ -12,6 +12,7 @@ PACKAGES=(
   clang libclang-rt-14-dev clang-format
   libegl-dev libegl-mesa0 libgl1-mesa-dri libopengl-dev libembree-dev libpng-dev
   libbullet-extras-dev libjpeg-dev libompl-dev
+  libwebsocketpp-dev libboost-dev
 )
 
 missing=()

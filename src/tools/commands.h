@@ -11,4 +11,8 @@ int RunAssetsCommand(int argc, char** argv);
 /// "tasks"). Returns the exit code (0 success, 1 failure, 2 bad command line).
 int RunTasksCommand(int argc, char** argv);
 
+/// `partsim serve ...`: a scene stepped in real time behind a rosbridge v2 WebSocket server
+/// (arguments after "serve"). Returns the exit code (0 success, 1 failure, 2 bad command line).
+int RunServeCommand(int argc, char** argv);
+
 }  // namespace partsim::tools

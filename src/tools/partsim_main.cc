@@ -45,6 +45,7 @@ usage:
   partsim render [FILE.urdf] --out DIR [options]
   partsim assets generate --out DIR [options]   (see partsim assets --help)
   partsim tasks demo|evaluate [options]         (see partsim tasks --help)
+  partsim serve [SCENE.urdf] [options]          (see partsim serve --help)
   partsim --help | --version
 
 info       prints the links (name, parent, mass), the joints (name, type, parent -> child,
@@ -692,12 +693,13 @@ int main(int argc, char** argv) {
   }
   if (command == "assets") return partsim::tools::RunAssetsCommand(argc - 2, argv + 2);
   if (command == "tasks") return partsim::tools::RunTasksCommand(argc - 2, argv + 2);
+  if (command == "serve") return partsim::tools::RunServeCommand(argc - 2, argv + 2);
   if (command != "info" && command != "simulate" && command != "render") {
-    std::fprintf(
-        stderr,
-        "partsim: unknown %s '%s' (expected info, simulate, render, assets or tasks; see partsim "
-        "--help)\n",
-        command[0] == '-' ? "option" : "command", command.c_str());
+    std::fprintf(stderr,
+                 "partsim: unknown %s '%s' (expected info, simulate, render, assets, tasks or "
+                 "serve; see partsim "
+                 "--help)\n",
+                 command[0] == '-' ? "option" : "command", command.c_str());
     return 2;
   }
   try {

@@ -1,0 +1,63 @@
+// A rosbridge v2 protocol server (JSON over WebSocket) in front of a SimServer: /clock,
+// /joint_states and /tf are published from the simulation thread; joint position, velocity and
+// trajectory commands, rosapi services and the simulation controls (pause, resume, reset, step)
+// come in. Each client has its own subscriptions and a bounded outgoing queue: a client that
+// reads slowly loses messages, the simulation never waits for it.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "partsim/physics/scene.h"
+#include "partsim/robot/controllers.h"
+#include "partsim/server/sim_server.h"
+
+namespace partsim {
+
+struct RosbridgeOptions {
+  std::string address = "127.0.0.1";  ///< interface to listen on ("0.0.0.0" for all)
+  int port = 9090;                    ///< 0 picks a free port (see GetPort)
+  /// Incoming messages larger than this close the connection with WebSocket code 1009.
+  size_t max_message_bytes = 16u << 20;
+  size_t max_client_queue = 200;          ///< messages waiting per client before drops
+  size_t max_client_buffered = 4u << 20;  ///< bytes in a client's socket queue before drops
+  double control_rate = 0.0;              ///< Hz of the robot controllers; 0: every step
+};
+
+/// Counters for the README and the tests.
+struct RosbridgeStats {
+  long long clients = 0;            ///< connected now
+  long long messages_sent = 0;      ///< handed to sockets
+  long long messages_dropped = 0;   ///< dropped for slow clients
+  long long commands = 0;           ///< robot commands applied
+  double mean_latency_steps = 0.0;  ///< steps between a command's arrival and its application
+  long long max_latency_steps = 0;
+  long long errors = 0;  ///< status errors sent
+};
+
+class RosbridgeServer {
+ public:
+  /// `robot` is the articulation commanded under /<robot_name>/...; the server adds its
+  /// controllers to `loop` (call before sim->Start()). All pointers must outlive the server.
+  RosbridgeServer(SimServer* sim, Scene* scene, ControlLoop* loop, const Articulation& robot,
+                  const std::string& robot_name, const RosbridgeOptions& options = {});
+  ~RosbridgeServer();
+  RosbridgeServer(const RosbridgeServer&) = delete;
+  RosbridgeServer& operator=(const RosbridgeServer&) = delete;
+
+  /// Starts listening and serving on a thread of its own; throws partsim::Error if the port
+  /// cannot be opened. Also installs the SimServer's step callback.
+  void Start();
+  /// Closes all connections and joins the network thread. Idempotent.
+  void Stop();
+  /// The port listened on (after Start).
+  int GetPort() const;
+  RosbridgeStats GetStats() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace partsim

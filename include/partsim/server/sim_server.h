@@ -1,0 +1,90 @@
+// Asynchronous mode: a Scene stepped on its own thread in real time, at a real-time factor or
+// as fast as possible, with a monotonic clock and a thread-safe command queue. Commands posted
+// from any thread run on the simulation thread between two steps, so they take effect at the
+// simulation time at which they arrive.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "partsim/physics/scene.h"
+#include "partsim/robot/controllers.h"
+
+namespace partsim {
+
+/// How fast the simulation thread steps.
+struct SimServerOptions {
+  /// Simulated seconds per wall-clock second; 1 is real time. Ignored when `fast` is set.
+  double realtime_factor = 1.0;
+  bool fast = false;  ///< step as fast as possible
+  /// Falling behind the wall clock by more than this (s) drops the lag instead of catching up.
+  double max_lag = 0.1;
+};
+
+/// Runs a Scene (and an optional ControlLoop over it) on its own thread. Every scene access from
+/// other threads must go through Post(); the step callback runs on the simulation thread.
+class SimServer {
+ public:
+  /// A command run on the simulation thread between two steps.
+  using Command = std::function<void()>;
+  /// Called on the simulation thread after every step with the clock (steps since Start).
+  using StepCallback = std::function<void(long long clock_steps)>;
+
+  /// `scene` (and `loop`, which may be null) must outlive the server. The state at construction
+  /// is what Reset() goes back to.
+  SimServer(Scene* scene, ControlLoop* loop, const SimServerOptions& options = {});
+  ~SimServer();
+  SimServer(const SimServer&) = delete;
+  SimServer& operator=(const SimServer&) = delete;
+
+  /// Starts the thread, running unless `paused`. Throws partsim::Error if already started.
+  void Start(bool paused = false);
+  /// Stops and joins the thread (queued commands still run first). Idempotent.
+  void Stop();
+  void Pause();
+  void Resume();
+  bool IsPaused() const { return paused_; }
+  /// While paused: advances exactly n steps, then stays paused. Running: no effect.
+  void StepN(int n);
+  /// Restores the state from construction (queued like a command). The clock keeps counting.
+  void Reset();
+  /// Queues a command; it runs before the next step (or at once while paused).
+  void Post(Command command);
+  /// Sets the callback (before Start).
+  void SetStepCallback(StepCallback callback) { callback_ = std::move(callback); }
+  void SetOptions(const SimServerOptions& options);
+
+  /// Monotonic clock: steps taken since Start (Reset does not rewind it), and in seconds.
+  long long GetClockSteps() const { return clock_steps_; }
+  double GetClockSeconds() const { return clock_steps_ * dt_; }
+  double GetTimestep() const { return dt_; }
+  /// Commands run so far.
+  long long GetCommandsRun() const { return commands_run_; }
+
+ private:
+  void Loop();
+  void RunCommands(std::unique_lock<std::mutex>& lock);
+  Scene* scene_;
+  ControlLoop* loop_;
+  SimServerOptions options_;
+  double dt_;
+  std::vector<char> initial_state_;
+  StepCallback callback_;
+  std::thread thread_;
+  mutable std::mutex mutex_;
+  std::condition_variable cv_;
+  std::vector<Command> queue_;
+  bool stop_ = false;
+  bool resync_ = true;  ///< re-anchor the wall clock at the next step
+  std::atomic<bool> paused_{false};
+  std::atomic<long long> pending_steps_{0};
+  std::atomic<long long> clock_steps_{0};
+  std::atomic<long long> commands_run_{0};
+};
+
+}  // namespace partsim

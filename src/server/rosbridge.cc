@@ -1,0 +1,642 @@
+#include "partsim/server/rosbridge.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <thread>
+#include <websocketpp/config/asio_no_tls.hpp>
+#include <websocketpp/server.hpp>
+
+#include "partsim/core/error.h"
+
+namespace partsim {
+
+namespace {
+
+using json = nlohmann::json;
+using WsServer = websocketpp::server<websocketpp::config::asio>;
+using Hdl = websocketpp::connection_hdl;
+using WallClock = std::chrono::steady_clock;
+
+// topics the simulation publishes, and the commands it takes
+const char* kClockType = "rosgraph_msgs/Clock";
+const char* kJointStateType = "sensor_msgs/JointState";
+const char* kTfType = "tf2_msgs/TFMessage";
+const char* kFloat64ArrayType = "std_msgs/Float64MultiArray";
+const char* kTrajectoryType = "trajectory_msgs/JointTrajectory";
+
+json Stamp(double t) {
+  double secs = std::floor(t);
+  return {{"secs", static_cast<long long>(secs)},
+          {"nsecs", static_cast<long long>(std::llround((t - secs) * 1e9)) % 1000000000}};
+}
+
+/// Reads a ROS duration {secs, nsecs} (or a number of seconds).
+double Duration(const json& d) {
+  if (d.is_number()) return d.get<double>();
+  if (!d.is_object()) throw Error("time_from_start is not a duration");
+  double s = d.value("secs", 0.0) + d.value("nsecs", 0.0) * 1e-9;
+  if (d.contains("sec")) s = d.value("sec", 0.0) + d.value("nanosec", 0.0) * 1e-9;
+  return s;
+}
+
+/// Numbers of a JSON array; throws naming `what`.
+std::vector<double> Numbers(const json& a, const std::string& what) {
+  if (!a.is_array()) throw Error(what + " is not an array of numbers");
+  std::vector<double> v;
+  for (const json& x : a) {
+    if (!x.is_number()) throw Error(what + " holds a value that is not a number");
+    double d = x.get<double>();
+    if (!std::isfinite(d)) throw Error(what + " holds a value that is not finite");
+    v.push_back(d);
+  }
+  return v;
+}
+
+Eigen::VectorXd ToVector(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+}  // namespace
+
+struct RosbridgeServer::Impl {
+  struct Subscription {
+    double throttle_ms = 0;
+    size_t queue_length = 0;  // 0: the server's bound
+    WallClock::time_point last_sent{};
+  };
+  struct Client {
+    Hdl hdl;
+    std::map<std::string, Subscription> subs;
+    std::map<std::string, std::string> advertised;  // topic -> type
+    std::set<std::string> services;                 // advertised by this client
+    std::mutex out_mutex;
+    std::deque<std::pair<std::string, size_t>> out;  // message, queue bound
+    std::atomic<bool> flush_scheduled{false};
+  };
+  using ClientPtr = std::shared_ptr<Client>;
+
+  SimServer* sim;
+  Scene* scene;
+  ControlLoop* loop;
+  Articulation robot;
+  std::string robot_name;
+  RosbridgeOptions options;
+  std::shared_ptr<JointPositionController> position_ctrl;
+  std::shared_ptr<JointVelocityController> velocity_ctrl;
+  std::shared_ptr<JointTrajectoryController> trajectory_ctrl;
+  std::shared_ptr<Controller> active;  // sim thread only
+
+  WsServer ws;
+  std::thread io_thread;
+  int port = 0;
+  bool started = false;
+
+  mutable std::mutex clients_mutex;
+  std::map<Hdl, ClientPtr, std::owner_less<Hdl>> clients;
+  // calls to client-advertised services: our id -> (caller, caller's id, service)
+  struct PendingCall {
+    std::weak_ptr<Client> caller;
+    json id;
+  };
+  std::map<std::string, PendingCall> pending_calls;
+  long long next_call = 0;
+
+  std::atomic<long long> sent{0}, dropped{0}, commands{0}, errors{0}, max_latency{0};
+  std::atomic<long long> latency_sum{0};
+
+  // ---- outgoing ----
+  /// Queues a message for a client from any thread; drops the oldest beyond the bound.
+  void Enqueue(const ClientPtr& c, const std::string& msg, size_t bound) {
+    if (bound == 0 || bound > options.max_client_queue) bound = options.max_client_queue;
+    {
+      std::lock_guard<std::mutex> lock(c->out_mutex);
+      c->out.emplace_back(msg, bound);
+      while (c->out.size() > bound) {
+        c->out.pop_front();
+        ++dropped;
+      }
+    }
+    if (!c->flush_scheduled.exchange(true)) {
+      std::weak_ptr<Client> weak = c;
+      boost::asio::post(ws.get_io_service(), [this, weak] {
+        if (ClientPtr cp = weak.lock()) Flush(cp);
+      });
+    }
+  }
+
+  /// Network thread: hands queued messages to the socket unless its queue is full.
+  void Flush(const ClientPtr& c) {
+    std::deque<std::pair<std::string, size_t>> todo;
+    {
+      std::lock_guard<std::mutex> lock(c->out_mutex);
+      todo.swap(c->out);
+      c->flush_scheduled = false;
+    }
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = ws.get_con_from_hdl(c->hdl, ec);
+    if (ec || !con || con->get_state() != websocketpp::session::state::open) return;
+    for (auto& m : todo) {
+      if (con->get_buffered_amount() > options.max_client_buffered) {
+        ++dropped;
+        continue;
+      }
+      ec = con->send(m.first, websocketpp::frame::opcode::text);
+      if (ec) return;
+      ++sent;
+    }
+  }
+
+  void Status(const ClientPtr& c, const std::string& level, const std::string& msg,
+              const json& id = nullptr) {
+    json j = {{"op", "status"}, {"level", level}, {"msg", msg}};
+    if (!id.is_null()) j["id"] = id;
+    if (level == "error") ++errors;
+    Enqueue(c, j.dump(), 0);
+  }
+
+  // ---- topics ----
+  std::string Prefix() const { return "/" + robot_name; }
+  std::map<std::string, std::string> SimTopics() const {
+    return {{"/clock", kClockType},
+            {"/joint_states", kJointStateType},
+            {"/tf", kTfType},
+            {Prefix() + "/joint_position_controller/command", kFloat64ArrayType},
+            {Prefix() + "/joint_velocity_controller/command", kFloat64ArrayType},
+            {Prefix() + "/joint_trajectory_controller/command", kTrajectoryType}};
+  }
+  /// All topics with types: the simulation's and the clients' (clients_mutex held).
+  std::map<std::string, std::string> AllTopics() const {
+    std::map<std::string, std::string> t = SimTopics();
+    for (auto& [h, c] : clients)
+      for (auto& [topic, type] : c->advertised) t.emplace(topic, type);
+    return t;
+  }
+
+  // ---- simulation thread: messages after each step ----
+  json JointStateMsg(double t) const {
+    json names = json::array(), pos = json::array(), vel = json::array(), eff = json::array();
+    for (const Articulation& a : scene->GetArticulations()) {
+      Eigen::VectorXd q = a.GetQpos(), qd = a.GetQvel(), f = a.GetQf();
+      std::vector<Joint> joints = a.GetActiveJoints();
+      for (size_t i = 0; i < joints.size(); ++i) {
+        names.push_back(joints[i].GetName());
+        pos.push_back(q[i]);
+        vel.push_back(qd[i]);
+        eff.push_back(f[i]);
+      }
+    }
+    return {{"header", {{"seq", 0}, {"stamp", Stamp(t)}, {"frame_id", ""}}},
+            {"name", names},
+            {"position", pos},
+            {"velocity", vel},
+            {"effort", eff}};
+  }
+  json TfMsg(double t) const {
+    json tfs = json::array();
+    for (const Articulation& a : scene->GetArticulations())
+      for (const Link& l : a.GetLinks()) {
+        Pose X = l.GetPose();
+        tfs.push_back(
+            {{"header", {{"seq", 0}, {"stamp", Stamp(t)}, {"frame_id", "world"}}},
+             {"child_frame_id", l.GetName()},
+             {"transform",
+              {{"translation", {{"x", X.p.x()}, {"y", X.p.y()}, {"z", X.p.z()}}},
+               {"rotation", {{"x", X.q.x()}, {"y", X.q.y()}, {"z", X.q.z()}, {"w", X.q.w()}}}}}});
+      }
+    return {{"transforms", tfs}};
+  }
+
+  void OnStep(long long steps) {
+    const double t = steps * sim->GetTimestep();
+    const WallClock::time_point now = WallClock::now();
+    std::lock_guard<std::mutex> lock(clients_mutex);
+    if (clients.empty()) return;
+    static const char* kPublished[] = {"/clock", "/joint_states", "/tf"};
+    for (const char* topic : kPublished) {
+      std::string text;  // built once, when some client is due
+      for (auto& [h, c] : clients) {
+        auto it = c->subs.find(topic);
+        if (it == c->subs.end()) continue;
+        Subscription& s = it->second;
+        if (s.throttle_ms > 0 &&
+            std::chrono::duration<double, std::milli>(now - s.last_sent).count() < s.throttle_ms)
+          continue;
+        if (text.empty()) {
+          json msg = std::string(topic) == "/clock"          ? json{{"clock", Stamp(t)}}
+                     : std::string(topic) == "/joint_states" ? JointStateMsg(t)
+                                                             : TfMsg(t);
+          text = json{{"op", "publish"}, {"topic", topic}, {"msg", msg}}.dump();
+        }
+        s.last_sent = now;
+        Enqueue(c, text, s.queue_length);
+      }
+    }
+  }
+
+  // ---- commands (applied on the simulation thread) ----
+  void Activate(const std::shared_ptr<Controller>& c) {
+    if (active == c) return;
+    if (active) loop->Remove(active);
+    loop->Add(c);
+    active = c;
+  }
+
+  void PostCommand(const ClientPtr& client, const json& id, std::function<void()> apply) {
+    const long long arrival = sim->GetClockSteps();
+    std::weak_ptr<Client> weak = client;
+    sim->Post([this, arrival, weak, id, apply] {
+      long long lat = sim->GetClockSteps() - arrival;
+      latency_sum += lat;
+      long long m = max_latency;
+      while (lat > m && !max_latency.compare_exchange_weak(m, lat)) {
+      }
+      ++commands;
+      try {
+        apply();
+      } catch (const std::exception& e) {
+        if (ClientPtr c = weak.lock()) Status(c, "error", e.what(), id);
+      }
+    });
+  }
+
+  /// Checks and applies a message published to one of the simulation's command topics.
+  void HandleCommand(const ClientPtr& c, const std::string& topic, const json& msg,
+                     const json& id) {
+    if (!msg.is_object()) throw Error("publish to " + topic + ": msg is not an object");
+    const int n = position_ctrl->NumJoints();
+    if (topic == Prefix() + "/joint_position_controller/command" ||
+        topic == Prefix() + "/joint_velocity_controller/command") {
+      if (!msg.contains("data")) throw Error(topic + ": std_msgs/Float64MultiArray needs 'data'");
+      std::vector<double> data = Numbers(msg["data"], topic + " data");
+      if (static_cast<int>(data.size()) != n)
+        throw Error(topic + ": data has " + std::to_string(data.size()) + " values, the robot " +
+                    std::to_string(n) + " joints");
+      Eigen::VectorXd v = ToVector(data);
+      if (topic.find("position") != std::string::npos)
+        PostCommand(c, id, [this, v] {
+          position_ctrl->SetTarget(v);
+          Activate(position_ctrl);
+        });
+      else
+        PostCommand(c, id, [this, v] {
+          velocity_ctrl->SetTarget(v);
+          Activate(velocity_ctrl);
+        });
+      return;
+    }
+    // trajectory_msgs/JointTrajectory
+    if (!msg.contains("joint_names") || !msg["joint_names"].is_array() || !msg.contains("points") ||
+        !msg["points"].is_array())
+      throw Error(topic + ": trajectory_msgs/JointTrajectory needs joint_names and points");
+    const std::vector<std::string>& all = position_ctrl->GetJointNames();
+    std::vector<int> index;  // controller index of each named joint
+    for (const json& name : msg["joint_names"]) {
+      if (!name.is_string()) throw Error(topic + ": joint_names holds a non-string");
+      auto it = std::find(all.begin(), all.end(), name.get<std::string>());
+      if (it == all.end()) throw Error(topic + ": unknown joint '" + name.get<std::string>() + "'");
+      index.push_back(static_cast<int>(it - all.begin()));
+    }
+    if (msg["points"].empty()) throw Error(topic + ": no points");
+    std::vector<double> times;
+    std::vector<std::vector<double>> pos, vel;
+    for (size_t k = 0; k < msg["points"].size(); ++k) {
+      const json& p = msg["points"][k];
+      std::string what = topic + " points[" + std::to_string(k) + "]";
+      if (!p.is_object() || !p.contains("positions")) throw Error(what + " has no positions");
+      pos.push_back(Numbers(p["positions"], what + ".positions"));
+      if (pos.back().size() != index.size())
+        throw Error(what + ".positions does not match joint_names");
+      if (p.contains("velocities") && p["velocities"].is_array() && !p["velocities"].empty()) {
+        vel.push_back(Numbers(p["velocities"], what + ".velocities"));
+        if (vel.back().size() != index.size())
+          throw Error(what + ".velocities does not match joint_names");
+      }
+      times.push_back(p.contains("time_from_start") ? Duration(p["time_from_start"]) : 0.0);
+    }
+    if (!vel.empty() && vel.size() != pos.size()) vel.clear();
+    PostCommand(c, id, [this, index, times, pos, vel] {
+      // joints not named hold where they are; a first point after 0 starts from here
+      Eigen::VectorXd here = trajectory_ctrl->GetQpos();
+      JointTrajectory traj;
+      if (times.front() > 1e-9) {
+        traj.times.push_back(0.0);
+        traj.positions.push_back(here);
+        if (!vel.empty()) traj.velocities.push_back(Eigen::VectorXd::Zero(here.size()));
+      }
+      for (size_t k = 0; k < times.size(); ++k) {
+        Eigen::VectorXd q = here, qd = Eigen::VectorXd::Zero(here.size());
+        for (size_t i = 0; i < index.size(); ++i) {
+          q[index[i]] = pos[k][i];
+          if (!vel.empty()) qd[index[i]] = vel[k][i];
+        }
+        traj.times.push_back(times[k]);
+        traj.positions.push_back(q);
+        if (!vel.empty()) traj.velocities.push_back(qd);
+      }
+      trajectory_ctrl->SetTrajectory(traj);
+      Activate(trajectory_ctrl);
+    });
+  }
+
+  // ---- services ----
+  /// Built-in services; returns false if `service` is not one.
+  bool CallBuiltin(const ClientPtr& c, const std::string& service, const json& args,
+                   const json& id) {
+    json values;
+    if (service == "/rosapi/topics") {
+      json topics = json::array(), types = json::array();
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      for (auto& [t, ty] : AllTopics()) {
+        topics.push_back(t);
+        types.push_back(ty);
+      }
+      values = {{"topics", topics}, {"types", types}};
+    } else if (service == "/rosapi/topic_type") {
+      if (!args.is_object() || !args.contains("topic") || !args["topic"].is_string())
+        throw Error("/rosapi/topic_type needs args {topic: string}");
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      auto all = AllTopics();
+      auto it = all.find(args["topic"].get<std::string>());
+      values = {{"type", it == all.end() ? "" : it->second}};
+    } else if (service == "/rosapi/services") {
+      json names = {"/rosapi/topics",  "/rosapi/topic_type", "/rosapi/services", "/partsim/pause",
+                    "/partsim/resume", "/partsim/reset",     "/partsim/step",    "/partsim/stats"};
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      for (auto& [h, cl] : clients)
+        for (const std::string& s : cl->services) names.push_back(s);
+      values = {{"services", names}};
+    } else if (service == "/partsim/pause") {
+      sim->Pause();
+      values = json::object();
+    } else if (service == "/partsim/resume") {
+      sim->Resume();
+      values = json::object();
+    } else if (service == "/partsim/reset") {
+      sim->Reset();
+      values = json::object();
+    } else if (service == "/partsim/step") {
+      int n = 1;
+      if (args.is_object() && args.contains("n")) {
+        if (!args["n"].is_number_integer() || args["n"].get<int>() < 1)
+          throw Error("/partsim/step: n must be a positive integer");
+        n = args["n"].get<int>();
+      }
+      sim->StepN(n);
+      values = json::object();
+    } else if (service == "/partsim/stats") {
+      RosbridgeStats s = Stats();
+      values = {{"clients", s.clients},
+                {"messages_sent", s.messages_sent},
+                {"messages_dropped", s.messages_dropped},
+                {"commands", s.commands},
+                {"mean_latency_steps", s.mean_latency_steps},
+                {"max_latency_steps", s.max_latency_steps},
+                {"clock_steps", sim->GetClockSteps()},
+                {"timestep", sim->GetTimestep()}};
+    } else {
+      return false;
+    }
+    json r = {
+        {"op", "service_response"}, {"service", service}, {"values", values}, {"result", true}};
+    if (!id.is_null()) r["id"] = id;
+    Enqueue(c, r.dump(), 0);
+    return true;
+  }
+
+  RosbridgeStats Stats() const {
+    RosbridgeStats s;
+    {
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      s.clients = static_cast<long long>(clients.size());
+    }
+    s.messages_sent = sent;
+    s.messages_dropped = dropped;
+    s.commands = commands;
+    s.mean_latency_steps = commands > 0 ? static_cast<double>(latency_sum) / commands : 0.0;
+    s.max_latency_steps = max_latency;
+    s.errors = errors;
+    return s;
+  }
+
+  // ---- network thread: one incoming message ----
+  void OnMessage(Hdl hdl, WsServer::message_ptr m) {
+    ClientPtr c;
+    {
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      auto it = clients.find(hdl);
+      if (it == clients.end()) return;
+      c = it->second;
+    }
+    json j;
+    try {
+      j = json::parse(m->get_payload());
+    } catch (const std::exception& e) {
+      Status(c, "error", std::string("malformed JSON: ") + e.what());
+      return;
+    }
+    json id = j.is_object() && j.contains("id") ? j["id"] : json();
+    try {
+      if (!j.is_object() || !j.contains("op") || !j["op"].is_string())
+        throw Error("message has no 'op' string");
+      Handle(c, j["op"].get<std::string>(), j, id);
+    } catch (const std::exception& e) {
+      Status(c, "error", e.what(), id);
+    }
+  }
+
+  static std::string Str(const json& j, const char* key, const std::string& op) {
+    if (!j.contains(key) || !j[key].is_string())
+      throw Error("op '" + op + "' needs a string '" + key + "'");
+    return j[key].get<std::string>();
+  }
+  /// A topic or service name; ROS resolves "rosapi/topics" to "/rosapi/topics" at the root.
+  static std::string Name(const json& j, const char* key, const std::string& op) {
+    std::string n = Str(j, key, op);
+    if (n.empty()) throw Error("op '" + op + "': empty '" + key + "'");
+    return n[0] == '/' ? n : "/" + n;
+  }
+
+  void Handle(const ClientPtr& c, const std::string& op, const json& j, const json& id) {
+    const auto sim_topics = SimTopics();
+    if (op == "subscribe") {
+      std::string topic = Name(j, "topic", op);
+      if (j.contains("type") && j["type"].is_string()) {
+        std::lock_guard<std::mutex> lock(clients_mutex);
+        auto all = AllTopics();
+        auto it = all.find(topic);
+        if (it != all.end() && it->second != j["type"].get<std::string>())
+          throw Error("subscribe " + topic + ": type is " + it->second + ", not " +
+                      j["type"].get<std::string>());
+      }
+      Subscription s;
+      if (j.contains("throttle_rate") && j["throttle_rate"].is_number())
+        s.throttle_ms = j["throttle_rate"].get<double>();
+      if (j.contains("queue_length") && j["queue_length"].is_number_integer() &&
+          j["queue_length"].get<long long>() > 0)
+        s.queue_length = static_cast<size_t>(j["queue_length"].get<long long>());
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      c->subs[topic] = s;
+    } else if (op == "unsubscribe") {
+      std::string topic = Name(j, "topic", op);
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      c->subs.erase(topic);
+    } else if (op == "advertise") {
+      std::string topic = Name(j, "topic", op), type = Str(j, "type", op);
+      auto it = sim_topics.find(topic);
+      if (it != sim_topics.end() && it->second != type)
+        throw Error("advertise " + topic + ": its type is " + it->second + ", not " + type);
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      for (auto& [h, other] : clients) {
+        auto o = other->advertised.find(topic);
+        if (o != other->advertised.end() && o->second != type)
+          throw Error("advertise " + topic + ": already advertised as " + o->second);
+      }
+      c->advertised[topic] = type;
+    } else if (op == "unadvertise") {
+      std::string topic = Name(j, "topic", op);
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      c->advertised.erase(topic);
+    } else if (op == "publish") {
+      std::string topic = Name(j, "topic", op);
+      if (!j.contains("msg")) throw Error("publish " + topic + ": no 'msg'");
+      if (topic == "/clock" || topic == "/joint_states" || topic == "/tf")
+        throw Error("publish " + topic + ": the simulation publishes this topic");
+      if (sim_topics.count(topic)) {
+        HandleCommand(c, topic, j["msg"], id);
+        return;
+      }
+      // a client's own topic: relay to its subscribers
+      std::string text = json{{"op", "publish"}, {"topic", topic}, {"msg", j["msg"]}}.dump();
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      for (auto& [h, other] : clients) {
+        auto it = other->subs.find(topic);
+        if (it != other->subs.end()) Enqueue(other, text, it->second.queue_length);
+      }
+    } else if (op == "call_service") {
+      std::string service = Name(j, "service", op);
+      json args = j.contains("args") ? j["args"] : json::object();
+      if (CallBuiltin(c, service, args, id)) return;
+      // a service some client advertised: forward it with our own id
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      for (auto& [h, provider] : clients) {
+        if (!provider->services.count(service)) continue;
+        std::string call_id = "partsim_call_" + std::to_string(next_call++);
+        pending_calls[call_id] = {c, id};
+        Enqueue(provider,
+                json{{"op", "call_service"}, {"service", service}, {"args", args}, {"id", call_id}}
+                    .dump(),
+                0);
+        return;
+      }
+      throw Error("call_service: no service '" + service + "'");
+    } else if (op == "advertise_service") {
+      std::string service = Name(j, "service", op);
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      c->services.insert(service);
+    } else if (op == "unadvertise_service") {
+      std::string service = Name(j, "service", op);
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      c->services.erase(service);
+    } else if (op == "service_response") {
+      if (!j.contains("id") || !j["id"].is_string())
+        throw Error("service_response needs the 'id' of the call it answers");
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      auto it = pending_calls.find(j["id"].get<std::string>());
+      if (it == pending_calls.end())
+        throw Error("service_response: no pending call '" + j["id"].get<std::string>() + "'");
+      json r = j;
+      if (it->second.id.is_null())
+        r.erase("id");
+      else
+        r["id"] = it->second.id;
+      if (ClientPtr caller = it->second.caller.lock()) Enqueue(caller, r.dump(), 0);
+      pending_calls.erase(it);
+    } else {
+      throw Error("unknown op '" + op + "'");
+    }
+  }
+};
+
+RosbridgeServer::RosbridgeServer(SimServer* sim, Scene* scene, ControlLoop* loop,
+                                 const Articulation& robot, const std::string& robot_name,
+                                 const RosbridgeOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.sim = sim;
+  m.scene = scene;
+  m.loop = loop;
+  m.robot = robot;
+  m.robot_name = robot_name;
+  m.options = options;
+  JointControllerOptions co;
+  co.control_rate = options.control_rate > 0 ? options.control_rate : 1.0 / scene->GetTimestep();
+  m.position_ctrl =
+      std::make_shared<JointPositionController>(robot, std::vector<std::string>{}, co);
+  m.velocity_ctrl =
+      std::make_shared<JointVelocityController>(robot, std::vector<std::string>{}, co);
+  m.trajectory_ctrl =
+      std::make_shared<JointTrajectoryController>(robot, std::vector<std::string>{}, co);
+  m.Activate(m.position_ctrl);
+
+  m.ws.clear_access_channels(websocketpp::log::alevel::all);
+  m.ws.clear_error_channels(websocketpp::log::elevel::all);
+  m.ws.init_asio();
+  m.ws.set_reuse_addr(true);
+  m.ws.set_max_message_size(options.max_message_bytes);
+  m.ws.set_open_handler([this](Hdl h) {
+    auto c = std::make_shared<Impl::Client>();
+    c->hdl = h;
+    std::lock_guard<std::mutex> lock(impl_->clients_mutex);
+    impl_->clients[h] = c;
+  });
+  auto gone = [this](Hdl h) {
+    std::lock_guard<std::mutex> lock(impl_->clients_mutex);
+    impl_->clients.erase(h);
+  };
+  m.ws.set_close_handler(gone);
+  m.ws.set_fail_handler(gone);
+  m.ws.set_message_handler([this](Hdl h, WsServer::message_ptr msg) { impl_->OnMessage(h, msg); });
+}
+
+RosbridgeServer::~RosbridgeServer() { Stop(); }
+
+void RosbridgeServer::Start() {
+  Impl& m = *impl_;
+  if (m.started) throw Error("RosbridgeServer: already started");
+  websocketpp::lib::error_code ec;
+  boost::asio::ip::tcp::endpoint ep(boost::asio::ip::make_address(m.options.address),
+                                    static_cast<unsigned short>(m.options.port));
+  m.ws.listen(ep, ec);
+  if (ec)
+    throw Error("rosbridge: cannot listen on " + m.options.address + ":" +
+                std::to_string(m.options.port) + ": " + ec.message());
+  m.ws.start_accept(ec);
+  if (ec) throw Error("rosbridge: cannot accept: " + ec.message());
+  boost::system::error_code bec;
+  m.port = m.ws.get_local_endpoint(bec).port();
+  m.sim->SetStepCallback([this](long long steps) { impl_->OnStep(steps); });
+  m.io_thread = std::thread([this] { impl_->ws.run(); });
+  m.started = true;
+}
+
+void RosbridgeServer::Stop() {
+  Impl& m = *impl_;
+  if (!m.started) return;
+  m.started = false;
+  websocketpp::lib::error_code ec;
+  m.ws.stop_listening(ec);
+  m.ws.stop();
+  if (m.io_thread.joinable()) m.io_thread.join();
+}
+
+int RosbridgeServer::GetPort() const { return impl_->port; }
+
+RosbridgeStats RosbridgeServer::GetStats() const { return impl_->Stats(); }
+
+}  // namespace partsim

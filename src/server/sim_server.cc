@@ -1,0 +1,137 @@
+#include "partsim/server/sim_server.h"
+
+#include <chrono>
+
+#include "partsim/core/error.h"
+
+namespace partsim {
+
+using Clock = std::chrono::steady_clock;
+
+SimServer::SimServer(Scene* scene, ControlLoop* loop, const SimServerOptions& options)
+    : scene_(scene), loop_(loop), options_(options) {
+  if (!scene_) throw Error("SimServer: scene is null");
+  if (!options_.fast && !(options_.realtime_factor > 0))
+    throw Error("SimServer: realtime_factor must be positive");
+  dt_ = scene_->GetTimestep();
+  initial_state_ = scene_->Pack();
+}
+
+SimServer::~SimServer() { Stop(); }
+
+void SimServer::Start(bool paused) {
+  if (thread_.joinable()) throw Error("SimServer: already started");
+  paused_ = paused;
+  stop_ = false;
+  thread_ = std::thread([this] { Loop(); });
+}
+
+void SimServer::Stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void SimServer::Pause() {
+  paused_ = true;
+  cv_.notify_all();
+}
+
+void SimServer::Resume() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    paused_ = false;
+    resync_ = true;
+  }
+  cv_.notify_all();
+}
+
+void SimServer::StepN(int n) {
+  if (n <= 0) return;
+  pending_steps_ += n;
+  cv_.notify_all();
+}
+
+void SimServer::Reset() {
+  Post([this] { scene_->Unpack(initial_state_); });
+}
+
+void SimServer::Post(Command command) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.push_back(std::move(command));
+  }
+  cv_.notify_all();
+}
+
+void SimServer::SetOptions(const SimServerOptions& options) {
+  if (!options.fast && !(options.realtime_factor > 0))
+    throw Error("SimServer: realtime_factor must be positive");
+  std::lock_guard<std::mutex> lock(mutex_);
+  options_ = options;
+  resync_ = true;
+}
+
+void SimServer::RunCommands(std::unique_lock<std::mutex>& lock) {
+  // run outside the lock so commands may post further commands
+  std::vector<Command> todo;
+  todo.swap(queue_);
+  lock.unlock();
+  for (Command& c : todo) {
+    c();
+    ++commands_run_;
+  }
+  lock.lock();
+}
+
+void SimServer::Loop() {
+  Clock::time_point anchor_wall;
+  long long anchor_steps = 0;
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    RunCommands(lock);
+    if (stop_) break;
+    // paused with nothing to step: wait for a command, a step request or resume
+    if (paused_ && pending_steps_ == 0) {
+      cv_.wait(lock, [this] { return stop_ || !queue_.empty() || !paused_ || pending_steps_ > 0; });
+      continue;
+    }
+    const bool single = paused_;
+    if (single) --pending_steps_;
+    // pace against the wall clock
+    if (!single && !options_.fast) {
+      if (resync_) {
+        anchor_wall = Clock::now();
+        anchor_steps = clock_steps_;
+        resync_ = false;
+      }
+      const double sim_ahead = (clock_steps_ - anchor_steps) * dt_ / options_.realtime_factor;
+      Clock::time_point due = anchor_wall + std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double>(sim_ahead));
+      Clock::time_point now = Clock::now();
+      if (now > due + std::chrono::duration<double>(options_.max_lag)) {
+        resync_ = true;  // too far behind: drop the lag
+      } else if (due > now) {
+        // wake early for commands, pause or stop
+        if (cv_.wait_until(lock, due,
+                           [this] { return stop_ || !queue_.empty() || paused_.load(); }))
+          continue;
+      }
+    } else {
+      resync_ = true;
+    }
+    lock.unlock();
+    if (loop_)
+      loop_->Step(1);
+    else
+      scene_->Step(1);
+    const long long now_steps = ++clock_steps_;
+    if (callback_) callback_(now_steps);
+    lock.lock();
+  }
+}
+
+}  // namespace partsim

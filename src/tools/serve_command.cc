@@ -1,0 +1,172 @@
+// `partsim serve`: a scene stepped in real time (or faster) behind a rosbridge v2 server.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "commands.h"
+#include "partsim/assets/default_objects.h"
+#include "partsim/assets/urdf.h"
+#include "partsim/robot/robots.h"
+#include "partsim/server/rosbridge.h"
+#include "partsim/server/sim_server.h"
+
+namespace partsim::tools {
+namespace {
+
+constexpr char kServeUsage[] = R"(usage:
+  partsim serve [SCENE.urdf] [--port P] [--rate R | --realtime-factor F | --fast]
+                [--robot gripper|panda] [--address A] [--duration S]
+
+Steps a scene on its own thread and serves it over the rosbridge v2 protocol (JSON over
+WebSocket): /clock, /joint_states and /tf out; /<robot>/joint_position_controller/command,
+/<robot>/joint_velocity_controller/command (std_msgs/Float64MultiArray) and
+/<robot>/joint_trajectory_controller/command (trajectory_msgs/JointTrajectory) in; services
+/rosapi/topics, /rosapi/topic_type, /rosapi/services, /partsim/pause|resume|reset|step|stats.
+With no SCENE, a built-in cabinet stands in front of the robot.
+  --port P               WebSocket port (default 9090; 0 picks a free one, printed on start)
+  --rate R               physics rate in Hz (default 500), stepped in real time
+  --realtime-factor F    simulated seconds per wall second (default 1)
+  --fast                 step as fast as possible
+  --robot gripper|panda  the robot (default panda), commanded under /panda or /flying_gripper
+  --address A            interface to listen on (default 127.0.0.1)
+  --duration S           stop after S wall-clock seconds (default: run until SIGINT/SIGTERM)
+)";
+
+struct ServeUsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+double ParsePositive(const std::string& flag, const std::string& v, bool allow_zero = false) {
+  char* end = nullptr;
+  double d = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != '\0' || !(allow_zero ? d >= 0 : d > 0) || d > 1e9)
+    throw ServeUsageError("partsim serve: " + flag + " expects a " +
+                          (allow_zero ? "non-negative" : "positive") + " number, got '" + v + "'");
+  return d;
+}
+
+std::atomic<bool> g_stop{false};
+void OnSignal(int) { g_stop = true; }
+
+}  // namespace
+
+int RunServeCommand(int argc, char** argv) {
+  std::string scene_file, robot_kind = "panda", address = "127.0.0.1";
+  int port = 9090;
+  double rate = 500, factor = 1, duration = 0;
+  bool fast = false;
+  try {
+    for (int i = 0; i < argc; ++i) {
+      std::string a = argv[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw ServeUsageError("partsim serve: " + a + " needs a value");
+        return argv[++i];
+      };
+      if (a == "-h" || a == "--help") {
+        std::fputs(kServeUsage, stdout);
+        return 0;
+      } else if (a == "--port") {
+        double p = ParsePositive(a, value(), true);
+        if (p > 65535 || p != static_cast<int>(p))
+          throw ServeUsageError("partsim serve: --port expects an integer in [0, 65535]");
+        port = static_cast<int>(p);
+      } else if (a == "--rate") {
+        rate = ParsePositive(a, value());
+      } else if (a == "--realtime-factor") {
+        factor = ParsePositive(a, value());
+      } else if (a == "--fast") {
+        fast = true;
+      } else if (a == "--duration") {
+        duration = ParsePositive(a, value());
+      } else if (a == "--address") {
+        address = value();
+      } else if (a == "--robot") {
+        robot_kind = value();
+        if (robot_kind != "gripper" && robot_kind != "panda")
+          throw ServeUsageError("partsim serve: --robot expects gripper or panda, got '" +
+                                robot_kind + "'");
+      } else if (!a.empty() && a[0] == '-') {
+        throw ServeUsageError("partsim serve: unknown option '" + a + "'");
+      } else if (scene_file.empty()) {
+        scene_file = a;
+      } else {
+        throw ServeUsageError("partsim serve: unexpected extra argument '" + a + "'");
+      }
+    }
+  } catch (const ServeUsageError& e) {
+    std::fprintf(stderr, "%s\n%s", e.what(), kServeUsage);
+    return 2;
+  }
+
+  try {
+    // the scene: the given URDF or the built-in cabinet, then the robot
+    SceneConfig cfg;
+    cfg.timestep = 1.0 / rate;
+    Scene scene(cfg);
+    scene.AddGround(0.0);
+    UrdfLoader loader(&scene);
+    loader.fix_root_link = true;
+    ArticulationDesc object = scene_file.empty() ? loader.Parse(MakeCabinetUrdf(), ".", "cabinet")
+                                                 : loader.ParseFile(scene_file);
+    object.root_pose = Pose(Eigen::Vector3d(1.0, 0, 0));
+    scene.AddArticulation(object);
+    RobotModel model = robot_kind == "panda" ? BuildPanda() : BuildFlyingGripper();
+    if (robot_kind == "gripper") model.articulation.root_pose = Pose(Eigen::Vector3d(0, 0, 0.5));
+    Articulation robot = scene.AddArticulation(model.articulation);
+    Eigen::VectorXd q = robot.GetQpos();
+    for (size_t i = 0; i < model.arm_joints.size() && i < model.home.size(); ++i)
+      q[robot.FindJointByName(model.arm_joints[i]).GetDofIndex()] = model.home[i];
+    for (const std::string& g : model.gripper_joints) {
+      int d = robot.FindJointByName(g).GetDofIndex();
+      if (d >= 0) q[d] = model.gripper_open;
+    }
+    robot.SetQpos(q);
+
+    ControlLoop loop(&scene);
+    SimServerOptions so;
+    so.fast = fast;
+    so.realtime_factor = factor;
+    SimServer sim(&scene, &loop, so);
+    RosbridgeOptions ro;
+    ro.address = address;
+    ro.port = port;
+    RosbridgeServer bridge(&sim, &scene, &loop, robot, robot.GetName(), ro);
+    bridge.Start();
+    sim.Start();
+    std::printf(
+        "partsim serve: rosbridge on ws://%s:%d, robot /%s (%d joints), %g Hz physics, %s\n",
+        address.c_str(), bridge.GetPort(), robot.GetName().c_str(), robot.Dof(), rate,
+        fast ? "as fast as possible" : ("real-time factor " + std::to_string(factor)).c_str());
+    std::fflush(stdout);
+
+    std::signal(SIGINT, OnSignal);
+    std::signal(SIGTERM, OnSignal);
+    auto t0 = std::chrono::steady_clock::now();
+    while (!g_stop) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      if (duration > 0 &&
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >= duration)
+        break;
+    }
+    sim.Stop();
+    bridge.Stop();
+    RosbridgeStats s = bridge.GetStats();
+    std::printf(
+        "partsim serve: stopped after %lld steps (%.3f s simulated); %lld messages sent, %lld "
+        "dropped; %lld commands, latency %.2f steps mean, %lld max\n",
+        sim.GetClockSteps(), sim.GetClockSeconds(), s.messages_sent, s.messages_dropped, s.commands,
+        s.mean_latency_steps, s.max_latency_steps);
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "partsim serve: %s\n", e.what());
+    return 1;
+  }
+}
+
+}  // namespace partsim::tools
