@@ -1,0 +1,129 @@
+// SimServer: stepping on its own thread, pause/step-N/reset, commands between steps.
+#include "partsim/server/sim_server.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "partsim/robot/robots.h"
+
+namespace partsim {
+namespace {
+
+using namespace std::chrono_literals;
+
+/// Waits up to 10 s for `pred`.
+template <class F>
+bool WaitFor(F pred) {
+  for (int i = 0; i < 1000; ++i) {
+    if (pred()) return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return pred();
+}
+
+class SimServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    scene_.AddGround(0);
+    RobotModel m = BuildFlyingGripper();
+    m.articulation.root_pose = Pose(Eigen::Vector3d(0, 0, 0.5));
+    robot_ = scene_.AddArticulation(m.articulation);
+  }
+  Scene scene_;
+  Articulation robot_;
+};
+
+TEST_F(SimServerTest, FastModeStepsAndStopJoins) {
+  SimServerOptions o;
+  o.fast = true;
+  SimServer sim(&scene_, nullptr, o);
+  sim.Start();
+  EXPECT_TRUE(WaitFor([&] { return sim.GetClockSteps() > 200; }));
+  sim.Stop();
+  const long long n = sim.GetClockSteps();
+  EXPECT_NEAR(scene_.GetTime(), n * scene_.GetTimestep(), 1e-9);
+  std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(sim.GetClockSteps(), n);  // stopped means stopped
+}
+
+TEST_F(SimServerTest, PausedServerStepsExactlyWhatIsAsked) {
+  SimServer sim(&scene_, nullptr);
+  sim.Start(/*paused=*/true);
+  std::this_thread::sleep_for(30ms);
+  EXPECT_EQ(sim.GetClockSteps(), 0);
+  sim.StepN(7);
+  EXPECT_TRUE(WaitFor([&] { return sim.GetClockSteps() == 7; }));
+  std::this_thread::sleep_for(30ms);
+  EXPECT_EQ(sim.GetClockSteps(), 7);
+  sim.Resume();
+  EXPECT_TRUE(WaitFor([&] { return sim.GetClockSteps() > 20; }));
+  sim.Pause();
+  std::this_thread::sleep_for(30ms);
+  const long long n = sim.GetClockSteps();
+  std::this_thread::sleep_for(30ms);
+  EXPECT_EQ(sim.GetClockSteps(), n);
+}
+
+TEST_F(SimServerTest, CommandsRunBetweenStepsAtTheirArrivalTime) {
+  SimServer sim(&scene_, nullptr);
+  sim.Start(/*paused=*/true);
+  sim.StepN(5);
+  ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() == 5; }));
+  long long seen = -1;
+  sim.Post([&] { seen = sim.GetClockSteps(); });
+  ASSERT_TRUE(WaitFor([&] { return sim.GetCommandsRun() == 1; }));
+  EXPECT_EQ(seen, 5);  // applied at once while paused, before any further step
+  // a drive target posted while running takes effect
+  Eigen::VectorXd target = Eigen::VectorXd::Zero(robot_.Dof());
+  target[2] = 0.2;  // z slide
+  sim.Post([&] {
+    robot_.SetDriveProperty(2000, 200);
+    robot_.SetDriveTarget(target);
+  });
+  sim.Resume();
+  ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() > 300; }));
+  sim.Stop();
+  EXPECT_GT(robot_.GetQpos()[2], 0.1);
+}
+
+TEST_F(SimServerTest, ResetRestoresTheStateButNotTheClock) {
+  const Eigen::VectorXd q0 = robot_.GetQpos();
+  SimServerOptions o;
+  o.fast = true;
+  SimServer sim(&scene_, nullptr, o);
+  sim.Post([&] { robot_.SetQvel(Eigen::VectorXd::Constant(robot_.Dof(), 0.5)); });
+  sim.Start();
+  ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() > 100; }));
+  sim.Pause();
+  std::this_thread::sleep_for(20ms);
+  const long long before = sim.GetClockSteps();
+  sim.Reset();
+  ASSERT_TRUE(WaitFor([&] { return sim.GetCommandsRun() == 2; }));
+  EXPECT_TRUE(robot_.GetQpos().isApprox(q0, 1e-12));
+  EXPECT_EQ(scene_.GetTime(), 0.0);
+  EXPECT_EQ(sim.GetClockSteps(), before);  // the clock is monotonic
+}
+
+TEST_F(SimServerTest, RealTimeFactorBoundsTheClock) {
+  // at a factor of 1 the simulation cannot run ahead of the wall clock
+  SimServer sim(&scene_, nullptr);
+  auto t0 = std::chrono::steady_clock::now();
+  sim.Start();
+  std::this_thread::sleep_for(200ms);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LE(sim.GetClockSeconds(), wall + 2 * scene_.GetTimestep());
+  EXPECT_GT(sim.GetClockSteps(), 0);
+  EXPECT_THROW(sim.Start(), Error);
+}
+
+TEST_F(SimServerTest, RejectsBadOptions) {
+  SimServerOptions o;
+  o.realtime_factor = 0;
+  EXPECT_THROW(SimServer(&scene_, nullptr, o), Error);
+  EXPECT_THROW(SimServer(nullptr, nullptr), Error);
+}
+
+}  // namespace
+}  // namespace partsim
