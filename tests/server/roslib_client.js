@@ -1,0 +1,89 @@
+// A rosbridge client written with roslib (npm), the JavaScript library ROS web tools use, run
+// against `partsim serve`. Usage: node roslib_client.js PORT ROBOT
+// Prints one JSON line with what it measured; exits 0 when every check passed.
+import { Ros, Topic, Service } from 'roslib';
+
+const port = process.argv[2];
+const robot = process.argv[3] || 'panda';
+const result = { connected: false, checks: {} };
+const fail = (why) => {
+  result.error = why;
+  console.log(JSON.stringify(result));
+  process.exit(1);
+};
+setTimeout(() => fail('timed out'), 40000);
+
+const ros = new Ros({ url: `ws://127.0.0.1:${port}` });
+ros.on('error', (e) => fail('connection error: ' + e));
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+const stampSecs = (s) => s.secs + s.nsecs * 1e-9;
+
+ros.on('connection', async () => {
+  result.connected = true;
+  // topics and types through rosapi
+  const topics = await new Promise((res, rej) => ros.getTopics(res, rej));
+  result.topics = topics.topics;
+  const trajTopic = `/${robot}/joint_trajectory_controller/command`;
+  for (const t of ['/clock', '/joint_states', '/tf', trajTopic])
+    if (!topics.topics.includes(t)) fail('rosapi/topics lacks ' + t);
+  result.joint_states_type = await new Promise((res, rej) => ros.getTopicType('/joint_states', res, rej));
+  if (result.joint_states_type !== 'sensor_msgs/JointState') fail('wrong /joint_states type');
+
+  // rates of /clock and /joint_states over two wall-clock seconds
+  let clocks = [], states = [], last = null;
+  const clock = new Topic({ ros, name: '/clock', messageType: 'rosgraph_msgs/Clock' });
+  const js = new Topic({ ros, name: '/joint_states', messageType: 'sensor_msgs/JointState' });
+  clock.subscribe((m) => clocks.push(stampSecs(m.clock)));
+  js.subscribe((m) => {
+    states.push(stampSecs(m.header.stamp));
+    last = m;
+  });
+  await sleep(300);  // let the subscriptions settle
+  clocks = [];
+  states = [];
+  const t0 = Date.now();
+  await sleep(2000);
+  const wall = (Date.now() - t0) / 1000;
+  result.clock_hz = clocks.length / wall;
+  result.joint_states_hz = states.length / wall;
+  result.sim_seconds_per_wall_second =
+    states.length > 1 ? (states[states.length - 1] - states[0]) / wall : 0;
+  for (let i = 1; i < clocks.length; ++i)
+    if (clocks[i] < clocks[i - 1]) fail('/clock went backwards');
+  if (!last || last.name.length !== last.position.length || last.velocity.length !== last.name.length ||
+      last.effort.length !== last.name.length || typeof last.header.frame_id !== 'string')
+    fail('malformed /joint_states');
+
+  // a trajectory for the robot's joints: every arm joint moves by 0.15 over 1.5 s
+  const names = last.name.filter((n) => n.startsWith(robot)).slice(0, 7);
+  const start = names.map((n) => last.position[last.name.indexOf(n)]);
+  const goal = start.map((q) => q + 0.15);
+  const traj = new Topic({ ros, name: trajTopic, messageType: 'trajectory_msgs/JointTrajectory' });
+  traj.publish({
+    header: { seq: 0, stamp: { secs: 0, nsecs: 0 }, frame_id: '' },
+    joint_names: names,
+    points: [
+      { positions: start.map((q, i) => q + 0.075), velocities: [], accelerations: [], effort: [],
+        time_from_start: { secs: 0, nsecs: 750000000 } },
+      { positions: goal, velocities: [], accelerations: [], effort: [],
+        time_from_start: { secs: 1, nsecs: 500000000 } },
+    ],
+  });
+  let err = Infinity;
+  const tSend = Date.now();
+  while (Date.now() - tSend < 8000) {
+    await sleep(100);
+    err = Math.max(...names.map((n, i) => Math.abs(last.position[last.name.indexOf(n)] - goal[i])));
+    if (err < 0.01 && Date.now() - tSend > 1500) break;
+  }
+  result.trajectory_joints = names;
+  result.trajectory_final_error = err;
+  result.trajectory_seconds = (Date.now() - tSend) / 1000;
+  if (!(err < 0.01)) fail('trajectory not executed: error ' + err);
+
+  // the server's own counters (command latency in steps)
+  const stats = new Service({ ros, name: '/partsim/stats', serviceType: 'std_srvs/Trigger' });
+  result.stats = await new Promise((res, rej) => stats.callService({}, res, rej));
+  console.log(JSON.stringify(result));
+  process.exit(0);
+});

@@ -1,0 +1,125 @@
+// `partsim serve` against a client nobody here wrote: roslib (npm) in Node.js runs
+// tests/server/roslib_client.js, which lists topics through rosapi, measures the /clock and
+// /joint_states rates and sends a JointTrajectory that the Panda must execute. The test script
+// installs roslib and ws into build/node (or PARTSIM_NODE_DIR); without node or that folder the
+// test is skipped.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#ifndef PARTSIM_CLI_PATH
+#error "PARTSIM_CLI_PATH must name the partsim executable"
+#endif
+
+namespace partsim {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+/// `partsim serve` in a child process; its first output line names the port.
+class ServeProcess {
+ public:
+  explicit ServeProcess(const std::string& args) {
+    int fds[2];
+    if (::pipe(fds) != 0) return;
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::dup2(fds[1], 1);
+      ::close(fds[0]);
+      ::close(fds[1]);
+      std::string cmd = std::string("exec '") + PARTSIM_CLI_PATH + "' serve " + args;
+      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    ::close(fds[1]);
+    out_ = ::fdopen(fds[0], "r");
+    char line[512];
+    if (out_ && std::fgets(line, sizeof(line), out_)) first_line_ = line;
+    size_t at = first_line_.find("127.0.0.1:");
+    if (at != std::string::npos) port_ = std::atoi(first_line_.c_str() + at + 10);
+  }
+  ~ServeProcess() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGTERM);
+      int status = 0;
+      ::waitpid(pid_, &status, 0);
+    }
+    if (out_) std::fclose(out_);
+  }
+  int Port() const { return port_; }
+  const std::string& FirstLine() const { return first_line_; }
+
+ private:
+  pid_t pid_ = -1;
+  FILE* out_ = nullptr;
+  std::string first_line_;
+  int port_ = 0;
+};
+
+/// Runs a shell command; returns its standard output and sets `code`.
+std::string RunShell(const std::string& cmd, int* code) {
+  std::string out;
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return out;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof(buf), p)) > 0) out.append(buf, n);
+  int status = ::pclose(p);
+  *code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+TEST(ServeTest, RoslibClientListsTopicsReceivesStatesAndDrivesATrajectory) {
+  int code = 0;
+  std::string node = RunShell("command -v node 2>/dev/null", &code);
+  while (!node.empty() && (node.back() == '\n' || node.back() == ' ')) node.pop_back();
+  if (node.empty()) GTEST_SKIP() << "node is not installed (scripts/test.sh installs it)";
+  const char* env = std::getenv("PARTSIM_NODE_DIR");
+  fs::path dir = env ? fs::path(env) : fs::path(PARTSIM_SOURCE_DIR) / "build" / "node";
+  if (!fs::exists(dir / "node_modules" / "roslib" / "package.json") ||
+      !fs::exists(dir / "node_modules" / "ws" / "package.json"))
+    GTEST_SKIP() << "roslib and ws are not installed in " << dir
+                 << " (scripts/test.sh runs npm install --prefix build/node roslib ws)";
+  // the client is an ES module that imports roslib: it runs from the folder that holds it
+  fs::path client = dir / "partsim_roslib_client.mjs";
+  fs::copy_file(fs::path(PARTSIM_SOURCE_DIR) / "tests" / "server" / "roslib_client.js", client,
+                fs::copy_options::overwrite_existing);
+
+  ServeProcess serve("--port 0 --robot panda --duration 120");
+  ASSERT_GT(serve.Port(), 0) << "partsim serve printed: " << serve.FirstLine();
+  std::string out = RunShell(
+      "'" + node + "' '" + client.string() + "' " + std::to_string(serve.Port()) + " panda", &code);
+  // the client prints one JSON line (the last line)
+  std::string last = out.substr(0, out.find_last_not_of('\n') + 1);
+  last = last.substr(last.rfind('\n') == std::string::npos ? 0 : last.rfind('\n') + 1);
+  json r = json::parse(last, nullptr, false);
+  ASSERT_FALSE(r.is_discarded()) << out;
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_TRUE(r.value("connected", false)) << out;
+  ASSERT_TRUE(r.contains("joint_states_hz")) << out;
+  // 500 Hz physics in real time: one message per step; loose bounds for a loaded machine
+  std::printf(
+      "roslib client: /clock %.1f Hz, /joint_states %.1f Hz, %.2f sim s per wall s, "
+      "trajectory error %.2g, command latency %.2f steps (max %lld)\n",
+      r["clock_hz"].get<double>(), r["joint_states_hz"].get<double>(),
+      r["sim_seconds_per_wall_second"].get<double>(), r["trajectory_final_error"].get<double>(),
+      r["stats"]["mean_latency_steps"].get<double>(),
+      r["stats"]["max_latency_steps"].get<long long>());
+  RecordProperty("joint_states_hz", std::to_string(r["joint_states_hz"].get<double>()));
+  EXPECT_GT(r["joint_states_hz"].get<double>(), 50.0);
+  EXPECT_GT(r["clock_hz"].get<double>(), 50.0);
+  EXPECT_LE(r["joint_states_hz"].get<double>(), 520.0);  // never more than one per step
+  EXPECT_LT(r["trajectory_final_error"].get<double>(), 0.01);
+  EXPECT_EQ(r["stats"]["commands"].get<long long>(), 1);
+}
+
+}  // namespace
+}  // namespace partsim
