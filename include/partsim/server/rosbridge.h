@@ -38,7 +38,8 @@ struct RosbridgeStats {
 class RosbridgeServer {
  public:
   /// `robot` is the articulation commanded under /<robot_name>/...; the server adds its
-  /// controllers to `loop` (call before sim->Start()). All pointers must outlive the server.
+  /// controllers to `loop` (call before sim->Start()). All pointers must outlive the server, and
+  /// the SimServer must be stopped before the server is destroyed (its step callback is ours).
   RosbridgeServer(SimServer* sim, Scene* scene, ControlLoop* loop, const Articulation& robot,
                   const std::string& robot_name, const RosbridgeOptions& options = {});
   ~RosbridgeServer();
