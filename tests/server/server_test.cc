@@ -121,5 +121,25 @@ TEST(ServeTest, RoslibClientListsTopicsReceivesStatesAndDrivesATrajectory) {
   EXPECT_EQ(r["stats"]["commands"].get<long long>(), 1);
 }
 
+TEST(ServeTest, RejectsBadArgumentsAndServesForADuration) {
+  int code = 0;
+  const std::string cli = std::string("'") + PARTSIM_CLI_PATH + "' serve ";
+  std::string out = RunShell(cli + "--robot ur5 2>&1", &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(out.find("--robot expects gripper or panda, got 'ur5'"), std::string::npos) << out;
+  RunShell(cli + "--rate -3 2>&1", &code);
+  EXPECT_EQ(code, 2);
+  RunShell(cli + "--port 70000 2>&1", &code);
+  EXPECT_EQ(code, 2);
+  out = RunShell(cli + "/nonexistent/scene.urdf --port 0 2>&1", &code);
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(out.find("/nonexistent/scene.urdf"), std::string::npos) << out;
+  // the flying gripper, as fast as possible, for a short while
+  out = RunShell(cli + "--robot gripper --fast --port 0 --duration 0.5 2>&1", &code);
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("robot /flying_gripper"), std::string::npos) << out;
+  EXPECT_NE(out.find("stopped after"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace partsim
