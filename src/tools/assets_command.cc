@@ -44,13 +44,10 @@ struct AssetsUsageError : std::runtime_error {
 };
 
 long long ParseInt(const std::string& flag, const std::string& v, long long lo) {
-  char* end = nullptr;
-  errno = 0;
-  long long n = std::strtoll(v.c_str(), &end, 10);
-  if (v.empty() || *end != '\0' || errno == ERANGE || n < lo) {
+  long long n = 0;
+  if (!ParseInteger(v, lo, &n))
     throw AssetsUsageError("partsim assets: " + flag +
                            " expects an integer >= " + std::to_string(lo) + ", got '" + v + "'");
-  }
   return n;
 }
 

@@ -1,7 +1,13 @@
 // Sub-commands of the `partsim` program that live in their own files.
 #pragma once
 
+#include <string>
+
 namespace partsim::tools {
+
+/// Reads a whole decimal integer >= `lo` from `text` into `out`; false if `text` is not one (or
+/// overflows).
+bool ParseInteger(const std::string& text, long long lo, long long* out);
 
 /// `partsim assets ...`: generate procedural PartNet-Mobility objects. `argv` holds the
 /// arguments after "assets". Returns the exit code (0 success, 1 failure, 2 bad command line).

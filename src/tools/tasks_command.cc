@@ -42,10 +42,8 @@ struct TasksUsageError : std::runtime_error {
 };
 
 long long ParseCount(const std::string& flag, const std::string& v, long long lo) {
-  char* end = nullptr;
-  errno = 0;
-  long long n = std::strtoll(v.c_str(), &end, 10);
-  if (v.empty() || *end != '\0' || errno == ERANGE || n < lo)
+  long long n = 0;
+  if (!ParseInteger(v, lo, &n))
     throw TasksUsageError("partsim tasks: " + flag +
                           " expects an integer >= " + std::to_string(lo) + ", got '" + v + "'");
   return n;

@@ -20,6 +20,7 @@
 #include <websocketpp/config/asio_no_tls_client.hpp>
 
 #include "partsim/robot/robots.h"
+#include "server/wait_for.h"
 
 namespace partsim {
 namespace {
@@ -28,15 +29,7 @@ using json = nlohmann::json;
 using namespace std::chrono_literals;
 using WsClient = websocketpp::client<websocketpp::config::asio_client>;
 
-/// Waits up to 10 s for `pred`.
-template <class F>
-bool WaitFor(F pred) {
-  for (int i = 0; i < 1000; ++i) {
-    if (pred()) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return pred();
-}
+using testing::WaitFor;
 
 /// A WebSocket client on its own thread that keeps every message it receives.
 class TestClient {

@@ -7,21 +7,14 @@
 #include <thread>
 
 #include "partsim/robot/robots.h"
+#include "server/wait_for.h"
 
 namespace partsim {
 namespace {
 
 using namespace std::chrono_literals;
 
-/// Waits up to 10 s for `pred`.
-template <class F>
-bool WaitFor(F pred) {
-  for (int i = 0; i < 1000; ++i) {
-    if (pred()) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return pred();
-}
+using testing::WaitFor;
 
 class SimServerTest : public ::testing::Test {
  protected:
