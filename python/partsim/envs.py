@@ -159,7 +159,18 @@ ROBOT_STATE_SIZE = 14
 OBS_MODES = ("raw", "mobility", "visual")
 
 
-class OpenCabinetEnv:
+class _ClosedByContext:
+    """``with env:`` closes the environment at the end of the block."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+
+class OpenCabinetEnv(_ClosedByContext):
     """Drawer pulling (``task="drawer"``) or door opening (``task="door"``) on generated cabinets
     with the flying gripper.
 
@@ -343,13 +354,6 @@ class OpenCabinetEnv:
         self._task = None
         self._closed = True
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
-
     # --- internals ---------------------------------------------------------------------------
 
     _last_picture_step = -1
@@ -423,7 +427,7 @@ def _stack(items):
     return np.stack(items)
 
 
-class VectorOpenCabinetEnv:
+class VectorOpenCabinetEnv(_ClosedByContext):
     """``num_envs`` copies of :class:`OpenCabinetEnv` stepped together on ``workers`` threads
     (default: one per copy; the simulation releases the GIL, so the copies run in parallel on
     several cores). Copy i always runs on thread ``i % workers``: the rasterizer's OpenGL context
@@ -518,13 +522,6 @@ class VectorOpenCabinetEnv:
         for t in self._threads:
             t.shutdown(wait=True)
         self._closed = True
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
 
     @staticmethod
     def _infos(items):
