@@ -1,9 +1,11 @@
 #include "partsim/server/rosbridge.h"
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -13,6 +15,8 @@
 #include <websocketpp/server.hpp>
 
 #include "partsim/core/error.h"
+#include "partsim/render/camera.h"
+#include "partsim/render/image_io.h"
 
 namespace partsim {
 
@@ -29,6 +33,36 @@ const char* kJointStateType = "sensor_msgs/JointState";
 const char* kTfType = "tf2_msgs/TFMessage";
 const char* kFloat64ArrayType = "std_msgs/Float64MultiArray";
 const char* kTrajectoryType = "trajectory_msgs/JointTrajectory";
+const char* kImageType = "sensor_msgs/Image";
+const char* kCameraInfoType = "sensor_msgs/CameraInfo";
+const char* kPointCloud2Type = "sensor_msgs/PointCloud2";
+const char* kImuType = "sensor_msgs/Imu";
+
+/// Base64 (RFC 4648, padded): how rosbridge sends uint8[] fields.
+std::string Base64(const uint8_t* data, size_t n) {
+  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((n + 2) / 3 * 4);
+  size_t i = 0;
+  for (; i + 2 < n; i += 3) {
+    uint32_t v = (uint32_t(data[i]) << 16) | (uint32_t(data[i + 1]) << 8) | data[i + 2];
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += kAlphabet[(v >> 6) & 63];
+    out += kAlphabet[v & 63];
+  }
+  if (i < n) {
+    uint32_t v = uint32_t(data[i]) << 16;
+    if (i + 1 < n) v |= uint32_t(data[i + 1]) << 8;
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += i + 1 < n ? kAlphabet[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+json Vector3(const Eigen::Vector3d& v) { return {{"x", v.x()}, {"y", v.y()}, {"z", v.z()}}; }
 
 json Stamp(double t) {
   double secs = std::floor(t);
@@ -91,6 +125,17 @@ struct RosbridgeServer::Impl {
   std::shared_ptr<JointVelocityController> velocity_ctrl;
   std::shared_ptr<JointTrajectoryController> trajectory_ctrl;
   std::shared_ptr<Controller> active;  // sim thread only
+
+  // sensors (read on the simulation thread)
+  struct CameraTopics {
+    Camera camera;
+    std::string image, info, points, frame;
+    double next_render = 0, next_info = 0;  // simulated time of the next message
+  };
+  std::vector<CameraTopics> cameras;  // set at Start
+  std::unique_ptr<Imu> imu;
+  std::string imu_frame;
+  double imu_next = 0;
 
   WsServer ws;
   std::thread io_thread;
@@ -163,12 +208,28 @@ struct RosbridgeServer::Impl {
   // ---- topics ----
   std::string Prefix() const { return "/" + robot_name; }
   std::map<std::string, std::string> SimTopics() const {
-    return {{"/clock", kClockType},
-            {"/joint_states", kJointStateType},
-            {"/tf", kTfType},
-            {Prefix() + "/joint_position_controller/command", kFloat64ArrayType},
-            {Prefix() + "/joint_velocity_controller/command", kFloat64ArrayType},
-            {Prefix() + "/joint_trajectory_controller/command", kTrajectoryType}};
+    std::map<std::string, std::string> t = {
+        {"/clock", kClockType},
+        {"/joint_states", kJointStateType},
+        {"/tf", kTfType},
+        {Prefix() + "/joint_position_controller/command", kFloat64ArrayType},
+        {Prefix() + "/joint_velocity_controller/command", kFloat64ArrayType},
+        {Prefix() + "/joint_trajectory_controller/command", kTrajectoryType},
+        {"/imu", kImuType}};
+    for (const CameraTopics& c : cameras) {
+      t.emplace(c.image, kImageType);
+      t.emplace(c.info, kCameraInfoType);
+      t.emplace(c.points, kPointCloud2Type);
+    }
+    return t;
+  }
+  /// Whether the simulation publishes `topic` (clients may not).
+  bool Published(const std::string& topic) const {
+    if (topic == "/clock" || topic == "/joint_states" || topic == "/tf" || topic == "/imu")
+      return true;
+    for (const CameraTopics& c : cameras)
+      if (topic == c.image || topic == c.info || topic == c.points) return true;
+    return false;
   }
   /// All topics with types: the simulation's and the clients' (clients_mutex held).
   std::map<std::string, std::string> AllTopics() const {
@@ -214,6 +275,10 @@ struct RosbridgeServer::Impl {
 
   void OnStep(long long steps) {
     const double t = steps * sim->GetTimestep();
+    PublishJointTopics(t);
+    PublishSensors(t);
+  }
+  void PublishJointTopics(double t) {
     const WallClock::time_point now = WallClock::now();
     std::lock_guard<std::mutex> lock(clients_mutex);
     if (clients.empty()) return;
@@ -235,6 +300,156 @@ struct RosbridgeServer::Impl {
         }
         s.last_sent = now;
         Enqueue(c, text, s.queue_length);
+      }
+    }
+  }
+
+  // ---- simulation thread: sensors ----
+  /// Whether some client subscribes to `topic` (clients_mutex held).
+  bool Wanted(const std::string& topic) const {
+    for (auto& [h, c] : clients)
+      if (c->subs.count(topic)) return true;
+    return false;
+  }
+  /// Sends `make()` (built once) to the clients subscribed to `topic` that are not throttled.
+  void Publish(const std::string& topic, const std::function<json()>& make,
+               WallClock::time_point now) {
+    std::string text;
+    std::lock_guard<std::mutex> lock(clients_mutex);
+    for (auto& [h, c] : clients) {
+      auto it = c->subs.find(topic);
+      if (it == c->subs.end()) continue;
+      Subscription& s = it->second;
+      if (s.throttle_ms > 0 &&
+          std::chrono::duration<double, std::milli>(now - s.last_sent).count() < s.throttle_ms)
+        continue;
+      if (text.empty()) text = json{{"op", "publish"}, {"topic", topic}, {"msg", make()}}.dump();
+      s.last_sent = now;
+      Enqueue(c, text, s.queue_length);
+    }
+  }
+  static json Header(double t, const std::string& frame) {
+    return {{"seq", 0}, {"stamp", Stamp(t)}, {"frame_id", frame}};
+  }
+  static json ImageMsg(const Camera& cam, double t, const std::string& frame) {
+    const int w = cam.GetWidth(), h = cam.GetHeight();
+    std::vector<uint8_t> rgba = cam.GetColorRGBA8(), rgb(static_cast<size_t>(w) * h * 3);
+    for (size_t i = 0, n = static_cast<size_t>(w) * h; i < n; ++i)
+      for (int k = 0; k < 3; ++k) rgb[i * 3 + k] = rgba[i * 4 + k];
+    return {{"header", Header(t, frame)},
+            {"height", h},
+            {"width", w},
+            {"encoding", "rgb8"},
+            {"is_bigendian", 0},
+            {"step", w * 3},
+            {"data", Base64(rgb.data(), rgb.size())}};
+  }
+  static json CameraInfoMsg(const Camera& cam, double t, const std::string& frame) {
+    Eigen::Matrix3d K = cam.GetIntrinsicMatrix();
+    json k = json::array(), p = json::array();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        k.push_back(K(r, c));
+        p.push_back(K(r, c));
+      }
+      p.push_back(0.0);
+    }
+    return {
+        {"header", Header(t, frame)},
+        {"height", cam.GetHeight()},
+        {"width", cam.GetWidth()},
+        {"distortion_model", "plumb_bob"},
+        {"D", {0.0, 0.0, 0.0, 0.0, 0.0}},
+        {"K", k},
+        {"R", {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}},
+        {"P", p},
+        {"binning_x", 0},
+        {"binning_y", 0},
+        {"roi",
+         {{"x_offset", 0}, {"y_offset", 0}, {"height", 0}, {"width", 0}, {"do_rectify", false}}}};
+  }
+  /// The points seen, in the optical frame (x right, y down, z forward), as x, y, z float32.
+  static json PointsMsg(const Camera& cam, double t, const std::string& frame) {
+    static_assert(sizeof(float) == 4, "float32 points");
+    PointCloud pc = MakePointCloud(cam, PointCloudFrame::kCamera);
+    std::vector<float> xyz(pc.positions.size());
+    for (size_t i = 0; i < pc.Size(); ++i) {  // OpenGL camera frame to the optical frame
+      xyz[3 * i] = pc.positions[3 * i];
+      xyz[3 * i + 1] = -pc.positions[3 * i + 1];
+      xyz[3 * i + 2] = -pc.positions[3 * i + 2];
+    }
+    json fields = json::array();
+    const char* names[] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k)
+      fields.push_back({{"name", names[k]}, {"offset", 4 * k}, {"datatype", 7}, {"count", 1}});
+    const size_t n = pc.Size();
+    return {{"header", Header(t, frame)},
+            {"height", 1},
+            {"width", n},
+            {"fields", fields},
+            {"is_bigendian", false},
+            {"point_step", 12},
+            {"row_step", 12 * n},
+            {"data", Base64(reinterpret_cast<const uint8_t*>(xyz.data()), xyz.size() * 4)},
+            {"is_dense", true}};
+  }
+  json ImuMsg(double t) const {
+    ImuReading r = imu->Read();
+    const json zeros = std::vector<double>(9, 0.0);
+    return {{"header", Header(t, imu_frame)},
+            {"orientation",
+             {{"x", r.orientation[1]},
+              {"y", r.orientation[2]},
+              {"z", r.orientation[3]},
+              {"w", r.orientation[0]}}},
+            {"orientation_covariance", zeros},
+            {"angular_velocity", Vector3(r.angular_velocity)},
+            {"angular_velocity_covariance", zeros},
+            {"linear_acceleration", Vector3(r.linear_acceleration)},
+            {"linear_acceleration_covariance", zeros}};
+  }
+
+  /// After a step: reads the sensors somebody subscribes to, when due, and publishes them.
+  void PublishSensors(double t) {
+    const double eps = 1e-9;
+    const WallClock::time_point now = WallClock::now();
+    bool want_imu = false;
+    std::vector<std::array<bool, 3>> want(cameras.size(), {false, false, false});
+    {
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      if (clients.empty()) return;
+      want_imu = imu && t + eps >= imu_next && Wanted("/imu");
+      for (size_t i = 0; i < cameras.size(); ++i) {
+        const CameraTopics& c = cameras[i];
+        if (t + eps >= c.next_render) want[i] = {Wanted(c.image), Wanted(c.points), false};
+        if (t + eps >= c.next_info) want[i][2] = Wanted(c.info);
+      }
+    }
+    if (want_imu) {
+      imu_next = options.imu_rate > 0 ? t + 1.0 / options.imu_rate : 0;
+      Publish(
+          "/imu", [&] { return ImuMsg(t); }, now);
+    }
+    const double period = options.camera_rate > 0 ? 1.0 / options.camera_rate : 0;
+    bool updated = false;
+    for (size_t i = 0; i < cameras.size(); ++i) {
+      CameraTopics& c = cameras[i];
+      if (want[i][0] || want[i][1]) {
+        if (!updated) scene->UpdateRender();  // poses of this step, once for all cameras
+        updated = true;
+        c.camera.TakePicture();
+        c.next_render = t + period;
+        if (want[i][0])
+          Publish(
+              c.image, [&] { return ImageMsg(c.camera, t, c.frame); }, now);
+        if (want[i][1])
+          Publish(
+              c.points, [&] { return PointsMsg(c.camera, t, c.frame); }, now);
+      }
+      if (want[i][2]) {
+        c.next_info = t + period;
+        Publish(
+            c.info, [&] { return CameraInfoMsg(c.camera, t, c.frame); }, now);
       }
     }
   }
@@ -505,7 +720,7 @@ struct RosbridgeServer::Impl {
     } else if (op == "publish") {
       std::string topic = Name(j, "topic", op);
       if (!j.contains("msg")) throw Error("publish " + topic + ": no 'msg'");
-      if (topic == "/clock" || topic == "/joint_states" || topic == "/tf")
+      if (Published(topic))
         throw Error("publish " + topic + ": the simulation publishes this topic");
       if (sim_topics.count(topic)) {
         HandleCommand(c, topic, j["msg"], id);
@@ -583,6 +798,12 @@ RosbridgeServer::RosbridgeServer(SimServer* sim, Scene* scene, ControlLoop* loop
   m.trajectory_ctrl =
       std::make_shared<JointTrajectoryController>(robot, std::vector<std::string>{}, co);
   m.Activate(m.position_ctrl);
+  const std::vector<Link> links = robot.GetLinks();
+  if (!links.empty()) {
+    Link l = options.imu_link.empty() ? links.back() : robot.FindLinkByName(options.imu_link);
+    m.imu = std::make_unique<Imu>(l);
+    m.imu_frame = l.GetName();
+  }
 
   m.ws.clear_access_channels(websocketpp::log::alevel::all);
   m.ws.clear_error_channels(websocketpp::log::elevel::all);
@@ -620,6 +841,16 @@ void RosbridgeServer::Start() {
   if (ec) throw Error("rosbridge: cannot accept: " + ec.message());
   boost::system::error_code bec;
   m.port = m.ws.get_local_endpoint(bec).port();
+  for (const Camera& cam : m.scene->GetCameras()) {
+    Impl::CameraTopics c;
+    c.camera = cam;
+    const std::string base = "/" + cam.GetName();
+    c.image = base + "/image_raw";
+    c.info = base + "/camera_info";
+    c.points = base + "/points";
+    c.frame = cam.GetName() + "_optical_frame";
+    m.cameras.push_back(c);
+  }
   m.sim->SetStepCallback([this](long long steps) { impl_->OnStep(steps); });
   m.io_thread = std::thread([this] { impl_->ws.run(); });
   m.started = true;

@@ -12,6 +12,8 @@
 #include "commands.h"
 #include "partsim/assets/default_objects.h"
 #include "partsim/assets/urdf.h"
+#include "partsim/render/camera.h"
+#include "partsim/render/camera_math.h"
 #include "partsim/robot/robots.h"
 #include "partsim/server/rosbridge.h"
 #include "partsim/server/sim_server.h"
@@ -21,13 +23,18 @@ namespace {
 
 constexpr char kServeUsage[] = R"(usage:
   partsim serve [SCENE.urdf] [--port P] [--rate R | --realtime-factor F | --fast]
-                [--robot gripper|panda] [--address A] [--duration S]
+                [--robot gripper|panda] [--address A] [--duration S] [--camera WxH]
+                [--camera-rate HZ]
 
 Steps a scene on its own thread and serves it over the rosbridge v2 protocol (JSON over
 WebSocket): /clock, /joint_states and /tf out; /<robot>/joint_position_controller/command,
 /<robot>/joint_velocity_controller/command (std_msgs/Float64MultiArray) and
 /<robot>/joint_trajectory_controller/command (trajectory_msgs/JointTrajectory) in; services
 /rosapi/topics, /rosapi/topic_type, /rosapi/services, /partsim/pause|resume|reset|step|stats.
+Sensors, read only while a client subscribes: /front_camera/image_raw (sensor_msgs/Image,
+rgb8), /front_camera/camera_info, /front_camera/points (sensor_msgs/PointCloud2, x y z
+float32) from a camera looking at the scene from the front, and /imu (sensor_msgs/Imu) on the
+robot's end-effector link at the physics rate.
 With no SCENE, a built-in cabinet stands in front of the robot.
   --port P               WebSocket port (default 9090; 0 picks a free one, printed on start)
   --rate R               physics rate in Hz (default 500), stepped in real time
@@ -36,6 +43,8 @@ With no SCENE, a built-in cabinet stands in front of the robot.
   --robot gripper|panda  the robot (default panda), commanded under /panda or /flying_gripper
   --address A            interface to listen on (default 127.0.0.1)
   --duration S           stop after S wall-clock seconds (default: run until SIGINT/SIGTERM)
+  --camera WxH           image size of /front_camera (default 640x480)
+  --camera-rate HZ       camera topics per simulated second (default 10; 0: every step)
 )";
 
 struct ServeUsageError : std::runtime_error {
@@ -61,6 +70,8 @@ int RunServeCommand(int argc, char** argv) {
   int port = 9090;
   double rate = 500, factor = 1, duration = 0;
   bool fast = false;
+  int cam_w = 640, cam_h = 480;
+  double camera_rate = 10;
   try {
     for (int i = 0; i < argc; ++i) {
       std::string a = argv[i];
@@ -84,6 +95,18 @@ int RunServeCommand(int argc, char** argv) {
         fast = true;
       } else if (a == "--duration") {
         duration = ParsePositive(a, value());
+      } else if (a == "--camera") {
+        std::string v = value();
+        int w = 0, h = 0;
+        char x = 0, extra = 0;
+        if (std::sscanf(v.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 ||
+            h < 1 || w > 8192 || h > 8192)
+          throw ServeUsageError("partsim serve: --camera expects WxH (e.g. 640x480), got '" + v +
+                                "'");
+        cam_w = w;
+        cam_h = h;
+      } else if (a == "--camera-rate") {
+        camera_rate = ParsePositive(a, value(), true);
       } else if (a == "--address") {
         address = value();
       } else if (a == "--robot") {
@@ -127,6 +150,12 @@ int RunServeCommand(int argc, char** argv) {
       if (d >= 0) q[d] = model.gripper_open;
     }
     robot.SetQpos(q);
+    // lights and a camera in front of the robot and the object, looking at both
+    scene.SetAmbientLight(Eigen::Vector3f(0.35f, 0.35f, 0.35f));
+    scene.AddDirectionalLight(Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+    Camera camera = scene.AddCamera("front_camera", cam_w, cam_h, 1.0, 0.05, 20.0);
+    camera.SetLocalPose(
+        CameraLookAt(Eigen::Vector3d(1.3, -2.2, 1.4), Eigen::Vector3d(0.5, 0, 0.4)));
 
     ControlLoop loop(&scene);
     SimServerOptions so;
@@ -136,6 +165,8 @@ int RunServeCommand(int argc, char** argv) {
     RosbridgeOptions ro;
     ro.address = address;
     ro.port = port;
+    ro.camera_rate = camera_rate;
+    ro.imu_link = model.ee_link;
     RosbridgeServer bridge(&sim, &scene, &loop, robot, robot.GetName(), ro);
     bridge.Start();
     sim.Start();

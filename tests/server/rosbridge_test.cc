@@ -10,15 +10,20 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 #include <websocketpp/client.hpp>
 #include <websocketpp/config/asio_no_tls_client.hpp>
 
+#include "partsim/render/camera.h"
+#include "partsim/render/camera_math.h"
 #include "partsim/robot/robots.h"
 #include "server/wait_for.h"
 
@@ -51,7 +56,9 @@ class TestClient {
       const size_t at = text.rfind("\"topic\":\"");
       const std::string topic = at == std::string::npos ? "" : text.substr(at + 9);
       std::lock_guard<std::mutex> lock(mutex_);
-      if (topic.rfind("/tf\"", 0) == 0) {
+      if (!count_topic_.empty() && topic.rfind(count_topic_ + "\"", 0) == 0) {
+        ++counted_;
+      } else if (topic.rfind("/tf\"", 0) == 0) {
         ++tf_count_;
       } else if (topic.rfind("/clock\"", 0) == 0) {
         json j = json::parse(text, nullptr, false);
@@ -111,6 +118,15 @@ class TestClient {
     std::lock_guard<std::mutex> lock(mutex_);
     return tf_count_;
   }
+  /// Only count the messages of `topic` (set before subscribing).
+  void CountOnly(const std::string& topic) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    count_topic_ = topic;
+  }
+  long long Counted() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return counted_;
+  }
   /// Keep /joint_states messages (set before subscribing).
   void KeepJointStates() { keep_joint_states_ = true; }
   bool Closed() const { return closed_; }
@@ -124,6 +140,8 @@ class TestClient {
   std::vector<json> messages_;
   double last_clock_ = -1;
   long long tf_count_ = 0;
+  std::string count_topic_;
+  long long counted_ = 0;
   std::atomic<bool> keep_joint_states_{false};
   std::atomic<bool> open_{false}, closed_{false};
   std::atomic<int> close_code_{0};
@@ -383,6 +401,197 @@ TEST_F(RosbridgeTest, ClientThatNeverReadsDoesNotStallOthers) {
   // two seconds of simulated time pass for the reader while the sleeper's queue overflows
   EXPECT_TRUE(ClockAdvances(*watcher, 2.0));
   EXPECT_TRUE(WaitFor([&] { return bridge_->GetStats().messages_dropped > 0; }));
+}
+
+/// Decodes padded base64.
+std::vector<uint8_t> DecodeBase64(const std::string& s) {
+  auto val = [](char c) -> int {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    return c == '+' ? 62 : c == '/' ? 63 : -1;
+  };
+  std::vector<uint8_t> out;
+  uint32_t acc = 0;
+  int bits = 0;
+  for (char c : s) {
+    int v = val(c);
+    if (v < 0) break;  // '=' padding
+    acc = (acc << 6) | static_cast<uint32_t>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<uint8_t>((acc >> bits) & 0xff));
+    }
+  }
+  return out;
+}
+
+/// A flying gripper in front of a camera, with an IMU on its hand, behind a rosbridge server.
+class RosbridgeSensorTest : public ::testing::Test {
+ protected:
+  void Start(int width, int height, double camera_rate) {
+    scene_ = std::make_unique<Scene>();
+    scene_->AddGround(0);
+    RobotModel m = BuildFlyingGripper();
+    m.articulation.root_pose = Pose(Eigen::Vector3d(0, 0, 0.5));
+    robot_ = scene_->AddArticulation(m.articulation);
+    scene_->SetAmbientLight(Eigen::Vector3f(0.35f, 0.35f, 0.35f));
+    scene_->AddDirectionalLight(Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+    camera_ = scene_->AddCamera("cam", width, height, 1.0, 0.05, 20.0);
+    camera_.SetLocalPose(CameraLookAt(Eigen::Vector3d(1.2, -0.8, 1.0), Eigen::Vector3d(0, 0, 0.4)));
+    loop_ = std::make_unique<ControlLoop>(scene_.get());
+    sim_ = std::make_unique<SimServer>(scene_.get(), loop_.get());
+    RosbridgeOptions o;
+    o.port = 0;
+    o.camera_rate = camera_rate;
+    o.imu_link = m.ee_link;
+    bridge_ = std::make_unique<RosbridgeServer>(sim_.get(), scene_.get(), loop_.get(), robot_,
+                                                robot_.GetName(), o);
+    bridge_->Start();
+    sim_->Start();
+    port_ = bridge_->GetPort();
+  }
+  void TearDown() override {
+    if (sim_) sim_->Stop();
+    if (bridge_) bridge_->Stop();
+  }
+  static json Published(TestClient& c, const std::string& topic) {
+    return c.WaitMessage(
+        [&](const json& m) { return m.value("op", "") == "publish" && m["topic"] == topic; });
+  }
+  std::unique_ptr<Scene> scene_;
+  Articulation robot_;
+  Camera camera_;
+  std::unique_ptr<ControlLoop> loop_;
+  std::unique_ptr<SimServer> sim_;
+  std::unique_ptr<RosbridgeServer> bridge_;
+  int port_ = 0;
+};
+
+TEST_F(RosbridgeSensorTest, ImageCameraInfoAndPoints) {
+  Start(160, 120, 10);
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "call_service"}, {"service", "/rosapi/topics"}, {"id", "t"}});
+  json topics = c.WaitMessage([](const json& m) { return m.value("id", "") == "t"; });
+  ASSERT_FALSE(topics.is_null());
+  std::set<std::string> names(topics["values"]["topics"].begin(), topics["values"]["topics"].end());
+  for (const char* t : {"/cam/image_raw", "/cam/camera_info", "/cam/points", "/imu"})
+    EXPECT_TRUE(names.count(t)) << t;
+  for (const char* t : {"/cam/image_raw", "/cam/camera_info", "/cam/points"})
+    c.Send(json{{"op", "subscribe"}, {"topic", t}});
+
+  json image = Published(c, "/cam/image_raw");
+  ASSERT_FALSE(image.is_null());
+  const json& im = image["msg"];
+  EXPECT_EQ(im["width"], 160);
+  EXPECT_EQ(im["height"], 120);
+  EXPECT_EQ(im["step"], 160 * 3);
+  EXPECT_EQ(im["encoding"], "rgb8");
+  std::vector<uint8_t> rgb = DecodeBase64(im["data"].get<std::string>());
+  ASSERT_EQ(rgb.size(), 160u * 120u * 3u);
+  std::set<uint32_t> colours;
+  for (size_t i = 0; i < rgb.size(); i += 3)
+    colours.insert((uint32_t(rgb[i]) << 16) | (uint32_t(rgb[i + 1]) << 8) | rgb[i + 2]);
+  EXPECT_GT(colours.size(), 10u);
+
+  json info = Published(c, "/cam/camera_info");
+  ASSERT_FALSE(info.is_null());
+  Eigen::Matrix3d K = camera_.GetIntrinsicMatrix();
+  ASSERT_EQ(info["msg"]["K"].size(), 9u);
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(info["msg"]["K"][3 * r + k].get<double>(), K(r, k), 1e-9);
+  EXPECT_EQ(info["msg"]["P"].size(), 12u);
+  EXPECT_EQ(info["msg"]["distortion_model"], "plumb_bob");
+  EXPECT_EQ(info["msg"]["width"], 160);
+  EXPECT_EQ(info["msg"]["height"], 120);
+
+  json points = Published(c, "/cam/points");
+  ASSERT_FALSE(points.is_null());
+  const json& pc = points["msg"];
+  ASSERT_EQ(pc["fields"].size(), 3u);
+  const char* field_names[] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(pc["fields"][k]["name"], field_names[k]);
+    EXPECT_EQ(pc["fields"][k]["offset"], 4 * k);
+    EXPECT_EQ(pc["fields"][k]["datatype"], 7);  // FLOAT32
+    EXPECT_EQ(pc["fields"][k]["count"], 1);
+  }
+  EXPECT_EQ(pc["point_step"], 12);
+  EXPECT_EQ(pc["is_bigendian"], false);
+  std::vector<uint8_t> bytes = DecodeBase64(pc["data"].get<std::string>());
+  const size_t n = pc["width"].get<size_t>() * pc["height"].get<size_t>();
+  ASSERT_EQ(bytes.size(), n * 12);
+  EXPECT_EQ(pc["row_step"].get<size_t>(), pc["width"].get<size_t>() * 12);
+  size_t in_front = 0;
+  for (size_t i = 0; i < n; ++i) {
+    float p[3];
+    std::memcpy(p, bytes.data() + 12 * i, 12);
+    if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]) && p[2] > 0.05f &&
+        p[2] < 20.f)
+      ++in_front;  // optical frame: z forward
+  }
+  EXPECT_GT(in_front, 1000u);
+}
+
+TEST_F(RosbridgeSensorTest, ImuAtRestReadsGravity) {
+  Start(32, 24, 10);
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  std::this_thread::sleep_for(500ms);  // let the hand settle under its position controller
+  c.Send(json{{"op", "subscribe"}, {"topic", "/imu"}, {"throttle_rate", 50}});
+  ASSERT_TRUE(WaitFor([&] {
+    int n = 0;
+    for (const json& m : c.Messages()) n += m.value("topic", "") == "/imu";
+    return n >= 5;
+  }));
+  json last;
+  for (const json& m : c.Messages())
+    if (m.value("topic", "") == "/imu") last = m["msg"];
+  const json& a = last["linear_acceleration"];
+  const double g = std::sqrt(a["x"].get<double>() * a["x"].get<double>() +
+                             a["y"].get<double>() * a["y"].get<double>() +
+                             a["z"].get<double>() * a["z"].get<double>());
+  EXPECT_NEAR(g, 9.81, 0.3);
+  const json& q = last["orientation"];
+  EXPECT_NEAR(
+      q["x"].get<double>() * q["x"].get<double>() + q["y"].get<double>() * q["y"].get<double>() +
+          q["z"].get<double>() * q["z"].get<double>() + q["w"].get<double>() * q["w"].get<double>(),
+      1.0, 1e-6);
+  EXPECT_EQ(last["orientation_covariance"].size(), 9u);
+}
+
+TEST_F(RosbridgeSensorTest, PublishingToSensorTopicsIsRefusedAndNothingComesUnasked) {
+  Start(32, 24, 10);
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(
+      json{{"op", "publish"}, {"topic", "/cam/image_raw"}, {"msg", json::object()}, {"id", "p"}});
+  json err = c.WaitMessage([](const json& m) { return m.value("id", "") == "p"; });
+  EXPECT_TRUE(IsError(err));
+  std::this_thread::sleep_for(300ms);
+  for (const json& m : c.Messages()) EXPECT_NE(m.value("op", ""), "publish");
+}
+
+/// Images per second at 640x480 delivered to one client, cameras rendered every step
+/// (llvmpipe: the rasterizer on the CPU). Prints the figure for the README.
+TEST_F(RosbridgeSensorTest, ImageThroughput640x480) {
+  Start(640, 480, 0);
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.CountOnly("/cam/image_raw");
+  c.Send(json{{"op", "subscribe"}, {"topic", "/cam/image_raw"}});
+  ASSERT_TRUE(WaitFor([&] { return c.Counted() > 0; }));
+  const long long n0 = c.Counted();
+  const auto t0 = std::chrono::steady_clock::now();
+  std::this_thread::sleep_for(5s);
+  const long long n = c.Counted() - n0;
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("rosbridge 640x480 image_raw: %lld images in %.2f s = %.1f images/s\n", n, secs,
+              n / secs);
+  EXPECT_GT(n, 0);
 }
 
 }  // namespace

@@ -2,7 +2,10 @@
 // /joint_states and /tf are published from the simulation thread; joint position, velocity and
 // trajectory commands, rosapi services and the simulation controls (pause, resume, reset, step)
 // come in. Each client has its own subscriptions and a bounded outgoing queue: a client that
-// reads slowly loses messages, the simulation never waits for it.
+// reads slowly loses messages, the simulation never waits for it. Every camera of the scene at
+// Start() publishes /<camera>/image_raw, /<camera>/camera_info and /<camera>/points, and an IMU on
+// the robot publishes /imu; sensors are read (cameras rendered) on the simulation thread between
+// steps, and only while some client subscribes.
 #pragma once
 
 #include <memory>
@@ -22,6 +25,12 @@ struct RosbridgeOptions {
   size_t max_client_queue = 200;          ///< messages waiting per client before drops
   size_t max_client_buffered = 4u << 20;  ///< bytes in a client's socket queue before drops
   double control_rate = 0.0;              ///< Hz of the robot controllers; 0: every step
+  /// Hz (simulated time) of the camera topics; 0: every step. A camera renders only while some
+  /// client subscribes to its image_raw or points topic.
+  double camera_rate = 10.0;
+  double imu_rate = 0.0;  ///< Hz (simulated time) of /imu; 0: every step
+  /// Link of the robot carrying the /imu IMU; empty: the robot's last link (its end effector).
+  std::string imu_link;
 };
 
 /// Counters for the README and the tests.
@@ -47,7 +56,8 @@ class RosbridgeServer {
   RosbridgeServer& operator=(const RosbridgeServer&) = delete;
 
   /// Starts listening and serving on a thread of its own; throws partsim::Error if the port
-  /// cannot be opened. Also installs the SimServer's step callback.
+  /// cannot be opened. Also installs the SimServer's step callback and takes the scene's cameras
+  /// (add them before Start).
   void Start();
   /// Closes all connections and joins the network thread. Idempotent.
   void Stop();
