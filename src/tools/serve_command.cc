@@ -33,8 +33,8 @@ WebSocket): /clock, /joint_states and /tf out; /<robot>/joint_position_controlle
 /rosapi/topics, /rosapi/topic_type, /rosapi/services, /partsim/pause|resume|reset|step|stats.
 Sensors, read only while a client subscribes: /front_camera/image_raw (sensor_msgs/Image,
 rgb8), /front_camera/camera_info, /front_camera/points (sensor_msgs/PointCloud2, x y z
-float32) from a camera looking at the scene from the front, and /imu (sensor_msgs/Imu) on the
-robot's end-effector link at the physics rate.
+float32) from a camera looking at the robot and the object from the -y side, and /imu
+(sensor_msgs/Imu) on the robot's end-effector link at the physics rate.
 With no SCENE, a built-in cabinet stands in front of the robot.
   --port P               WebSocket port (default 9090; 0 picks a free one, printed on start)
   --rate R               physics rate in Hz (default 500), stepped in real time
