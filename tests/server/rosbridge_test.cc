@@ -358,7 +358,9 @@ TEST_F(RosbridgeTest, HugeMessageIsRejectedAndServerStaysUp) {
                         std::string(20u << 20, 'a') + "\"}}";
   big.Send(payload);
   EXPECT_TRUE(WaitFor([&] { return big.Closed(); }));
-  EXPECT_EQ(big.CloseCode(), 1009);  // "message too big"
+  // "message too big" (1009); when the server drops the socket while the client is still
+  // writing the 20 MB, the client sees the connection end without a close frame (1006)
+  EXPECT_TRUE(big.CloseCode() == 1009 || big.CloseCode() == 1006) << big.CloseCode();
   EXPECT_TRUE(ClockAdvances(*watcher, 0.05));
 }
 
