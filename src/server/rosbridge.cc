@@ -280,28 +280,20 @@ struct RosbridgeServer::Impl {
   }
   void PublishJointTopics(double t) {
     const WallClock::time_point now = WallClock::now();
-    std::lock_guard<std::mutex> lock(clients_mutex);
-    if (clients.empty()) return;
-    static const char* kPublished[] = {"/clock", "/joint_states", "/tf"};
-    for (const char* topic : kPublished) {
-      std::string text;  // built once, when some client is due
-      for (auto& [h, c] : clients) {
-        auto it = c->subs.find(topic);
-        if (it == c->subs.end()) continue;
-        Subscription& s = it->second;
-        if (s.throttle_ms > 0 &&
-            std::chrono::duration<double, std::milli>(now - s.last_sent).count() < s.throttle_ms)
-          continue;
-        if (text.empty()) {
-          json msg = std::string(topic) == "/clock"          ? json{{"clock", Stamp(t)}}
-                     : std::string(topic) == "/joint_states" ? JointStateMsg(t)
-                                                             : TfMsg(t);
-          text = json{{"op", "publish"}, {"topic", topic}, {"msg", msg}}.dump();
-        }
-        s.last_sent = now;
-        Enqueue(c, text, s.queue_length);
-      }
+    {
+      std::lock_guard<std::mutex> lock(clients_mutex);
+      if (clients.empty()) return;
     }
+    Publish(
+        "/clock",
+        [&] {
+          return json{{"clock", Stamp(t)}};
+        },
+        now);
+    Publish(
+        "/joint_states", [&] { return JointStateMsg(t); }, now);
+    Publish(
+        "/tf", [&] { return TfMsg(t); }, now);
   }
 
   // ---- simulation thread: sensors ----
