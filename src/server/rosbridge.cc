@@ -177,16 +177,16 @@ struct RosbridgeServer::Impl {
 
   /// Network thread: hands queued messages to the socket unless its queue is full.
   void Flush(const ClientPtr& c) {
-    std::deque<std::pair<std::string, size_t>> todo;
+    std::deque<std::pair<std::string, size_t>> pending;
     {
       std::lock_guard<std::mutex> lock(c->out_mutex);
-      todo.swap(c->out);
+      pending.swap(c->out);
       c->flush_scheduled = false;
     }
     websocketpp::lib::error_code ec;
     WsServer::connection_ptr con = ws.get_con_from_hdl(c->hdl, ec);
     if (ec || !con || con->get_state() != websocketpp::session::state::open) return;
-    for (auto& m : todo) {
+    for (auto& m : pending) {
       if (con->get_buffered_amount() > options.max_client_buffered) {
         ++dropped;
         continue;

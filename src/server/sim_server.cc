@@ -77,10 +77,10 @@ void SimServer::SetOptions(const SimServerOptions& options) {
 
 void SimServer::RunCommands(std::unique_lock<std::mutex>& lock) {
   // run outside the lock so commands may post further commands
-  std::vector<Command> todo;
-  todo.swap(queue_);
+  std::vector<Command> pending;
+  pending.swap(queue_);
   lock.unlock();
-  for (Command& c : todo) {
+  for (Command& c : pending) {
     c();
     ++commands_run_;
   }

@@ -80,12 +80,21 @@ std::vector<Eigen::Vector3d> TaskImpl::HandlePoints() const {
   return out;
 }
 
+Eigen::Vector3d TaskImpl::HandleCentreInLink() const {
+  // the mean of the handle's vertices, in the target link's frame
+  Link link = object.GetLink(target_link);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  size_t n = 0;
+  for (const VisualShape& v : link.GetDesc().visuals) {
+    if (v.name.rfind("handle-", 0) != 0 || !v.mesh) continue;
+    for (const Eigen::Vector3f& p : v.mesh->vertices) sum += v.pose.Transform(p.cast<double>());
+    n += v.mesh->vertices.size();
+  }
+  return n > 0 ? Eigen::Vector3d(sum / static_cast<double>(n)) : Eigen::Vector3d::Zero();
+}
+
 Eigen::Vector3d TaskImpl::HandleCentre() const {
-  std::vector<Eigen::Vector3d> pts = HandlePoints();
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : pts) c += p;
-  return pts.empty() ? object.GetLink(target_link).GetPose().p
-                     : Eigen::Vector3d(c / static_cast<double>(pts.size()));
+  return object.GetLink(target_link).GetPose().Transform(handle_centre_in_link);
 }
 
 Eigen::Vector3d TaskImpl::AverageNormal() const {

@@ -265,6 +265,7 @@ void TaskImpl::Reset(std::uint64_t seed) {
   range = lim[1] - lim[0];
   start_time = scene->GetTime();
   rest_orientation = object.GetLink(target_link).GetPose().q;
+  handle_centre_in_link = HandleCentreInLink();
   grasped_once = false;
 
   // gripper open, in front of the target's handle and to one side
@@ -275,9 +276,6 @@ void TaskImpl::Reset(std::uint64_t seed) {
       handle + Eigen::Vector3d(0.3 + 0.05 * U(rng), side * (0.3 + 0.05 * U(rng)), 0.05 * U(rng));
   Eigen::Quaterniond q(Eigen::AngleAxisd(0.1 * U(rng), Eigen::Vector3d::UnitZ()) *
                        Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitY()));
-  Eigen::VectorXd qpos = robot.GetQpos();
-  qpos.setZero();
-  robot.SetQpos(qpos);
   PlaceGripper(Pose(p, q), 1.0);
   if (options.init_on_handle) {
     Pose grasp = GroundTruthGrasp();
@@ -286,7 +284,6 @@ void TaskImpl::Reset(std::uint64_t seed) {
     for (int i = 0; i < 25; ++i) StepControl();
     start_time = scene->GetTime();
   }
-  last_progress = Progress();
   had_grasp = TouchesTarget();
   last_reward = 0.0;
 }
@@ -441,7 +438,6 @@ void TaskImpl::StepControl() {
   if (!grasped_once) r -= 0.5 * (TcpPose().p - HandleCentre()).norm();
   grasped_once = grasped_once || touching;
   had_grasp = touching;
-  last_progress = p;
   last_reward = r;
 }
 

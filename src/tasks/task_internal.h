@@ -61,7 +61,9 @@ struct TaskImpl {
   Eigen::VectorXd MobilityObservation() const;
   /// World points of the target's handle meshes (ground truth).
   std::vector<Eigen::Vector3d> HandlePoints() const;
+  /// Centre of the target's handle (mean of its mesh vertices), in the world.
   Eigen::Vector3d HandleCentre() const;
+  Eigen::Vector3d HandleCentreInLink() const;
   /// Outward normal of the target's front (it faces +x at rest).
   Eigen::Vector3d AverageNormal() const;
   /// Signed distance of the target's front face along AverageNormal (a point on the face, dotted
@@ -89,11 +91,12 @@ struct TaskImpl {
   double range = 0.0;
   double start_time = 0.0;
   Eigen::Quaterniond rest_orientation = Eigen::Quaterniond::Identity();  // target link at rest
+  Eigen::Vector3d handle_centre_in_link = Eigen::Vector3d::Zero();
   Pose tcp_target;
   Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
   bool velocity_mode = false;
   double gripper_fraction = 1.0;
-  double last_progress = 0.0, last_reward = 0.0;
+  double last_reward = 0.0;
   bool had_grasp = false, grasped_once = false;
 };
 

@@ -666,7 +666,7 @@ void BuildCart(ObjectBuilder& b, Rng& rng) {
     for (int s : {-1, 1}) {
       V3 c(s * (w / 2 + 0.03 + ww / 2), wr, zf - wr - 0.04);
       Wheel(b, body, c, V3::UnitX(), wr, ww, Rubber(), metal);
-      // axle stub along x, held by a strut from the frame
+      // short axle along x, held by a strut from the frame
       b.Add(fp,
             Rod(V3(s * (w / 2 - 0.012), wr, c.z()), V3(s * (w / 2 + 0.03 - 2 * kGap), wr, c.z()),
                 0.008),
