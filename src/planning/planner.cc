@@ -62,7 +62,7 @@ struct MotionPlanner::Impl {
     return full;
   }
 
-  std::string LinkName(int link) const { return arm.GetLink(link).GetName(); }
+  std::string LinkName(int link) const { return world_arm.GetLink(link).GetName(); }
 
   bool Check(const Eigen::VectorXd& q, double clearance, std::string* reason) {
     for (Eigen::Index i = 0; i < q.size(); ++i)
@@ -272,7 +272,7 @@ PlanResult MotionPlanner::PlanToJoints(const Eigen::VectorXd& goal, const Planne
   auto t0 = std::chrono::steady_clock::now();
   impl_->CheckVector(goal, "goal");
   CheckOptions(options);
-  impl_->Snapshot();
+  if (!options.use_last_snapshot || !impl_->world) impl_->Snapshot();
   return impl_->Plan(goal, options, t0);
 }
 
@@ -369,9 +369,9 @@ PlanResult MotionPlanner::PlanToPose(const std::string& link, const Pose& tcp_of
   CheckOptions(options);
   if (!target.p.allFinite() || !target.q.coeffs().allFinite())
     throw Error("MotionPlanner::PlanToPose: target is not finite");
-  KinematicModel model = KinematicModel::FromArticulation(p.arm);
+  if (!options.use_last_snapshot || !p.world) p.Snapshot();
+  KinematicModel model = KinematicModel::FromArticulation(p.world_arm);
   const int link_index = model.LinkIndex(link);
-  p.Snapshot();
   IkOptions ik;
   ik.offset = tcp_offset;
   ik.active.assign(model.Dof(), false);

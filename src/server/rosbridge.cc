@@ -92,10 +92,6 @@ std::vector<double> Numbers(const json& a, const std::string& what) {
   return v;
 }
 
-Eigen::VectorXd ToVector(const std::vector<double>& v) {
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
-}
-
 }  // namespace
 
 struct RosbridgeServer::Impl {
@@ -115,32 +111,23 @@ struct RosbridgeServer::Impl {
   };
   using ClientPtr = std::shared_ptr<Client>;
 
+  ServedRobot* robot;
   SimServer* sim;
-  Scene* scene;
-  ControlLoop* loop;
-  Articulation robot;
   std::string robot_name;
   RosbridgeOptions options;
-  std::shared_ptr<JointPositionController> position_ctrl;
-  std::shared_ptr<JointVelocityController> velocity_ctrl;
-  std::shared_ptr<JointTrajectoryController> trajectory_ctrl;
-  std::shared_ptr<Controller> active;  // sim thread only
 
   // sensors (read on the simulation thread)
   struct CameraTopics {
-    Camera camera;
-    std::string image, info, points, frame;
+    std::string image, info, points;
     double next_render = 0, next_info = 0;  // simulated time of the next message
   };
-  std::vector<CameraTopics> cameras;  // set at Start
-  std::unique_ptr<Imu> imu;
-  std::string imu_frame;
+  std::vector<CameraTopics> cameras;  // one per robot->GetCameras()
   double imu_next = 0;
 
   WsServer ws;
   std::thread io_thread;
   int port = 0;
-  bool started = false;
+  std::atomic<bool> started{false};
 
   mutable std::mutex clients_mutex;
   std::map<Hdl, ClientPtr, std::owner_less<Hdl>> clients;
@@ -152,8 +139,7 @@ struct RosbridgeServer::Impl {
   std::map<std::string, PendingCall> pending_calls;
   long long next_call = 0;
 
-  std::atomic<long long> sent{0}, dropped{0}, commands{0}, errors{0}, max_latency{0};
-  std::atomic<long long> latency_sum{0};
+  std::atomic<long long> sent{0}, dropped{0}, errors{0};
 
   // ---- outgoing ----
   /// Queues a message for a client from any thread; drops the oldest beyond the bound.
@@ -214,6 +200,7 @@ struct RosbridgeServer::Impl {
         {"/tf", kTfType},
         {Prefix() + "/joint_position_controller/command", kFloat64ArrayType},
         {Prefix() + "/joint_velocity_controller/command", kFloat64ArrayType},
+        {Prefix() + "/joint_effort_controller/command", kFloat64ArrayType},
         {Prefix() + "/joint_trajectory_controller/command", kTrajectoryType},
         {"/imu", kImuType}};
     for (const CameraTopics& c : cameras) {
@@ -241,35 +228,24 @@ struct RosbridgeServer::Impl {
 
   // ---- simulation thread: messages after each step ----
   json JointStateMsg(double t) const {
-    json names = json::array(), pos = json::array(), vel = json::array(), eff = json::array();
-    for (const Articulation& a : scene->GetArticulations()) {
-      Eigen::VectorXd q = a.GetQpos(), qd = a.GetQvel(), f = a.GetQf();
-      std::vector<Joint> joints = a.GetActiveJoints();
-      for (size_t i = 0; i < joints.size(); ++i) {
-        names.push_back(joints[i].GetName());
-        pos.push_back(q[i]);
-        vel.push_back(qd[i]);
-        eff.push_back(f[i]);
-      }
-    }
-    return {{"header", {{"seq", 0}, {"stamp", Stamp(t)}, {"frame_id", ""}}},
-            {"name", names},
-            {"position", pos},
-            {"velocity", vel},
-            {"effort", eff}};
+    JointStateReading r = robot->ReadJointStates();
+    return {{"header", Header(t, "")},
+            {"name", r.names},
+            {"position", r.position},
+            {"velocity", r.velocity},
+            {"effort", r.effort}};
   }
   json TfMsg(double t) const {
     json tfs = json::array();
-    for (const Articulation& a : scene->GetArticulations())
-      for (const Link& l : a.GetLinks()) {
-        Pose X = l.GetPose();
-        tfs.push_back(
-            {{"header", {{"seq", 0}, {"stamp", Stamp(t)}, {"frame_id", "world"}}},
-             {"child_frame_id", l.GetName()},
-             {"transform",
-              {{"translation", {{"x", X.p.x()}, {"y", X.p.y()}, {"z", X.p.z()}}},
-               {"rotation", {{"x", X.q.x()}, {"y", X.q.y()}, {"z", X.q.z()}, {"w", X.q.w()}}}}}});
-      }
+    for (const FrameReading& f : robot->ReadFrames()) {
+      const Pose& X = f.pose;
+      tfs.push_back(
+          {{"header", Header(t, "world")},
+           {"child_frame_id", f.child},
+           {"transform",
+            {{"translation", {{"x", X.p.x()}, {"y", X.p.y()}, {"z", X.p.z()}}},
+             {"rotation", {{"x", X.q.x()}, {"y", X.q.y()}, {"z", X.q.z()}, {"w", X.q.w()}}}}}});
+    }
     return {{"transforms", tfs}};
   }
 
@@ -325,9 +301,7 @@ struct RosbridgeServer::Impl {
   }
   static json ImageMsg(const Camera& cam, double t, const std::string& frame) {
     const int w = cam.GetWidth(), h = cam.GetHeight();
-    std::vector<uint8_t> rgba = cam.GetColorRGBA8(), rgb(static_cast<size_t>(w) * h * 3);
-    for (size_t i = 0, n = static_cast<size_t>(w) * h; i < n; ++i)
-      for (int k = 0; k < 3; ++k) rgb[i * 3 + k] = rgba[i * 4 + k];
+    std::vector<uint8_t> rgb = CameraRgb8(cam);
     return {{"header", Header(t, frame)},
             {"height", h},
             {"width", w},
@@ -337,15 +311,8 @@ struct RosbridgeServer::Impl {
             {"data", Base64(rgb.data(), rgb.size())}};
   }
   static json CameraInfoMsg(const Camera& cam, double t, const std::string& frame) {
-    Eigen::Matrix3d K = cam.GetIntrinsicMatrix();
-    json k = json::array(), p = json::array();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) {
-        k.push_back(K(r, c));
-        p.push_back(K(r, c));
-      }
-      p.push_back(0.0);
-    }
+    std::vector<double> p = CameraProjection(cam);
+    json k = {p[0], p[1], p[2], p[4], p[5], p[6], p[8], p[9], p[10]};
     return {
         {"header", Header(t, frame)},
         {"height", cam.GetHeight()},
@@ -363,18 +330,12 @@ struct RosbridgeServer::Impl {
   /// The points seen, in the optical frame (x right, y down, z forward), as x, y, z float32.
   static json PointsMsg(const Camera& cam, double t, const std::string& frame) {
     static_assert(sizeof(float) == 4, "float32 points");
-    PointCloud pc = MakePointCloud(cam, PointCloudFrame::kCamera);
-    std::vector<float> xyz(pc.positions.size());
-    for (size_t i = 0; i < pc.Size(); ++i) {  // OpenGL camera frame to the optical frame
-      xyz[3 * i] = pc.positions[3 * i];
-      xyz[3 * i + 1] = -pc.positions[3 * i + 1];
-      xyz[3 * i + 2] = -pc.positions[3 * i + 2];
-    }
+    std::vector<float> xyz = CameraOpticalPoints(cam);
     json fields = json::array();
     const char* names[] = {"x", "y", "z"};
     for (int k = 0; k < 3; ++k)
       fields.push_back({{"name", names[k]}, {"offset", 4 * k}, {"datatype", 7}, {"count", 1}});
-    const size_t n = pc.Size();
+    const size_t n = xyz.size() / 3;
     return {{"header", Header(t, frame)},
             {"height", 1},
             {"width", n},
@@ -386,9 +347,9 @@ struct RosbridgeServer::Impl {
             {"is_dense", true}};
   }
   json ImuMsg(double t) const {
-    ImuReading r = imu->Read();
+    ImuReading r = robot->GetImu()->Read();
     const json zeros = std::vector<double>(9, 0.0);
-    return {{"header", Header(t, imu_frame)},
+    return {{"header", Header(t, robot->GetImuFrame())},
             {"orientation",
              {{"x", r.orientation[1]},
               {"y", r.orientation[2]},
@@ -405,12 +366,14 @@ struct RosbridgeServer::Impl {
   void PublishSensors(double t) {
     const double eps = 1e-9;
     const WallClock::time_point now = WallClock::now();
+    const ServedRobotOptions& ro = robot->GetOptions();
+    std::vector<CameraSensor>& sensors = robot->GetCameras();
     bool want_imu = false;
     std::vector<std::array<bool, 3>> want(cameras.size(), {false, false, false});
     {
       std::lock_guard<std::mutex> lock(clients_mutex);
       if (clients.empty()) return;
-      want_imu = imu && t + eps >= imu_next && Wanted("/imu");
+      want_imu = robot->GetImu() && t + eps >= imu_next && Wanted("/imu");
       for (size_t i = 0; i < cameras.size(); ++i) {
         const CameraTopics& c = cameras[i];
         if (t + eps >= c.next_render) want[i] = {Wanted(c.image), Wanted(c.points), false};
@@ -418,137 +381,86 @@ struct RosbridgeServer::Impl {
       }
     }
     if (want_imu) {
-      imu_next = options.imu_rate > 0 ? t + 1.0 / options.imu_rate : 0;
+      imu_next = ro.imu_rate > 0 ? t + 1.0 / ro.imu_rate : 0;
       Publish(
           "/imu", [&] { return ImuMsg(t); }, now);
     }
-    const double period = options.camera_rate > 0 ? 1.0 / options.camera_rate : 0;
-    bool updated = false;
+    const double period = ro.camera_rate > 0 ? 1.0 / ro.camera_rate : 0;
     for (size_t i = 0; i < cameras.size(); ++i) {
       CameraTopics& c = cameras[i];
+      const std::string& frame = sensors[i].frame;
       if (want[i][0] || want[i][1]) {
-        if (!updated) scene->UpdateRender();  // poses of this step, once for all cameras
-        updated = true;
-        c.camera.TakePicture();
+        const Camera& cam = robot->TakePicture(i);
         c.next_render = t + period;
         if (want[i][0])
           Publish(
-              c.image, [&] { return ImageMsg(c.camera, t, c.frame); }, now);
+              c.image, [&] { return ImageMsg(cam, t, frame); }, now);
         if (want[i][1])
           Publish(
-              c.points, [&] { return PointsMsg(c.camera, t, c.frame); }, now);
+              c.points, [&] { return PointsMsg(cam, t, frame); }, now);
       }
       if (want[i][2]) {
         c.next_info = t + period;
         Publish(
-            c.info, [&] { return CameraInfoMsg(c.camera, t, c.frame); }, now);
+            c.info, [&] { return CameraInfoMsg(sensors[i].camera, t, frame); }, now);
       }
     }
   }
 
   // ---- commands (applied on the simulation thread) ----
-  void Activate(const std::shared_ptr<Controller>& c) {
-    if (active == c) return;
-    if (active) loop->Remove(active);
-    loop->Add(c);
-    active = c;
-  }
-
-  void PostCommand(const ClientPtr& client, const json& id, std::function<void()> apply) {
-    const long long arrival = sim->GetClockSteps();
+  ServedRobot::ErrorSink ErrorsTo(const ClientPtr& client, const json& id) {
     std::weak_ptr<Client> weak = client;
-    sim->Post([this, arrival, weak, id, apply] {
-      long long lat = sim->GetClockSteps() - arrival;
-      latency_sum += lat;
-      long long m = max_latency;
-      while (lat > m && !max_latency.compare_exchange_weak(m, lat)) {
-      }
-      ++commands;
-      try {
-        apply();
-      } catch (const std::exception& e) {
-        if (ClientPtr c = weak.lock()) Status(c, "error", e.what(), id);
-      }
-    });
+    return [this, weak, id](const std::string& e) {
+      if (ClientPtr c = weak.lock()) Status(c, "error", e, id);
+    };
   }
 
   /// Checks and applies a message published to one of the simulation's command topics.
   void HandleCommand(const ClientPtr& c, const std::string& topic, const json& msg,
                      const json& id) {
     if (!msg.is_object()) throw Error("publish to " + topic + ": msg is not an object");
-    const int n = position_ctrl->NumJoints();
-    if (topic == Prefix() + "/joint_position_controller/command" ||
-        topic == Prefix() + "/joint_velocity_controller/command") {
+    for (const char* kind : {"position", "velocity", "effort"}) {
+      if (topic != Prefix() + "/joint_" + kind + "_controller/command") continue;
       if (!msg.contains("data")) throw Error(topic + ": std_msgs/Float64MultiArray needs 'data'");
       std::vector<double> data = Numbers(msg["data"], topic + " data");
-      if (static_cast<int>(data.size()) != n)
-        throw Error(topic + ": data has " + std::to_string(data.size()) + " values, the robot " +
-                    std::to_string(n) + " joints");
-      Eigen::VectorXd v = ToVector(data);
-      if (topic.find("position") != std::string::npos)
-        PostCommand(c, id, [this, v] {
-          position_ctrl->SetTarget(v);
-          Activate(position_ctrl);
-        });
+      if (kind[0] == 'p')
+        robot->CommandPositions(data, topic, ErrorsTo(c, id));
+      else if (kind[0] == 'v')
+        robot->CommandVelocities(data, topic, ErrorsTo(c, id));
       else
-        PostCommand(c, id, [this, v] {
-          velocity_ctrl->SetTarget(v);
-          Activate(velocity_ctrl);
-        });
+        robot->CommandEfforts(data, topic, ErrorsTo(c, id));
       return;
     }
-    // trajectory_msgs/JointTrajectory
-    if (!msg.contains("joint_names") || !msg["joint_names"].is_array() || !msg.contains("points") ||
-        !msg["points"].is_array())
-      throw Error(topic + ": trajectory_msgs/JointTrajectory needs joint_names and points");
-    const std::vector<std::string>& all = position_ctrl->GetJointNames();
-    std::vector<int> index;  // controller index of each named joint
+    TrajectoryCommand cmd = ParseTrajectory(msg, topic);
+    auto errors = ErrorsTo(c, id);
+    robot->CommandTrajectory(cmd, topic, [errors](TrajectoryOutcome o, const std::string& m) {
+      if (o == TrajectoryOutcome::kInvalidGoal) errors(m);
+    });
+  }
+
+  /// A trajectory_msgs/JointTrajectory; throws naming `what`.
+  static TrajectoryCommand ParseTrajectory(const json& msg, const std::string& what) {
+    if (!msg.is_object() || !msg.contains("joint_names") || !msg["joint_names"].is_array() ||
+        !msg.contains("points") || !msg["points"].is_array())
+      throw Error(what + ": trajectory_msgs/JointTrajectory needs joint_names and points");
+    TrajectoryCommand cmd;
     for (const json& name : msg["joint_names"]) {
-      if (!name.is_string()) throw Error(topic + ": joint_names holds a non-string");
-      auto it = std::find(all.begin(), all.end(), name.get<std::string>());
-      if (it == all.end()) throw Error(topic + ": unknown joint '" + name.get<std::string>() + "'");
-      index.push_back(static_cast<int>(it - all.begin()));
+      if (!name.is_string()) throw Error(what + ": joint_names holds a non-string");
+      cmd.joint_names.push_back(name.get<std::string>());
     }
-    if (msg["points"].empty()) throw Error(topic + ": no points");
-    std::vector<double> times;
-    std::vector<std::vector<double>> pos, vel;
+    if (msg["points"].empty()) throw Error(what + ": no points");
     for (size_t k = 0; k < msg["points"].size(); ++k) {
       const json& p = msg["points"][k];
-      std::string what = topic + " points[" + std::to_string(k) + "]";
-      if (!p.is_object() || !p.contains("positions")) throw Error(what + " has no positions");
-      pos.push_back(Numbers(p["positions"], what + ".positions"));
-      if (pos.back().size() != index.size())
-        throw Error(what + ".positions does not match joint_names");
-      if (p.contains("velocities") && p["velocities"].is_array() && !p["velocities"].empty()) {
-        vel.push_back(Numbers(p["velocities"], what + ".velocities"));
-        if (vel.back().size() != index.size())
-          throw Error(what + ".velocities does not match joint_names");
-      }
-      times.push_back(p.contains("time_from_start") ? Duration(p["time_from_start"]) : 0.0);
+      std::string where = what + " points[" + std::to_string(k) + "]";
+      if (!p.is_object() || !p.contains("positions")) throw Error(where + " has no positions");
+      cmd.positions.push_back(Numbers(p["positions"], where + ".positions"));
+      if (p.contains("velocities") && p["velocities"].is_array() && !p["velocities"].empty())
+        cmd.velocities.push_back(Numbers(p["velocities"], where + ".velocities"));
+      cmd.times.push_back(p.contains("time_from_start") ? Duration(p["time_from_start"]) : 0.0);
     }
-    if (!vel.empty() && vel.size() != pos.size()) vel.clear();
-    PostCommand(c, id, [this, index, times, pos, vel] {
-      // joints not named hold where they are; a first point after 0 starts from here
-      Eigen::VectorXd here = trajectory_ctrl->GetQpos();
-      JointTrajectory traj;
-      if (times.front() > 1e-9) {
-        traj.times.push_back(0.0);
-        traj.positions.push_back(here);
-        if (!vel.empty()) traj.velocities.push_back(Eigen::VectorXd::Zero(here.size()));
-      }
-      for (size_t k = 0; k < times.size(); ++k) {
-        Eigen::VectorXd q = here, qd = Eigen::VectorXd::Zero(here.size());
-        for (size_t i = 0; i < index.size(); ++i) {
-          q[index[i]] = pos[k][i];
-          if (!vel.empty()) qd[index[i]] = vel[k][i];
-        }
-        traj.times.push_back(times[k]);
-        traj.positions.push_back(q);
-        if (!vel.empty()) traj.velocities.push_back(qd);
-      }
-      trajectory_ctrl->SetTrajectory(traj);
-      Activate(trajectory_ctrl);
-    });
+    if (!cmd.velocities.empty() && cmd.velocities.size() != cmd.positions.size())
+      cmd.velocities.clear();  // velocities on some points only: interpolate positions alone
+    return cmd;
   }
 
   // ---- services ----
@@ -572,8 +484,9 @@ struct RosbridgeServer::Impl {
       auto it = all.find(args["topic"].get<std::string>());
       values = {{"type", it == all.end() ? "" : it->second}};
     } else if (service == "/rosapi/services") {
-      json names = {"/rosapi/topics",  "/rosapi/topic_type", "/rosapi/services", "/partsim/pause",
-                    "/partsim/resume", "/partsim/reset",     "/partsim/step",    "/partsim/stats"};
+      json names = {"/rosapi/topics", "/rosapi/topic_type", "/rosapi/services",
+                    "/partsim/pause", "/partsim/resume",    "/partsim/reset",
+                    "/partsim/step",  "/partsim/stats",     Prefix() + "/plan"};
       std::lock_guard<std::mutex> lock(clients_mutex);
       for (auto& [h, cl] : clients)
         for (const std::string& s : cl->services) names.push_back(s);
@@ -606,6 +519,9 @@ struct RosbridgeServer::Impl {
                 {"max_latency_steps", s.max_latency_steps},
                 {"clock_steps", sim->GetClockSteps()},
                 {"timestep", sim->GetTimestep()}};
+    } else if (service == Prefix() + "/plan") {
+      CallPlan(c, service, args, id);
+      return true;
     } else {
       return false;
     }
@@ -616,6 +532,64 @@ struct RosbridgeServer::Impl {
     return true;
   }
 
+  /// /<robot>/plan: {joint_goal: [..]} or {pose_goal: geometry_msgs/Pose}, optional execute
+  /// (default true), time_limit, clearance, algorithm. Answers once planned (from the worker).
+  void CallPlan(const ClientPtr& c, const std::string& service, const json& args, const json& id) {
+    if (!args.is_object()) throw Error(service + ": args must be an object");
+    PlanRequest req;
+    if (args.contains("joint_goal")) {
+      req.joint_goal = Numbers(args["joint_goal"], service + " joint_goal");
+    } else if (args.contains("pose_goal") && args["pose_goal"].is_object()) {
+      const json& pg = args["pose_goal"];
+      if (!pg.contains("position") || !pg.contains("orientation"))
+        throw Error(service + ": pose_goal needs position and orientation");
+      auto num = [&](const json& o, const char* k) {
+        if (!o.is_object() || !o.contains(k) || !o[k].is_number())
+          throw Error(service + ": pose_goal field '" + k + "' is missing or not a number");
+        return o[k].get<double>();
+      };
+      const json &p = pg["position"], &q = pg["orientation"];
+      req.pose_goal = Pose(Eigen::Vector3d(num(p, "x"), num(p, "y"), num(p, "z")),
+                           Eigen::Quaterniond(num(q, "w"), num(q, "x"), num(q, "y"), num(q, "z")));
+    } else {
+      throw Error(service + ": args need joint_goal (one value per joint) or pose_goal");
+    }
+    if (args.contains("execute")) {
+      if (!args["execute"].is_boolean()) throw Error(service + ": execute must be a boolean");
+      req.execute = args["execute"].get<bool>();
+    }
+    for (const char* k : {"time_limit", "clearance"})
+      if (args.contains(k)) {
+        if (!args[k].is_number()) throw Error(service + ": " + k + " must be a number");
+        (k[0] == 't' ? req.options.time_limit : req.options.clearance) = args[k].get<double>();
+      }
+    if (args.contains("algorithm")) req.options.algorithm = Str(args, "algorithm", service);
+    std::weak_ptr<Client> weak = c;
+    robot->Plan(req, [this, weak, service, id](const PlanResult& r) {
+      ClientPtr cp = weak.lock();
+      if (!cp) return;
+      json points = json::array();
+      const JointTrajectory& t = r.trajectory;
+      for (size_t k = 0; k < t.times.size(); ++k) {
+        json p = {{"positions", std::vector<double>(t.positions[k].data(),
+                                                    t.positions[k].data() + t.positions[k].size())},
+                  {"time_from_start", Stamp(t.times[k])}};
+        if (!t.velocities.empty())
+          p["velocities"] = std::vector<double>(t.velocities[k].data(),
+                                                t.velocities[k].data() + t.velocities[k].size());
+        points.push_back(p);
+      }
+      json values = {{"success", r.success},
+                     {"message", r.message},
+                     {"planning_time", r.planning_time},
+                     {"trajectory", {{"joint_names", robot->GetJointNames()}, {"points", points}}}};
+      json out = {
+          {"op", "service_response"}, {"service", service}, {"values", values}, {"result", true}};
+      if (!id.is_null()) out["id"] = id;
+      Enqueue(cp, out.dump(), 0);
+    });
+  }
+
   RosbridgeStats Stats() const {
     RosbridgeStats s;
     {
@@ -624,9 +598,10 @@ struct RosbridgeServer::Impl {
     }
     s.messages_sent = sent;
     s.messages_dropped = dropped;
-    s.commands = commands;
-    s.mean_latency_steps = commands > 0 ? static_cast<double>(latency_sum) / commands : 0.0;
-    s.max_latency_steps = max_latency;
+    CommandStats cs = robot->GetCommandStats();
+    s.commands = cs.commands;
+    s.mean_latency_steps = cs.mean_latency_steps;
+    s.max_latency_steps = cs.max_latency_steps;
     s.errors = errors;
     return s;
   }
@@ -770,32 +745,25 @@ struct RosbridgeServer::Impl {
   }
 };
 
-RosbridgeServer::RosbridgeServer(SimServer* sim, Scene* scene, ControlLoop* loop,
-                                 const Articulation& robot, const std::string& robot_name,
-                                 const RosbridgeOptions& options)
+RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& options)
     : impl_(std::make_unique<Impl>()) {
+  if (!robot) throw Error("RosbridgeServer: robot is null");
   Impl& m = *impl_;
-  m.sim = sim;
-  m.scene = scene;
-  m.loop = loop;
   m.robot = robot;
-  m.robot_name = robot_name;
+  m.sim = robot->GetSim();
+  m.robot_name = robot->GetName();
   m.options = options;
-  JointControllerOptions co;
-  co.control_rate = options.control_rate > 0 ? options.control_rate : 1.0 / scene->GetTimestep();
-  m.position_ctrl =
-      std::make_shared<JointPositionController>(robot, std::vector<std::string>{}, co);
-  m.velocity_ctrl =
-      std::make_shared<JointVelocityController>(robot, std::vector<std::string>{}, co);
-  m.trajectory_ctrl =
-      std::make_shared<JointTrajectoryController>(robot, std::vector<std::string>{}, co);
-  m.Activate(m.position_ctrl);
-  const std::vector<Link> links = robot.GetLinks();
-  if (!links.empty()) {
-    Link l = options.imu_link.empty() ? links.back() : robot.FindLinkByName(options.imu_link);
-    m.imu = std::make_unique<Imu>(l);
-    m.imu_frame = l.GetName();
+  for (const CameraSensor& cam : robot->GetCameras()) {
+    Impl::CameraTopics c;
+    const std::string base = "/" + cam.name;
+    c.image = base + "/image_raw";
+    c.info = base + "/camera_info";
+    c.points = base + "/points";
+    m.cameras.push_back(c);
   }
+  m.sim->AddStepCallback([this](long long steps) {
+    if (impl_->started) impl_->OnStep(steps);
+  });
 
   m.ws.clear_access_channels(websocketpp::log::alevel::all);
   m.ws.clear_error_channels(websocketpp::log::elevel::all);
@@ -833,17 +801,6 @@ void RosbridgeServer::Start() {
   if (ec) throw Error("rosbridge: cannot accept: " + ec.message());
   boost::system::error_code bec;
   m.port = m.ws.get_local_endpoint(bec).port();
-  for (const Camera& cam : m.scene->GetCameras()) {
-    Impl::CameraTopics c;
-    c.camera = cam;
-    const std::string base = "/" + cam.GetName();
-    c.image = base + "/image_raw";
-    c.info = base + "/camera_info";
-    c.points = base + "/points";
-    c.frame = cam.GetName() + "_optical_frame";
-    m.cameras.push_back(c);
-  }
-  m.sim->SetStepCallback([this](long long steps) { impl_->OnStep(steps); });
   m.io_thread = std::thread([this] { impl_->ws.run(); });
   m.started = true;
 }

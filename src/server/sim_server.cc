@@ -129,7 +129,7 @@ void SimServer::Loop() {
     else
       scene_->Step(1);
     const long long now_steps = ++clock_steps_;
-    if (callback_) callback_(now_steps);
+    for (const StepCallback& callback : callbacks_) callback(now_steps);
     lock.lock();
   }
 }

@@ -16,6 +16,7 @@
 #include "partsim/render/camera_math.h"
 #include "partsim/robot/robots.h"
 #include "partsim/server/rosbridge.h"
+#include "partsim/server/served_robot.h"
 #include "partsim/server/sim_server.h"
 
 namespace partsim::tools {
@@ -162,12 +163,16 @@ int RunServeCommand(int argc, char** argv) {
     so.fast = fast;
     so.realtime_factor = factor;
     SimServer sim(&scene, &loop, so);
+    ServedRobotOptions sro;
+    sro.camera_rate = camera_rate;
+    sro.imu_link = model.ee_link;
+    sro.ee_link = model.ee_link;
+    sro.tcp_in_ee = model.tcp_in_ee;
+    ServedRobot served(&sim, &scene, &loop, robot, robot.GetName(), sro);
     RosbridgeOptions ro;
     ro.address = address;
     ro.port = port;
-    ro.camera_rate = camera_rate;
-    ro.imu_link = model.ee_link;
-    RosbridgeServer bridge(&sim, &scene, &loop, robot, robot.GetName(), ro);
+    RosbridgeServer bridge(&served, ro);
     bridge.Start();
     sim.Start();
     std::printf(

@@ -219,10 +219,11 @@ class RosbridgeTest : public ::testing::Test {
     robot_ = scene_->AddArticulation(m.articulation);
     loop_ = std::make_unique<ControlLoop>(scene_.get());
     sim_ = std::make_unique<SimServer>(scene_.get(), loop_.get());
+    served_ = std::make_unique<ServedRobot>(sim_.get(), scene_.get(), loop_.get(), robot_,
+                                            robot_.GetName());
     RosbridgeOptions o;
     o.port = 0;
-    bridge_ = std::make_unique<RosbridgeServer>(sim_.get(), scene_.get(), loop_.get(), robot_,
-                                                robot_.GetName(), o);
+    bridge_ = std::make_unique<RosbridgeServer>(served_.get(), o);
     bridge_->Start();
     sim_->Start();
     port_ = bridge_->GetPort();
@@ -248,6 +249,7 @@ class RosbridgeTest : public ::testing::Test {
   Articulation robot_;
   std::unique_ptr<ControlLoop> loop_;
   std::unique_ptr<SimServer> sim_;
+  std::unique_ptr<ServedRobot> served_;
   std::unique_ptr<RosbridgeServer> bridge_;
   int port_ = 0;
 };
@@ -444,12 +446,14 @@ class RosbridgeSensorTest : public ::testing::Test {
     camera_.SetLocalPose(CameraLookAt(Eigen::Vector3d(1.2, -0.8, 1.0), Eigen::Vector3d(0, 0, 0.4)));
     loop_ = std::make_unique<ControlLoop>(scene_.get());
     sim_ = std::make_unique<SimServer>(scene_.get(), loop_.get());
+    ServedRobotOptions so;
+    so.camera_rate = camera_rate;
+    so.imu_link = m.ee_link;
+    served_ = std::make_unique<ServedRobot>(sim_.get(), scene_.get(), loop_.get(), robot_,
+                                            robot_.GetName(), so);
     RosbridgeOptions o;
     o.port = 0;
-    o.camera_rate = camera_rate;
-    o.imu_link = m.ee_link;
-    bridge_ = std::make_unique<RosbridgeServer>(sim_.get(), scene_.get(), loop_.get(), robot_,
-                                                robot_.GetName(), o);
+    bridge_ = std::make_unique<RosbridgeServer>(served_.get(), o);
     bridge_->Start();
     sim_->Start();
     port_ = bridge_->GetPort();
@@ -467,6 +471,7 @@ class RosbridgeSensorTest : public ::testing::Test {
   Camera camera_;
   std::unique_ptr<ControlLoop> loop_;
   std::unique_ptr<SimServer> sim_;
+  std::unique_ptr<ServedRobot> served_;
   std::unique_ptr<RosbridgeServer> bridge_;
   int port_ = 0;
 };

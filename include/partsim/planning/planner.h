@@ -24,7 +24,11 @@ struct PlannerOptions {
   /// "RRTConnect", "RRT", "RRTstar", "PRM" or "KPIECE1"; anything else throws partsim::Error.
   std::string algorithm = "RRTConnect";
   bool simplify = true;  ///< shortcut and smooth the path found
-  int ik_attempts = 8;   ///< PlanToPose: IK solutions tried (from the start, then random)
+  /// Plan against the snapshot of the last UpdateSnapshot() instead of taking one now. A server
+  /// takes the snapshot on its simulation thread and plans on another: with this set, planning
+  /// reads nothing of the live scene.
+  bool use_last_snapshot = false;
+  int ik_attempts = 8;  ///< PlanToPose: IK solutions tried (from the start, then random)
 };
 
 /// What a planning request produced.

@@ -1,19 +1,18 @@
-// A rosbridge v2 protocol server (JSON over WebSocket) in front of a SimServer: /clock,
-// /joint_states and /tf are published from the simulation thread; joint position, velocity and
-// trajectory commands, rosapi services and the simulation controls (pause, resume, reset, step)
-// come in. Each client has its own subscriptions and a bounded outgoing queue: a client that
-// reads slowly loses messages, the simulation never waits for it. Every camera of the scene at
-// Start() publishes /<camera>/image_raw, /<camera>/camera_info and /<camera>/points, and an IMU on
-// the robot publishes /imu; sensors are read (cameras rendered) on the simulation thread between
-// steps, and only while some client subscribes.
+// A rosbridge v2 protocol server (JSON over WebSocket) in front of a ServedRobot: /clock,
+// /joint_states and /tf (links and camera optical frames) are published from the simulation
+// thread; joint position, velocity, effort and trajectory commands, motion planning
+// (/<robot>/plan), rosapi services and the simulation controls (pause, resume, reset, step) come
+// in. Each client has its own subscriptions and a bounded outgoing queue: a client that reads
+// slowly loses messages, the simulation never waits for it. Every camera of the served robot
+// publishes /<camera>/image_raw, /<camera>/camera_info and /<camera>/points, and its IMU /imu;
+// sensors are read (cameras rendered) on the simulation thread between steps, and only while
+// some client subscribes.
 #pragma once
 
 #include <memory>
 #include <string>
 
-#include "partsim/physics/scene.h"
-#include "partsim/robot/controllers.h"
-#include "partsim/server/sim_server.h"
+#include "partsim/server/served_robot.h"
 
 namespace partsim {
 
@@ -24,13 +23,6 @@ struct RosbridgeOptions {
   size_t max_message_bytes = 16u << 20;
   size_t max_client_queue = 200;          ///< messages waiting per client before drops
   size_t max_client_buffered = 4u << 20;  ///< bytes in a client's socket queue before drops
-  double control_rate = 0.0;              ///< Hz of the robot controllers; 0: every step
-  /// Hz (simulated time) of the camera topics; 0: every step. A camera renders only while some
-  /// client subscribes to its image_raw or points topic.
-  double camera_rate = 10.0;
-  double imu_rate = 0.0;  ///< Hz (simulated time) of /imu; 0: every step
-  /// Link of the robot carrying the /imu IMU; empty: the robot's last link (its end effector).
-  std::string imu_link;
 };
 
 /// Counters for the README and the tests.
@@ -38,7 +30,7 @@ struct RosbridgeStats {
   long long clients = 0;            ///< connected now
   long long messages_sent = 0;      ///< handed to sockets
   long long messages_dropped = 0;   ///< dropped for slow clients
-  long long commands = 0;           ///< robot commands applied
+  long long commands = 0;           ///< robot commands applied (from any front-end)
   double mean_latency_steps = 0.0;  ///< steps between a command's arrival and its application
   long long max_latency_steps = 0;
   long long errors = 0;  ///< status errors sent
@@ -46,18 +38,16 @@ struct RosbridgeStats {
 
 class RosbridgeServer {
  public:
-  /// `robot` is the articulation commanded under /<robot_name>/...; the server adds its
-  /// controllers to `loop` (call before sim->Start()). All pointers must outlive the server, and
-  /// the SimServer must be stopped before the server is destroyed (its step callback is ours).
-  RosbridgeServer(SimServer* sim, Scene* scene, ControlLoop* loop, const Articulation& robot,
-                  const std::string& robot_name, const RosbridgeOptions& options = {});
+  /// Serves `robot`, commanded under /<robot name>/...; adds a step callback to its SimServer
+  /// (construct before sim->Start()). The robot must outlive the server, and the SimServer must
+  /// be stopped before the server is destroyed.
+  explicit RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& options = {});
   ~RosbridgeServer();
   RosbridgeServer(const RosbridgeServer&) = delete;
   RosbridgeServer& operator=(const RosbridgeServer&) = delete;
 
   /// Starts listening and serving on a thread of its own; throws partsim::Error if the port
-  /// cannot be opened. Also installs the SimServer's step callback and takes the scene's cameras
-  /// (add them before Start).
+  /// cannot be opened.
   void Start();
   /// Closes all connections and joins the network thread. Idempotent.
   void Stop();

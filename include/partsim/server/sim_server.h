@@ -55,8 +55,8 @@ class SimServer {
   void Reset();
   /// Queues a command; it runs before the next step (or at once while paused).
   void Post(Command command);
-  /// Sets the callback (before Start).
-  void SetStepCallback(StepCallback callback) { callback_ = std::move(callback); }
+  /// Adds a callback run after every step, in the order added (before Start).
+  void AddStepCallback(StepCallback callback) { callbacks_.push_back(std::move(callback)); }
   void SetOptions(const SimServerOptions& options);
 
   /// Monotonic clock: steps taken since Start (Reset does not rewind it), and in seconds.
@@ -74,7 +74,7 @@ class SimServer {
   SimServerOptions options_;
   double dt_;
   std::vector<char> initial_state_;
-  StepCallback callback_;
+  std::vector<StepCallback> callbacks_;
   std::thread thread_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;

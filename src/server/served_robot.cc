@@ -1,0 +1,541 @@
+#include "partsim/server/served_robot.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <future>
+#include <map>
+#include <thread>
+
+#include "partsim/core/error.h"
+#include "partsim/render/image_io.h"
+
+namespace partsim {
+
+namespace {
+
+/// Checks a vector of one value per commanded joint.
+void CheckValues(const std::vector<double>& v, size_t n, const std::string& what) {
+  if (v.size() != n)
+    throw Error(what + ": " + std::to_string(v.size()) + " values for " + std::to_string(n) +
+                " joints");
+  for (size_t i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i])) throw Error(what + ": value " + std::to_string(i) + " is not finite");
+}
+
+Eigen::VectorXd ToVector(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+/// The optical frame of a camera whose pose follows the OpenGL convention (looking down -z,
+/// y up): turned half a turn about x.
+Pose OpticalPose(const Pose& camera) {
+  return camera * Pose(Eigen::Vector3d::Zero(), Eigen::Quaterniond(0, 1, 0, 0));
+}
+
+}  // namespace
+
+struct ServedRobot::Impl {
+  ServedRobot* self;
+  SimServer* sim;
+  Scene* scene;
+  ControlLoop* loop;
+  std::vector<std::string> joint_names;
+  std::shared_ptr<JointPositionController> position;
+  std::shared_ptr<JointVelocityController> velocity;
+  std::shared_ptr<JointEffortController> effort;
+  std::shared_ptr<JointTrajectoryController> trajectory;
+  std::shared_ptr<Controller> active;  // simulation thread only
+  double default_path_tolerance = 0.1;
+
+  // the running trajectory goal (simulation thread only)
+  struct Goal {
+    long long id = 0;
+    DoneCallback done;
+    FeedbackCallback feedback;
+    double start = 0.0, end = 0.0;  ///< simulation times
+    double goal_time_tolerance = 0.0;
+    Eigen::VectorXd path_tolerance, goal_tolerance;  ///< per commanded joint
+    double next_feedback = 0.0;
+  };
+  std::unique_ptr<Goal> goal;
+  std::atomic<long long> next_goal{1};
+
+  std::atomic<long long> commands{0}, latency_sum{0}, max_latency{0};
+  long long rendered_at = -1;  // clock step of the last UpdateRender
+  std::vector<long long> pictured_at;
+
+  // planning worker
+  std::unique_ptr<MotionPlanner> planner;
+  std::string ee_link;
+  std::thread worker;
+  std::mutex jobs_mutex;
+  std::condition_variable jobs_cv;
+  std::deque<std::function<void()>> jobs;
+  bool stopping = false;
+
+  /// Runs `apply` on the simulation thread between steps, counting the latency.
+  void Post(std::function<void()> apply, ErrorSink on_error) {
+    const long long arrival = sim->GetClockSteps();
+    sim->Post([this, arrival, apply = std::move(apply), on_error = std::move(on_error)] {
+      long long lat = sim->GetClockSteps() - arrival;
+      latency_sum += lat;
+      long long m = max_latency;
+      while (lat > m && !max_latency.compare_exchange_weak(m, lat)) {
+      }
+      ++commands;
+      try {
+        apply();
+      } catch (const std::exception& e) {
+        if (on_error) on_error(e.what());
+      }
+    });
+  }
+
+  /// Ends the running goal, if any (simulation thread).
+  void Finish(TrajectoryOutcome outcome, const std::string& message) {
+    if (!goal) return;
+    std::unique_ptr<Goal> g = std::move(goal);
+    if (g->done) g->done(outcome, message);
+  }
+
+  void Activate(const std::shared_ptr<Controller>& c) {
+    if (c != trajectory) Finish(TrajectoryOutcome::kPreempted, "another command took over");
+    if (active == c) return;
+    if (active) loop->Remove(active);
+    loop->Add(c);
+    active = c;
+  }
+
+  /// Holds the robot where it is (simulation thread).
+  void Hold() {
+    position->SetTarget(position->GetQpos());
+    Activate(position);
+  }
+
+  /// After each step: feedback and the end of the running goal.
+  void OnStep() {
+    if (!goal) return;
+    if (active != trajectory) return Finish(TrajectoryOutcome::kPreempted, "controller replaced");
+    const double now = scene->GetTime(), t = now - goal->start;
+    const ControllerStatus& st = trajectory->GetStatus();
+    Eigen::VectorXd desired, desired_v;
+    trajectory->GetTrajectory().Sample(std::min(t, goal->end - goal->start), &desired, &desired_v);
+    const Eigen::VectorXd actual = trajectory->GetQpos(), err = desired - actual;
+    if (goal->feedback && now + 1e-9 >= goal->next_feedback) {
+      goal->next_feedback = now + 0.02;  // 50 Hz of simulated time
+      TrajectoryFeedback f;
+      f.time = now;
+      f.joint_names = joint_names;
+      f.desired = desired;
+      f.actual = actual;
+      f.error = err;
+      f.desired_velocity = desired_v;
+      f.actual_velocity = trajectory->GetQvel();
+      goal->feedback(f);
+    }
+    auto worst = [&](const Eigen::VectorXd& tol, bool* bad) {
+      int w = -1;
+      double excess = 0;
+      for (Eigen::Index i = 0; i < err.size(); ++i) {
+        double e = std::abs(err[i]) - tol[i];
+        if (tol[i] > 0 && e > excess) {
+          excess = e;
+          w = static_cast<int>(i);
+        }
+      }
+      *bad = w >= 0;
+      return w;
+    };
+    if (st.state == ControllerState::kFailed && t <= goal->end - goal->start) {
+      Finish(TrajectoryOutcome::kPathToleranceViolated, st.message);
+      return Hold();
+    }
+    bool bad = false;
+    if (t <= goal->end - goal->start) {
+      int w = worst(goal->path_tolerance, &bad);
+      if (bad) {
+        std::string msg = "joint '" + joint_names[w] + "' is " + std::to_string(err[w]) +
+                          " from the trajectory at t = " + std::to_string(t) +
+                          " s (path tolerance " + std::to_string(goal->path_tolerance[w]) + ")";
+        Finish(TrajectoryOutcome::kPathToleranceViolated, msg);
+        return Hold();
+      }
+      return;
+    }
+    int w = worst(goal->goal_tolerance, &bad);
+    if (!bad) return Finish(TrajectoryOutcome::kSucceeded, "");
+    if (t > goal->end - goal->start + goal->goal_time_tolerance) {
+      std::string msg = "joint '" + joint_names[w] + "' is " + std::to_string(err[w]) +
+                        " from its goal " + std::to_string(goal->goal_time_tolerance) +
+                        " s after the trajectory's end (goal tolerance " +
+                        std::to_string(goal->goal_tolerance[w]) + ")";
+      Finish(TrajectoryOutcome::kGoalToleranceViolated, msg);
+      Hold();
+    }
+  }
+
+  /// Index of each named joint among the commanded ones; throws naming `what`.
+  std::vector<int> Indices(const std::vector<std::string>& names, const std::string& what) const {
+    std::vector<int> index;
+    for (const std::string& n : names) {
+      auto it = std::find(joint_names.begin(), joint_names.end(), n);
+      if (it == joint_names.end()) throw Error(what + ": unknown joint '" + n + "'");
+      int i = static_cast<int>(it - joint_names.begin());
+      if (std::find(index.begin(), index.end(), i) != index.end())
+        throw Error(what + ": joint '" + n + "' is named twice");
+      index.push_back(i);
+    }
+    return index;
+  }
+
+  /// Per-joint tolerances from (name, value) pairs: `fallback` where none (or 0) is given, no
+  /// bound where negative.
+  Eigen::VectorXd Tolerances(const std::vector<std::pair<std::string, double>>& given,
+                             double fallback, const std::string& what) const {
+    Eigen::VectorXd tol =
+        Eigen::VectorXd::Constant(static_cast<Eigen::Index>(joint_names.size()), fallback);
+    for (const auto& [name, value] : given) {
+      int i = Indices({name}, what).front();
+      if (!std::isfinite(value)) throw Error(what + ": tolerance of '" + name + "' is not finite");
+      if (value > 0) tol[i] = value;
+      if (value < 0) tol[i] = 0;  // 0 in `tol` means unbounded
+    }
+    return tol;
+  }
+
+  void WorkerLoop() {
+    for (;;) {
+      std::function<void()> job;
+      {
+        std::unique_lock<std::mutex> lock(jobs_mutex);
+        jobs_cv.wait(lock, [this] { return stopping || !jobs.empty(); });
+        if (stopping) return;
+        job = std::move(jobs.front());
+        jobs.pop_front();
+      }
+      job();
+    }
+  }
+
+  /// Runs `f` on the simulation thread and waits for it; false if stopping first.
+  bool OnSimThread(const std::function<void()>& f) {
+    auto done = std::make_shared<std::promise<void>>();
+    std::future<void> fut = done->get_future();
+    sim->Post([f, done] {
+      f();
+      done->set_value();
+    });
+    while (fut.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+      std::lock_guard<std::mutex> lock(jobs_mutex);
+      if (stopping) return false;
+    }
+    return true;
+  }
+};
+
+ServedRobot::ServedRobot(SimServer* sim, Scene* scene, ControlLoop* loop, const Articulation& robot,
+                         const std::string& name, const ServedRobotOptions& options)
+    : name_(name),
+      sim_(sim),
+      scene_(scene),
+      robot_(robot),
+      options_(options),
+      impl_(std::make_unique<Impl>()) {
+  if (!sim || !scene || !loop) throw Error("ServedRobot: sim, scene and loop must not be null");
+  for (double r : {options.control_rate, options.camera_rate, options.imu_rate})
+    if (!(r >= 0) || !std::isfinite(r))
+      throw Error("ServedRobot: rates must be finite and >= 0 (0: every step)");
+  Impl& m = *impl_;
+  m.self = this;
+  m.sim = sim;
+  m.scene = scene;
+  m.loop = loop;
+  for (const Joint& j : robot.GetActiveJoints()) m.joint_names.push_back(j.GetName());
+  JointControllerOptions co;
+  co.control_rate = options.control_rate > 0 ? options.control_rate : 1.0 / scene->GetTimestep();
+  m.position = std::make_shared<JointPositionController>(robot, std::vector<std::string>{}, co);
+  m.velocity = std::make_shared<JointVelocityController>(robot, std::vector<std::string>{}, co);
+  m.effort = std::make_shared<JointEffortController>(robot, std::vector<std::string>{}, co);
+  m.trajectory = std::make_shared<JointTrajectoryController>(robot, std::vector<std::string>{}, co);
+  m.default_path_tolerance = m.trajectory->path_tolerance;
+  m.Activate(m.position);
+
+  const std::vector<Link> links = robot.GetLinks();
+  if (!links.empty()) {
+    Link l = options.imu_link.empty() ? links.back() : robot.FindLinkByName(options.imu_link);
+    imu_ = std::make_unique<Imu>(l);
+    imu_frame_ = l.GetName();
+    m.ee_link = options.ee_link.empty() ? links.back().GetName()
+                                        : robot.FindLinkByName(options.ee_link).GetName();
+  }
+  for (const Camera& cam : scene->GetCameras())
+    cameras_.push_back({cam, cam.GetName(), cam.GetName() + "_optical_frame"});
+  m.pictured_at.assign(cameras_.size(), -1);
+  if (robot.Dof() > 0) m.planner = std::make_unique<MotionPlanner>(robot);
+  sim->AddStepCallback([this](long long) { impl_->OnStep(); });
+  m.worker = std::thread([this] { impl_->WorkerLoop(); });
+}
+
+ServedRobot::~ServedRobot() {
+  {
+    std::lock_guard<std::mutex> lock(impl_->jobs_mutex);
+    impl_->stopping = true;
+  }
+  impl_->jobs_cv.notify_all();
+  if (impl_->worker.joinable()) impl_->worker.join();
+}
+
+const std::vector<std::string>& ServedRobot::GetJointNames() const { return impl_->joint_names; }
+
+void ServedRobot::CommandPositions(const std::vector<double>& values, const std::string& what,
+                                   ErrorSink on_error) {
+  CheckValues(values, impl_->joint_names.size(), what);
+  Eigen::VectorXd v = ToVector(values);
+  Impl* m = impl_.get();
+  m->Post(
+      [m, v] {
+        m->position->SetTarget(v);
+        m->Activate(m->position);
+      },
+      std::move(on_error));
+}
+
+void ServedRobot::CommandVelocities(const std::vector<double>& values, const std::string& what,
+                                    ErrorSink on_error) {
+  CheckValues(values, impl_->joint_names.size(), what);
+  Eigen::VectorXd v = ToVector(values);
+  Impl* m = impl_.get();
+  m->Post(
+      [m, v] {
+        m->velocity->SetTarget(v);
+        m->Activate(m->velocity);
+      },
+      std::move(on_error));
+}
+
+void ServedRobot::CommandEfforts(const std::vector<double>& values, const std::string& what,
+                                 ErrorSink on_error) {
+  CheckValues(values, impl_->joint_names.size(), what);
+  Eigen::VectorXd v = ToVector(values);
+  Impl* m = impl_.get();
+  m->Post(
+      [m, v] {
+        m->effort->SetTarget(v);
+        m->Activate(m->effort);
+      },
+      std::move(on_error));
+}
+
+long long ServedRobot::CommandTrajectory(const TrajectoryCommand& c, const std::string& what,
+                                         DoneCallback on_done, FeedbackCallback on_feedback) {
+  Impl* m = impl_.get();
+  const std::vector<int> index = m->Indices(c.joint_names, what);
+  if (index.empty()) throw Error(what + ": no joint_names");
+  if (c.times.empty() || c.positions.size() != c.times.size())
+    throw Error(what + ": " + std::to_string(c.positions.size()) + " points with positions for " +
+                std::to_string(c.times.size()) + " times (need at least one point)");
+  if (!c.velocities.empty() && c.velocities.size() != c.times.size())
+    throw Error(what + ": velocities given for " + std::to_string(c.velocities.size()) + " of " +
+                std::to_string(c.times.size()) + " points");
+  for (size_t k = 0; k < c.times.size(); ++k) {
+    const std::string p = what + " point " + std::to_string(k);
+    if (!std::isfinite(c.times[k]) || c.times[k] < 0)
+      throw Error(p + ": time_from_start must be finite and >= 0");
+    if (k > 0 && !(c.times[k] > c.times[k - 1]))
+      throw Error(p + ": time_from_start does not come after the previous point's");
+    CheckValues(c.positions[k], index.size(), p + " positions");
+    if (!c.velocities.empty()) CheckValues(c.velocities[k], index.size(), p + " velocities");
+  }
+  if (!(c.goal_time_tolerance >= 0) || !std::isfinite(c.goal_time_tolerance))
+    throw Error(what + ": goal_time_tolerance must be finite and >= 0");
+  auto g = std::make_shared<Impl::Goal>();
+  g->id = m->next_goal++;
+  g->done = std::move(on_done);
+  g->feedback = std::move(on_feedback);
+  g->path_tolerance = m->Tolerances(c.path_tolerance, m->default_path_tolerance, what);
+  g->goal_tolerance =
+      m->Tolerances(c.goal_tolerance, m->trajectory->GetOptions().position_tolerance, what);
+  g->goal_time_tolerance =
+      c.goal_time_tolerance > 0 ? c.goal_time_tolerance : m->trajectory->GetOptions().timeout;
+  m->Post(
+      [m, c, index, g] {
+        // joints not named hold where they are; a first point after 0 starts from here
+        Eigen::VectorXd here = m->trajectory->GetQpos();
+        JointTrajectory traj;
+        const bool vel = !c.velocities.empty();
+        if (c.times.front() > 1e-9) {
+          traj.times.push_back(0.0);
+          traj.positions.push_back(here);
+          if (vel) traj.velocities.push_back(Eigen::VectorXd::Zero(here.size()));
+        }
+        for (size_t k = 0; k < c.times.size(); ++k) {
+          Eigen::VectorXd q = here, qd = Eigen::VectorXd::Zero(here.size());
+          for (size_t i = 0; i < index.size(); ++i) {
+            q[index[i]] = c.positions[k][i];
+            if (vel) qd[index[i]] = c.velocities[k][i];
+          }
+          traj.times.push_back(c.times[k]);
+          traj.positions.push_back(q);
+          if (vel) traj.velocities.push_back(qd);
+        }
+        m->Finish(TrajectoryOutcome::kPreempted, "a new trajectory replaced it");
+        m->trajectory->SetTrajectory(traj);
+        m->Activate(m->trajectory);
+        if (m->trajectory->GetStatus().state == ControllerState::kFailed) {
+          if (g->done) g->done(TrajectoryOutcome::kInvalidGoal, m->trajectory->GetStatus().message);
+          return;
+        }
+        auto goal = std::make_unique<Impl::Goal>(*g);
+        goal->start = m->scene->GetTime();
+        goal->end = goal->start + traj.Duration();
+        goal->next_feedback = goal->start;
+        m->goal = std::move(goal);
+      },
+      [g](const std::string& e) {
+        if (g->done) g->done(TrajectoryOutcome::kInvalidGoal, e);
+      });
+  return g->id;
+}
+
+void ServedRobot::CancelTrajectory(long long id) {
+  Impl* m = impl_.get();
+  m->Post(
+      [m, id] {
+        if (!m->goal || m->goal->id != id) return;
+        m->Finish(TrajectoryOutcome::kPreempted, "cancelled");
+        m->Hold();
+      },
+      {});
+}
+
+void ServedRobot::Plan(const PlanRequest& request, PlanCallback on_result, DoneCallback on_done) {
+  Impl* m = impl_.get();
+  if (!m->planner) throw Error("plan: robot '" + name_ + "' has no joints to plan for");
+  if (!request.joint_goal.empty())
+    CheckValues(request.joint_goal, m->joint_names.size(), "plan: joint_goal");
+  else if (!request.pose_goal.p.allFinite() || !request.pose_goal.q.coeffs().allFinite() ||
+           std::abs(request.pose_goal.q.norm() - 1.0) > 1e-3)
+    throw Error("plan: pose_goal must be finite with a unit quaternion");
+  PlannerOptions opt = request.options;
+  opt.use_last_snapshot = true;
+  // check the options now, so that a bad request fails on the caller's thread
+  static const char* known[] = {"RRTConnect", "RRT", "RRTstar", "PRM", "KPIECE1"};
+  if (!(opt.time_limit > 0) || !std::isfinite(opt.time_limit) || !(opt.resolution > 0) ||
+      !std::isfinite(opt.resolution) || !(opt.clearance >= 0) || !std::isfinite(opt.clearance) ||
+      std::find(std::begin(known), std::end(known), opt.algorithm) == std::end(known))
+    throw Error(
+        "plan: options need time_limit > 0, resolution > 0, clearance >= 0 and an algorithm of "
+        "RRTConnect, RRT, RRTstar, PRM or KPIECE1");
+  {
+    std::lock_guard<std::mutex> lock(m->jobs_mutex);
+    m->jobs.push_back([this, m, request, opt, on_result, on_done] {
+      PlanResult r;
+      try {
+        if (!m->OnSimThread([m] { m->planner->UpdateSnapshot(); })) return;
+        r = request.joint_goal.empty()
+                ? m->planner->PlanToPose(m->ee_link, options_.tcp_in_ee, request.pose_goal, opt)
+                : m->planner->PlanToJoints(ToVector(request.joint_goal), opt);
+      } catch (const std::exception& e) {
+        r.success = false;
+        r.message = e.what();
+      }
+      if (on_result) on_result(r);
+      if (!r.success || !request.execute) return;
+      TrajectoryCommand c;
+      c.joint_names = m->planner->GetJointNames();
+      const JointTrajectory& t = r.trajectory;
+      for (size_t k = 0; k < t.times.size(); ++k) {
+        c.times.push_back(t.times[k]);
+        c.positions.emplace_back(t.positions[k].data(),
+                                 t.positions[k].data() + t.positions[k].size());
+        if (!t.velocities.empty())
+          c.velocities.emplace_back(t.velocities[k].data(),
+                                    t.velocities[k].data() + t.velocities[k].size());
+      }
+      try {
+        CommandTrajectory(c, "plan", on_done);
+      } catch (const std::exception& e) {
+        if (on_done) on_done(TrajectoryOutcome::kInvalidGoal, e.what());
+      }
+    });
+  }
+  m->jobs_cv.notify_all();
+}
+
+CommandStats ServedRobot::GetCommandStats() const {
+  CommandStats s;
+  s.commands = impl_->commands;
+  s.mean_latency_steps =
+      s.commands > 0 ? static_cast<double>(impl_->latency_sum) / s.commands : 0.0;
+  s.max_latency_steps = impl_->max_latency;
+  return s;
+}
+
+JointStateReading ServedRobot::ReadJointStates() const {
+  JointStateReading r;
+  for (const Articulation& a : scene_->GetArticulations()) {
+    Eigen::VectorXd q = a.GetQpos(), qd = a.GetQvel(), f = a.GetQf();
+    std::vector<Joint> joints = a.GetActiveJoints();
+    for (size_t i = 0; i < joints.size(); ++i) {
+      r.names.push_back(joints[i].GetName());
+      r.position.push_back(q[i]);
+      r.velocity.push_back(qd[i]);
+      r.effort.push_back(f[i]);
+    }
+  }
+  return r;
+}
+
+std::vector<FrameReading> ServedRobot::ReadFrames() const {
+  std::vector<FrameReading> frames;
+  for (const Articulation& a : scene_->GetArticulations())
+    for (const Link& l : a.GetLinks()) frames.push_back({l.GetName(), l.GetPose()});
+  for (const CameraSensor& c : cameras_)
+    frames.push_back({c.frame, OpticalPose(c.camera.GetPose())});
+  return frames;
+}
+
+const Camera& ServedRobot::TakePicture(size_t i) {
+  Impl& m = *impl_;
+  const long long step = sim_->GetClockSteps();
+  if (m.pictured_at.at(i) == step) return cameras_[i].camera;
+  if (m.rendered_at != step) scene_->UpdateRender();  // this step's poses, once for all cameras
+  m.rendered_at = step;
+  cameras_[i].camera.TakePicture();
+  m.pictured_at[i] = step;
+  return cameras_[i].camera;
+}
+
+std::vector<uint8_t> CameraRgb8(const Camera& cam) {
+  const size_t n = static_cast<size_t>(cam.GetWidth()) * cam.GetHeight();
+  std::vector<uint8_t> rgba = cam.GetColorRGBA8(), rgb(n * 3);
+  for (size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) rgb[i * 3 + k] = rgba[i * 4 + k];
+  return rgb;
+}
+
+std::vector<float> CameraOpticalPoints(const Camera& cam) {
+  PointCloud pc = MakePointCloud(cam, PointCloudFrame::kCamera);
+  std::vector<float> xyz(pc.positions.size());
+  for (size_t i = 0; i < pc.Size(); ++i) {  // OpenGL camera frame to the optical frame
+    xyz[3 * i] = pc.positions[3 * i];
+    xyz[3 * i + 1] = -pc.positions[3 * i + 1];
+    xyz[3 * i + 2] = -pc.positions[3 * i + 2];
+  }
+  return xyz;
+}
+
+std::vector<double> CameraProjection(const Camera& cam) {
+  Eigen::Matrix3d K = cam.GetIntrinsicMatrix();
+  std::vector<double> p;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) p.push_back(K(r, c));
+    p.push_back(0.0);
+  }
+  return p;
+}
+
+}  // namespace partsim
