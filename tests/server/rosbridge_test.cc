@@ -60,6 +60,7 @@ class TestClient {
         ++counted_;
       } else if (topic.rfind("/tf\"", 0) == 0) {
         ++tf_count_;
+        if (keep_tf_) messages_.push_back(json::parse(text, nullptr, false));
       } else if (topic.rfind("/clock\"", 0) == 0) {
         json j = json::parse(text, nullptr, false);
         last_clock_ = j["msg"]["clock"]["secs"].get<double>() +
@@ -129,6 +130,8 @@ class TestClient {
   }
   /// Keep /joint_states messages (set before subscribing).
   void KeepJointStates() { keep_joint_states_ = true; }
+  /// Keep /tf messages (set before subscribing).
+  void KeepTf() { keep_tf_ = true; }
   bool Closed() const { return closed_; }
   int CloseCode() const { return close_code_; }
 
@@ -143,6 +146,7 @@ class TestClient {
   std::string count_topic_;
   long long counted_ = 0;
   std::atomic<bool> keep_joint_states_{false};
+  std::atomic<bool> keep_tf_{false};
   std::atomic<bool> open_{false}, closed_{false};
   std::atomic<int> close_code_{0};
 };
@@ -350,6 +354,143 @@ TEST_F(RosbridgeTest, PositionCommandMovesTheRobotWithinAStep) {
   RosbridgeStats s = bridge_->GetStats();
   EXPECT_EQ(s.commands, 1);
   EXPECT_LE(s.max_latency_steps, 1);  // applied before the next step
+}
+
+/// Index of `joint` in a list of names (-1 if absent).
+int IndexOf(const json& names, const std::string& joint) {
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == joint) return static_cast<int>(i);
+  return -1;
+}
+
+double Seconds(const json& duration) {
+  return duration["secs"].get<double>() + 1e-9 * duration["nsecs"].get<double>();
+}
+
+TEST_F(RosbridgeTest, PlanServiceAnswersWithTheTrajectoryAndTheRobotReachesTheGoal) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.KeepJointStates();
+  c.Send(json{{"op", "subscribe"}, {"topic", "/joint_states"}, {"queue_length", 1}});
+  json first = c.WaitMessage([](const json& m) { return m.value("topic", "") == "/joint_states"; });
+  ASSERT_FALSE(first.is_null());
+  const json names = first["msg"]["name"];
+  const int x = IndexOf(names, "x");
+  ASSERT_GE(x, 0);
+  std::vector<double> start = first["msg"]["position"].get<std::vector<double>>();
+  std::vector<double> goal = start;
+  goal[x] += 0.2;  // m
+  c.Send(json{{"op", "call_service"},
+              {"service", "/" + robot_.GetName() + "/plan"},
+              {"args", {{"joint_goal", goal}, {"time_limit", 2.0}}},
+              {"id", "plan1"}});
+  json r = c.WaitMessage([](const json& m) { return m.value("id", "") == "plan1"; });
+  ASSERT_FALSE(r.is_null());
+  ASSERT_EQ(r["op"], "service_response") << r.dump();
+  EXPECT_TRUE(r["result"].get<bool>());
+  const json& v = r["values"];
+  ASSERT_TRUE(v["success"].get<bool>()) << v["message"];
+  EXPECT_EQ(v["message"], "");
+  EXPECT_GE(v["planning_time"].get<double>(), 0.0);
+  EXPECT_EQ(v["trajectory"]["joint_names"], names);
+  const json& points = v["trajectory"]["points"];
+  ASSERT_GE(points.size(), 2u);
+  for (size_t i = 0; i < goal.size(); ++i) {
+    EXPECT_NEAR(points.front()["positions"][i].get<double>(), start[i], 1e-2) << i;
+    EXPECT_NEAR(points.back()["positions"][i].get<double>(), goal[i], 1e-6) << i;
+  }
+  EXPECT_EQ(Seconds(points.front()["time_from_start"]), 0.0);
+  EXPECT_GT(Seconds(points.back()["time_from_start"]), 0.0);
+  // executed: the joint states arrive at the goal
+  json reached = c.WaitMessage([&](const json& m) {
+    return m.value("topic", "") == "/joint_states" &&
+           std::abs(m["msg"]["position"][x].get<double>() - goal[x]) < 1e-2;
+  });
+  EXPECT_FALSE(reached.is_null());
+}
+
+TEST_F(RosbridgeTest, PlanServiceRefusesBadArgsNamingTheProblem) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  const std::string plan = "/" + robot_.GetName() + "/plan";
+  const size_t n = robot_.Dof();
+  const std::vector<double> here(n, 0.0);
+  const json position = {{"x", 0.2}, {"y", 0.0}, {"z", 0.5}};
+  const std::vector<std::pair<json, std::string>> cases = {
+      {json::object(), "joint_goal"},
+      {{{"joint_goal", {0.1, 0.2}}}, "2 values for " + std::to_string(n) + " joints"},
+      {{{"joint_goal", {0.1, "a"}}}, "joint_goal holds a value that is not a number"},
+      {{{"joint_goal", here}, {"execute", "yes"}}, "execute must be a boolean"},
+      {{{"joint_goal", here}, {"time_limit", "long"}}, "time_limit must be a number"},
+      {{{"joint_goal", here}, {"time_limit", -1.0}}, "time_limit"},
+      {{{"joint_goal", here}, {"algorithm", "Nope"}}, "algorithm"},
+      {{{"pose_goal", {{"position", position}}}}, "orientation"},
+      {{{"pose_goal",
+         {{"position", position},
+          {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", 0.0}, {"w", 2.0}}}}}},
+       "unit quaternion"},
+      {{{"pose_goal",
+         {{"position", {{"x", 0.2}, {"y", "a"}, {"z", 0.5}}},
+          {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", 0.0}, {"w", 1.0}}}}}},
+       "'y'"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i)
+    c.Send(json{{"op", "call_service"},
+                {"service", plan},
+                {"args", cases[i].first},
+                {"id", "bad" + std::to_string(i)}});
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const std::string id = "bad" + std::to_string(i);
+    json e = c.WaitMessage([&](const json& m) { return m.value("id", "") == id; });
+    ASSERT_FALSE(e.is_null()) << id;
+    EXPECT_TRUE(IsError(e)) << e.dump();
+    const std::string msg = e.value("msg", "");
+    EXPECT_NE(msg.find(cases[i].second), std::string::npos)
+        << cases[i].first.dump() << ": \"" << msg << "\" does not name \"" << cases[i].second
+        << "\"";
+  }
+  // a good request still plans; the bad ones never get an answer
+  std::vector<double> goal(n, 0.0);
+  goal[0] = 0.1;
+  c.Send(json{{"op", "call_service"},
+              {"service", plan},
+              {"args", {{"joint_goal", goal}, {"execute", false}}},
+              {"id", "good"}});
+  json good = c.WaitMessage([](const json& m) {
+    return m.value("id", "") == "good" && m.value("op", "") == "service_response";
+  });
+  ASSERT_FALSE(good.is_null());
+  EXPECT_TRUE(good["values"]["success"].get<bool>()) << good["values"]["message"];
+  for (const json& m : c.Messages())
+    EXPECT_FALSE(m.value("op", "") == "service_response" && m.value("id", "").rfind("bad", 0) == 0)
+        << m.dump();
+}
+
+TEST_F(RosbridgeTest, EffortCommandIsAcceptedAndAWrongLengthIsRefused) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  const std::string topic = "/" + robot_.GetName() + "/joint_effort_controller/command";
+  std::vector<double> effort(robot_.Dof(), 0.0);
+  c.Send(json{{"op", "publish"}, {"topic", topic}, {"msg", {{"data", effort}}}, {"id", "e1"}});
+  c.Send(json{{"op", "publish"}, {"topic", topic}, {"msg", {{"data", {1.0, 2.0}}}}, {"id", "e2"}});
+  c.Send(json{{"op", "publish"}, {"topic", topic}, {"msg", {{"data", "a"}}}, {"id", "e3"}});
+  c.Send(json{{"op", "publish"}, {"topic", topic}, {"msg", json::object()}, {"id", "e4"}});
+  json e2 = c.WaitMessage([](const json& m) { return m.value("id", "") == "e2"; });
+  ASSERT_TRUE(IsError(e2)) << e2.dump();
+  EXPECT_NE(e2["msg"].get<std::string>().find(topic + ": 2 values for " +
+                                              std::to_string(robot_.Dof()) + " joints"),
+            std::string::npos)
+      << e2["msg"];
+  json e3 = c.WaitMessage([](const json& m) { return m.value("id", "") == "e3"; });
+  EXPECT_TRUE(IsError(e3)) << e3.dump();
+  json e4 = c.WaitMessage([](const json& m) { return m.value("id", "") == "e4"; });
+  ASSERT_TRUE(IsError(e4)) << e4.dump();
+  EXPECT_NE(e4["msg"].get<std::string>().find("'data'"), std::string::npos) << e4["msg"];
+  // the good one was applied (and only that one), without an error
+  EXPECT_TRUE(WaitFor([&] { return bridge_->GetStats().commands == 1; }));
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(bridge_->GetStats().commands, 1);
+  for (const json& m : c.Messages()) EXPECT_NE(m.value("id", ""), "e1") << m.dump();
 }
 
 TEST_F(RosbridgeTest, HugeMessageIsRejectedAndServerStaysUp) {
@@ -580,6 +721,55 @@ TEST_F(RosbridgeSensorTest, PublishingToSensorTopicsIsRefusedAndNothingComesUnas
   EXPECT_TRUE(IsError(err));
   std::this_thread::sleep_for(300ms);
   for (const json& m : c.Messages()) EXPECT_NE(m.value("op", ""), "publish");
+}
+
+/// The /tf transform of `child` in the first /tf message that `c` kept (null if none).
+json TfTransform(TestClient& c, const std::string& child) {
+  json found;
+  c.WaitMessage([&](const json& m) {
+    if (m.value("topic", "") != "/tf") return false;
+    for (const json& t : m["msg"]["transforms"])
+      if (t["child_frame_id"] == child) found = t;
+    return true;
+  });
+  return found;
+}
+
+TEST_F(RosbridgeSensorTest, TfHoldsTheCameraOpticalFrameAndEveryLink) {
+  Start(32, 24, 10);
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.KeepTf();
+  c.Send(json{{"op", "subscribe"}, {"topic", "/tf"}});
+  json t = TfTransform(c, "cam_optical_frame");
+  ASSERT_FALSE(t.is_null());
+  EXPECT_EQ(t["header"]["frame_id"], "world");
+  const json& p = t["transform"]["translation"];
+  EXPECT_NEAR(p["x"].get<double>(), 1.2, 1e-9);
+  EXPECT_NEAR(p["y"].get<double>(), -0.8, 1e-9);
+  EXPECT_NEAR(p["z"].get<double>(), 1.0, 1e-9);
+  for (const Link& l : robot_.GetLinks()) EXPECT_FALSE(TfTransform(c, l.GetName()).is_null());
+}
+
+// DISABLED: the optical frame on /tf has the wrong orientation (z points down in the image, not
+// forward); see ServedRobotTest.DISABLED_CameraOpticalFrameLooksAlongTheViewWithYDown and
+// OpticalPose in src/server/served_robot.cc.
+TEST_F(RosbridgeSensorTest, DISABLED_TfCameraOpticalFrameLooksAlongTheViewWithYDown) {
+  Start(32, 24, 10);
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.KeepTf();
+  c.Send(json{{"op", "subscribe"}, {"topic", "/tf"}});
+  json t = TfTransform(c, "cam_optical_frame");
+  ASSERT_FALSE(t.is_null());
+  const json& q = t["transform"]["rotation"];
+  const Eigen::Quaterniond rot(q["w"].get<double>(), q["x"].get<double>(), q["y"].get<double>(),
+                               q["z"].get<double>());
+  const Eigen::Vector3d eye(1.2, -0.8, 1.0), target(0, 0, 0.4);
+  const Eigen::Vector3d z = rot * Eigen::Vector3d::UnitZ(), y = rot * Eigen::Vector3d::UnitY();
+  EXPECT_LT((z - (target - eye).normalized()).norm(), 1e-6) << z.transpose();
+  const Eigen::Vector3d up = CameraLookAt(eye, target).q * Eigen::Vector3d::UnitZ();
+  EXPECT_LT((y + up).norm(), 1e-6) << y.transpose();
 }
 
 /// Images per second at 640x480 delivered to one client, cameras rendered every step
