@@ -14,6 +14,21 @@ PACKAGES=(
   libbullet-extras-dev libjpeg-dev libompl-dev
   libwebsocketpp-dev libboost-dev
 )
+# native ROS 1 (optional build; PARTSIM_NO_ROS1=1 leaves it out): roscpp, actionlib, the message
+# packages with their definitions and Debian's message generators; rospy, rostopic and
+# rosmaster for the tests
+if [ "${PARTSIM_NO_ROS1:-0}" != "1" ]; then
+  PACKAGES+=(
+    libroscpp-dev libactionlib-dev libactionlib-msgs-dev libstd-msgs-dev libstd-srvs-dev
+    libsensor-msgs-dev libtrajectory-msgs-dev libgeometry-msgs-dev libtf2-msgs-dev
+    libros-rosgraph-msgs-dev ros-message-generation python3-genmsg python3-gencpp python3-genpy
+    ros-std-msgs ros-std-srvs ros-sensor-msgs ros-trajectory-msgs ros-geometry-msgs
+    ros-actionlib-msgs
+    python3-rospy python3-rostopic python3-actionlib python3-rosmaster python3-std-msgs
+    python3-std-srvs python3-sensor-msgs python3-trajectory-msgs python3-geometry-msgs
+    python3-rosgraph-msgs python3-tf2-msgs python3-actionlib-msgs
+  )
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -279,7 +279,9 @@ ServedRobot::ServedRobot(SimServer* sim, Scene* scene, ControlLoop* loop, const 
   m.worker = std::thread([this] { impl_->WorkerLoop(); });
 }
 
-ServedRobot::~ServedRobot() {
+ServedRobot::~ServedRobot() { Close(); }
+
+void ServedRobot::Close() {
   {
     std::lock_guard<std::mutex> lock(impl_->jobs_mutex);
     impl_->stopping = true;
@@ -329,8 +331,7 @@ void ServedRobot::CommandEfforts(const std::vector<double>& values, const std::s
       std::move(on_error));
 }
 
-long long ServedRobot::CommandTrajectory(const TrajectoryCommand& c, const std::string& what,
-                                         DoneCallback on_done, FeedbackCallback on_feedback) {
+void ServedRobot::CheckTrajectory(const TrajectoryCommand& c, const std::string& what) const {
   Impl* m = impl_.get();
   const std::vector<int> index = m->Indices(c.joint_names, what);
   if (index.empty()) throw Error(what + ": no joint_names");
@@ -351,6 +352,15 @@ long long ServedRobot::CommandTrajectory(const TrajectoryCommand& c, const std::
   }
   if (!(c.goal_time_tolerance >= 0) || !std::isfinite(c.goal_time_tolerance))
     throw Error(what + ": goal_time_tolerance must be finite and >= 0");
+  m->Tolerances(c.path_tolerance, 0.0, what);
+  m->Tolerances(c.goal_tolerance, 0.0, what);
+}
+
+long long ServedRobot::CommandTrajectory(const TrajectoryCommand& c, const std::string& what,
+                                         DoneCallback on_done, FeedbackCallback on_feedback) {
+  CheckTrajectory(c, what);
+  Impl* m = impl_.get();
+  const std::vector<int> index = m->Indices(c.joint_names, what);
   auto g = std::make_shared<Impl::Goal>();
   g->id = m->next_goal++;
   g->done = std::move(on_done);
@@ -431,6 +441,7 @@ void ServedRobot::Plan(const PlanRequest& request, PlanCallback on_result, DoneC
         "RRTConnect, RRT, RRTstar, PRM or KPIECE1");
   {
     std::lock_guard<std::mutex> lock(m->jobs_mutex);
+    if (m->stopping) throw Error("plan: the server is shutting down");
     m->jobs.push_back([this, m, request, opt, on_result, on_done] {
       PlanResult r;
       try {

@@ -15,6 +15,7 @@
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/robot/robots.h"
+#include "partsim/server/ros1_bridge.h"
 #include "partsim/server/rosbridge.h"
 #include "partsim/server/served_robot.h"
 #include "partsim/server/sim_server.h"
@@ -25,7 +26,7 @@ namespace {
 constexpr char kServeUsage[] = R"(usage:
   partsim serve [SCENE.urdf] [--port P] [--rate R | --realtime-factor F | --fast]
                 [--robot gripper|panda] [--address A] [--duration S] [--camera WxH]
-                [--camera-rate HZ]
+                [--camera-rate HZ] [--ros1 [--ros1-wall-time]]
 
 Steps a scene on its own thread and serves it over the rosbridge v2 protocol (JSON over
 WebSocket): /clock, /joint_states and /tf out; /<robot>/joint_position_controller/command,
@@ -36,6 +37,12 @@ Sensors, read only while a client subscribes: /front_camera/image_raw (sensor_ms
 rgb8), /front_camera/camera_info, /front_camera/points (sensor_msgs/PointCloud2, x y z
 float32) from a camera looking at the robot and the object from the -y side, and /imu
 (sensor_msgs/Imu) on the robot's end-effector link at the physics rate.
+Motion planning: the /<robot>/plan service ({joint_goal: [..]} or {pose_goal: geometry_msgs/Pose},
+execute, time_limit) plans a collision-free path (OMPL) and runs it.
+With --ros1 (when partsim is built with ROS 1) a roscpp node serves the same topics and
+services to ROS 1 nodes, plus the action
+/<robot>/joint_trajectory_controller/follow_joint_trajectory (control_msgs); the master is
+ROS_MASTER_URI's, and /use_sim_time is set to true unless --ros1-wall-time.
 With no SCENE, a built-in cabinet stands in front of the robot.
   --port P               WebSocket port (default 9090; 0 picks a free one, printed on start)
   --rate R               physics rate in Hz (default 500), stepped in real time
@@ -46,6 +53,8 @@ With no SCENE, a built-in cabinet stands in front of the robot.
   --duration S           stop after S wall-clock seconds (default: run until SIGINT/SIGTERM)
   --camera WxH           image size of /front_camera (default 640x480)
   --camera-rate HZ       camera topics per simulated second (default 10; 0: every step)
+  --ros1                 also serve over native ROS 1 (needs a ROS master)
+  --ros1-wall-time       with --ros1: leave /use_sim_time alone
 )";
 
 struct ServeUsageError : std::runtime_error {
@@ -70,7 +79,7 @@ int RunServeCommand(int argc, char** argv) {
   std::string scene_file, robot_kind = "panda", address = "127.0.0.1";
   int port = 9090;
   double rate = 500, factor = 1, duration = 0;
-  bool fast = false;
+  bool fast = false, ros1 = false, ros1_sim_time = true;
   int cam_w = 640, cam_h = 480;
   double camera_rate = 10;
   try {
@@ -108,6 +117,10 @@ int RunServeCommand(int argc, char** argv) {
         cam_h = h;
       } else if (a == "--camera-rate") {
         camera_rate = ParsePositive(a, value(), true);
+      } else if (a == "--ros1") {
+        ros1 = true;
+      } else if (a == "--ros1-wall-time") {
+        ros1_sim_time = false;
       } else if (a == "--address") {
         address = value();
       } else if (a == "--robot") {
@@ -127,6 +140,15 @@ int RunServeCommand(int argc, char** argv) {
     std::fprintf(stderr, "%s\n%s", e.what(), kServeUsage);
     return 2;
   }
+#ifndef PARTSIM_WITH_ROS1
+  if (ros1) {
+    std::fprintf(stderr,
+                 "partsim serve: --ros1: this partsim was built without ROS 1 (install Debian's "
+                 "libroscpp-dev, libactionlib-dev and the ROS message packages that "
+                 "scripts/setup.sh lists, then rebuild)\n");
+    return 2;
+  }
+#endif
 
   try {
     // the scene: the given URDF or the built-in cabinet, then the robot
@@ -174,11 +196,21 @@ int RunServeCommand(int argc, char** argv) {
     ro.port = port;
     RosbridgeServer bridge(&served, ro);
     bridge.Start();
+#ifdef PARTSIM_WITH_ROS1
+    std::unique_ptr<Ros1Bridge> ros1_bridge;
+    if (ros1) {
+      Ros1Options o;
+      o.use_sim_time = ros1_sim_time;
+      ros1_bridge = std::make_unique<Ros1Bridge>(&served, o);
+      ros1_bridge->Start();
+    }
+#endif
     sim.Start();
     std::printf(
-        "partsim serve: rosbridge on ws://%s:%d, robot /%s (%d joints), %g Hz physics, %s\n",
+        "partsim serve: rosbridge on ws://%s:%d, robot /%s (%d joints), %g Hz physics, %s%s\n",
         address.c_str(), bridge.GetPort(), robot.GetName().c_str(), robot.Dof(), rate,
-        fast ? "as fast as possible" : ("real-time factor " + std::to_string(factor)).c_str());
+        fast ? "as fast as possible" : ("real-time factor " + std::to_string(factor)).c_str(),
+        ros1 ? ", ROS 1 node /partsim" : "");
     std::fflush(stdout);
 
     std::signal(SIGINT, OnSignal);
@@ -191,7 +223,11 @@ int RunServeCommand(int argc, char** argv) {
         break;
     }
     sim.Stop();
+    served.Close();
     bridge.Stop();
+#ifdef PARTSIM_WITH_ROS1
+    if (ros1_bridge) ros1_bridge->Stop();
+#endif
     RosbridgeStats s = bridge.GetStats();
     std::printf(
         "partsim serve: stopped after %lld steps (%.3f s simulated); %lld messages sent, %lld "

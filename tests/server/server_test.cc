@@ -4,9 +4,6 @@
 // installs roslib and ws into build/node (or PARTSIM_NODE_DIR); without node or that folder the
 // test is skipped.
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -17,65 +14,13 @@
 #ifndef PARTSIM_CLI_PATH
 #error "PARTSIM_CLI_PATH must name the partsim executable"
 #endif
+#include "server/process_util.h"
 
 namespace partsim {
 namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-
-/// `partsim serve` in a child process; its first output line names the port.
-class ServeProcess {
- public:
-  explicit ServeProcess(const std::string& args) {
-    int fds[2];
-    if (::pipe(fds) != 0) return;
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(fds[1], 1);
-      ::close(fds[0]);
-      ::close(fds[1]);
-      std::string cmd = std::string("exec '") + PARTSIM_CLI_PATH + "' serve " + args;
-      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-      ::_exit(127);
-    }
-    ::close(fds[1]);
-    out_ = ::fdopen(fds[0], "r");
-    char line[512];
-    if (out_ && std::fgets(line, sizeof(line), out_)) first_line_ = line;
-    size_t at = first_line_.find("127.0.0.1:");
-    if (at != std::string::npos) port_ = std::atoi(first_line_.c_str() + at + 10);
-  }
-  ~ServeProcess() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
-      int status = 0;
-      ::waitpid(pid_, &status, 0);
-    }
-    if (out_) std::fclose(out_);
-  }
-  int Port() const { return port_; }
-  const std::string& FirstLine() const { return first_line_; }
-
- private:
-  pid_t pid_ = -1;
-  FILE* out_ = nullptr;
-  std::string first_line_;
-  int port_ = 0;
-};
-
-/// Runs a shell command; returns its standard output and sets `code`.
-std::string RunShell(const std::string& cmd, int* code) {
-  std::string out;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return out;
-  char buf[4096];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof(buf), p)) > 0) out.append(buf, n);
-  int status = ::pclose(p);
-  *code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
 
 TEST(ServeTest, RoslibClientListsTopicsReceivesStatesAndDrivesATrajectory) {
   int code = 0;

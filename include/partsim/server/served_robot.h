@@ -135,6 +135,9 @@ class ServedRobot {
                          ErrorSink on_error = {});
   void CommandEfforts(const std::vector<double>& values, const std::string& what,
                       ErrorSink on_error = {});
+  /// Throws partsim::Error naming `what` and the fault if `command` is malformed (unknown or
+  /// repeated joints, counts that do not match, non-finite values, times not increasing).
+  void CheckTrajectory(const TrajectoryCommand& command, const std::string& what) const;
   /// Starts a trajectory (replacing any running goal, whose `on_done` reports kPreempted).
   /// Throws for malformed input; a well-formed goal the controller refuses (a waypoint outside
   /// the joint limits) ends through `on_done` with kInvalidGoal. `on_feedback` runs on the
@@ -148,6 +151,10 @@ class ServedRobot {
   /// trajectory as a goal. `on_result` runs on the worker thread. Throws for a malformed
   /// request (wrong number of joints, non-finite values, bad options).
   void Plan(const PlanRequest& request, PlanCallback on_result, DoneCallback on_done = {});
+  /// Stops the planning worker: a plan in progress finishes (its callbacks run), plans not yet
+  /// started are dropped. Call after stopping the SimServer and before destroying the
+  /// front-ends whose callbacks plans hold. Idempotent; the destructor calls it.
+  void Close();
   CommandStats GetCommandStats() const;
 
   // ---- readings (simulation thread: from step callbacks or posted commands) ----
