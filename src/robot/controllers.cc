@@ -158,8 +158,11 @@ JointEffortController::JointEffortController(const Articulation& robot,
                                              const JointControllerOptions& options)
     : Controller(robot, joints, options) {
   name_ = "JointEffortController of '" + robot.GetName() + "'";
-  // the drives must not fight the efforts
-  SetGains(robot_, joint_names_, 0.0, 0.0, kInf);
+  JointEffortController::ConfigureDrives();
+}
+
+void JointEffortController::ConfigureDrives() {
+  SetGains(robot_, joint_names_, 0.0, 0.0, kInf);  // the drives must not fight the efforts
 }
 
 void JointEffortController::SetTarget(const Eigen::VectorXd& effort) {
@@ -243,9 +246,13 @@ JointVelocityController::JointVelocityController(const Articulation& robot,
                                                  const JointControllerOptions& options)
     : Controller(robot, joints, options) {
   name_ = "JointVelocityController of '" + robot.GetName() + "'";
-  SetGains(robot_, joint_names_, 0.0, options_.damping, options_.force_limit);
+  JointVelocityController::ConfigureDrives();
   target_ = Eigen::VectorXd::Zero(NumJoints());
   SetTargets(robot_, joint_names_, GetQpos(), &target_);
+}
+
+void JointVelocityController::ConfigureDrives() {
+  SetGains(robot_, joint_names_, 0.0, options_.damping, options_.force_limit);
 }
 
 void JointVelocityController::SetTarget(const Eigen::VectorXd& qd) {
@@ -566,6 +573,10 @@ ControlLoop::ControlLoop(Scene* scene) : scene_(scene) {
   if (!scene) throw Error("ControlLoop: scene is null");
 }
 
+void Controller::ConfigureDrives() {
+  SetGains(robot_, joint_names_, options_.stiffness, options_.damping, options_.force_limit);
+}
+
 void ControlLoop::Add(std::shared_ptr<Controller> controller) {
   if (!controller) throw Error("ControlLoop::Add: controller is null");
   if (controller->GetRobot().GetScene() != scene_)
@@ -574,6 +585,7 @@ void ControlLoop::Add(std::shared_ptr<Controller> controller) {
   for (const Entry& e : entries_)
     if (e.controller == controller)
       throw Error("ControlLoop::Add: " + controller->GetName() + " was already added");
+  controller->ConfigureDrives();
   // its first update comes with the next step
   entries_.push_back({std::move(controller), step_count_});
 }

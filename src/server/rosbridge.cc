@@ -95,18 +95,59 @@ std::vector<double> Numbers(const json& a, const std::string& what) {
 }  // namespace
 
 struct RosbridgeServer::Impl {
-  struct Subscription {
+  /// One subscribe request.
+  struct Request {
     double throttle_ms = 0;
-    size_t queue_length = 0;  // 0: the server's bound
+    size_t queue_length = 0;   // 0: the server's bound
+    size_t fragment_size = 0;  // 0: whole messages
+    bool cbor = false;         // binary CBOR frames (uint8[] as byte strings) instead of JSON
+    long long order = 0;       // later requests choose the compression
+  };
+  /// A client's subscription to one topic: one message per publication, however many subscribe
+  /// requests (by id) it made; the most permissive settings of the requests apply.
+  struct Subscription : Request {
+    std::map<std::string, Request> requests;  // by subscribe id
     WallClock::time_point last_sent{};
+    void Merge() {
+      throttle_ms = 1e300;
+      queue_length = fragment_size = 0;
+      bool server_bound = false, all_fragment = true;
+      long long latest = -1;
+      for (const auto& [id, r] : requests) {
+        throttle_ms = std::min(throttle_ms, r.throttle_ms);
+        if (r.queue_length == 0) server_bound = true;  // the largest queue there is
+        queue_length = std::max(queue_length, r.queue_length);
+        all_fragment = all_fragment && r.fragment_size > 0;
+        fragment_size =
+            fragment_size == 0 ? r.fragment_size : std::min(fragment_size, r.fragment_size);
+        if (r.order > latest) {
+          latest = r.order;
+          cbor = r.cbor;
+        }
+      }
+      if (server_bound) queue_length = 0;
+      if (!all_fragment) fragment_size = 0;
+    }
+  };
+  struct Outgoing {
+    std::string data;
+    size_t bound;  // queue bound of its subscription
+    bool binary;
+  };
+  /// An incoming message arriving in fragments.
+  struct Partial {
+    std::vector<std::string> pieces;
+    std::vector<char> got;
+    size_t received = 0, bytes = 0;
   };
   struct Client {
     Hdl hdl;
     std::map<std::string, Subscription> subs;
     std::map<std::string, std::string> advertised;  // topic -> type
     std::set<std::string> services;                 // advertised by this client
+    std::map<std::string, Partial> partial;         // fragments by message id (network thread)
     std::mutex out_mutex;
-    std::deque<std::pair<std::string, size_t>> out;  // message, queue bound
+    std::deque<Outgoing> out;
     std::atomic<bool> flush_scheduled{false};
   };
   using ClientPtr = std::shared_ptr<Client>;
@@ -138,16 +179,18 @@ struct RosbridgeServer::Impl {
   };
   std::map<std::string, PendingCall> pending_calls;
   long long next_call = 0;
+  std::atomic<long long> next_fragment{0};
+  std::atomic<long long> next_request{0};
 
   std::atomic<long long> sent{0}, dropped{0}, errors{0};
 
   // ---- outgoing ----
   /// Queues a message for a client from any thread; drops the oldest beyond the bound.
-  void Enqueue(const ClientPtr& c, const std::string& msg, size_t bound) {
+  void Enqueue(const ClientPtr& c, const std::string& msg, size_t bound, bool binary = false) {
     if (bound == 0 || bound > options.max_client_queue) bound = options.max_client_queue;
     {
       std::lock_guard<std::mutex> lock(c->out_mutex);
-      c->out.emplace_back(msg, bound);
+      c->out.push_back({msg, bound, binary});
       while (c->out.size() > bound) {
         c->out.pop_front();
         ++dropped;
@@ -163,7 +206,7 @@ struct RosbridgeServer::Impl {
 
   /// Network thread: hands queued messages to the socket unless its queue is full.
   void Flush(const ClientPtr& c) {
-    std::deque<std::pair<std::string, size_t>> pending;
+    std::deque<Outgoing> pending;
     {
       std::lock_guard<std::mutex> lock(c->out_mutex);
       pending.swap(c->out);
@@ -177,7 +220,8 @@ struct RosbridgeServer::Impl {
         ++dropped;
         continue;
       }
-      ec = con->send(m.first, websocketpp::frame::opcode::text);
+      ec = con->send(
+          m.data, m.binary ? websocketpp::frame::opcode::binary : websocketpp::frame::opcode::text);
       if (ec) return;
       ++sent;
     }
@@ -279,10 +323,13 @@ struct RosbridgeServer::Impl {
       if (c->subs.count(topic)) return true;
     return false;
   }
-  /// Sends `make()` (built once) to the clients subscribed to `topic` that are not throttled.
+  /// Sends `make()` (built once, and encoded once per form: JSON text or CBOR) to the clients
+  /// subscribed to `topic` that are not throttled. uint8[] fields are json::binary values: base64
+  /// strings in JSON, byte strings in CBOR.
   void Publish(const std::string& topic, const std::function<json()>& make,
                WallClock::time_point now) {
-    std::string text;
+    json msg;
+    std::string text, cbor;
     std::lock_guard<std::mutex> lock(clients_mutex);
     for (auto& [h, c] : clients) {
       auto it = c->subs.find(topic);
@@ -291,10 +338,45 @@ struct RosbridgeServer::Impl {
       if (s.throttle_ms > 0 &&
           std::chrono::duration<double, std::milli>(now - s.last_sent).count() < s.throttle_ms)
         continue;
-      if (text.empty()) text = json{{"op", "publish"}, {"topic", topic}, {"msg", make()}}.dump();
+      if (msg.is_null()) msg = json{{"op", "publish"}, {"topic", topic}, {"msg", make()}};
       s.last_sent = now;
-      Enqueue(c, text, s.queue_length);
+      if (s.cbor) {
+        if (cbor.empty()) {
+          std::vector<uint8_t> bytes = json::to_cbor(msg);
+          cbor.assign(bytes.begin(), bytes.end());
+        }
+        Enqueue(c, cbor, s.queue_length, true);
+        continue;
+      }
+      if (text.empty()) text = TextForm(msg).dump();
+      if (s.fragment_size > 0 && text.size() > s.fragment_size)
+        EnqueueFragments(c, text, s);
+      else
+        Enqueue(c, text, s.queue_length);
     }
+  }
+  /// The message for JSON clients: binary fields become base64 strings.
+  static json TextForm(json j) {
+    if (j.is_binary()) return Base64(j.get_binary().data(), j.get_binary().size());
+    if (j.is_object() || j.is_array())
+      for (auto& v : j) v = TextForm(std::move(v));
+    return j;
+  }
+  /// rosbridge fragments: pieces of at most fragment_size characters of the JSON text.
+  void EnqueueFragments(const ClientPtr& c, const std::string& text, const Subscription& s) {
+    const size_t n = (text.size() + s.fragment_size - 1) / s.fragment_size;
+    const std::string id = "partsim_fragment_" + std::to_string(next_fragment++);
+    // the bound counts whole messages: all pieces of one message fit together
+    const size_t bound = (s.queue_length ? s.queue_length : options.max_client_queue) * n;
+    for (size_t i = 0; i < n; ++i)
+      Enqueue(c,
+              json{{"op", "fragment"},
+                   {"id", id},
+                   {"data", text.substr(i * s.fragment_size, s.fragment_size)},
+                   {"num", i},
+                   {"total", n}}
+                  .dump(),
+              bound);
   }
   static json Header(double t, const std::string& frame) {
     return {{"seq", 0}, {"stamp", Stamp(t)}, {"frame_id", frame}};
@@ -308,7 +390,7 @@ struct RosbridgeServer::Impl {
             {"encoding", "rgb8"},
             {"is_bigendian", 0},
             {"step", w * 3},
-            {"data", Base64(rgb.data(), rgb.size())}};
+            {"data", json::binary(std::move(rgb))}};
   }
   static json CameraInfoMsg(const Camera& cam, double t, const std::string& frame) {
     std::vector<double> p = CameraProjection(cam);
@@ -343,7 +425,9 @@ struct RosbridgeServer::Impl {
             {"is_bigendian", false},
             {"point_step", 12},
             {"row_step", 12 * n},
-            {"data", Base64(reinterpret_cast<const uint8_t*>(xyz.data()), xyz.size() * 4)},
+            {"data", json::binary(std::vector<uint8_t>(
+                         reinterpret_cast<const uint8_t*>(xyz.data()),
+                         reinterpret_cast<const uint8_t*>(xyz.data()) + xyz.size() * 4))},
             {"is_dense", true}};
   }
   json ImuMsg(double t) const {
@@ -615,14 +699,28 @@ struct RosbridgeServer::Impl {
       if (it == clients.end()) return;
       c = it->second;
     }
+    HandleText(c, m->get_payload());
+  }
+
+  /// One whole message (or one fragment of one) from a client.
+  void HandleText(const ClientPtr& c, const std::string& payload) {
     json j;
     try {
-      j = json::parse(m->get_payload());
+      j = json::parse(payload);
     } catch (const std::exception& e) {
       Status(c, "error", std::string("malformed JSON: ") + e.what());
       return;
     }
     json id = j.is_object() && j.contains("id") ? j["id"] : json();
+    if (j.is_object() && j.value("op", "") == "fragment") {
+      try {
+        std::string whole;
+        if (Reassemble(c, j, &whole)) HandleText(c, whole);
+      } catch (const std::exception& e) {
+        Status(c, "error", e.what(), id);
+      }
+      return;
+    }
     try {
       if (!j.is_object() || !j.contains("op") || !j["op"].is_string())
         throw Error("message has no 'op' string");
@@ -630,6 +728,46 @@ struct RosbridgeServer::Impl {
     } catch (const std::exception& e) {
       Status(c, "error", e.what(), id);
     }
+  }
+
+  /// Adds a fragment {id, data, num, total}; true with the whole text once all have come.
+  bool Reassemble(const ClientPtr& c, const json& j, std::string* whole) {
+    if (!j.contains("id") || !(j["id"].is_string() || j["id"].is_number()))
+      throw Error("fragment needs an 'id'");
+    if (!j.contains("data") || !j["data"].is_string()) throw Error("fragment needs string 'data'");
+    if (!j.contains("num") || !j["num"].is_number_unsigned() || !j.contains("total") ||
+        !j["total"].is_number_unsigned() || j["total"].get<size_t>() == 0 ||
+        j["num"].get<size_t>() >= j["total"].get<size_t>())
+      throw Error("fragment needs integers 0 <= num < total");
+    const std::string key = j["id"].is_string() ? j["id"].get<std::string>() : j["id"].dump();
+    const size_t total = j["total"].get<size_t>(), num = j["num"].get<size_t>();
+    if (total > options.max_message_bytes) throw Error("fragment: total is too large");
+    auto it = c->partial.find(key);
+    if (it == c->partial.end()) {
+      if (c->partial.size() >= 16) throw Error("fragment: too many messages in pieces at once");
+      it = c->partial.emplace(key, Partial()).first;
+      it->second.pieces.resize(total);
+      it->second.got.assign(total, 0);
+    }
+    Partial& p = it->second;
+    if (p.pieces.size() != total) {
+      c->partial.erase(it);
+      throw Error("fragment '" + key + "': total changed between pieces");
+    }
+    if (!p.got[num]) ++p.received;
+    p.got[num] = 1;
+    p.bytes = p.bytes - p.pieces[num].size() + j["data"].get_ref<const std::string&>().size();
+    p.pieces[num] = j["data"].get<std::string>();
+    if (p.bytes > options.max_message_bytes) {
+      c->partial.erase(it);
+      throw Error("fragment '" + key + "': the message exceeds " +
+                  std::to_string(options.max_message_bytes) + " bytes");
+    }
+    if (p.received < total) return false;
+    whole->clear();
+    for (const std::string& piece : p.pieces) *whole += piece;
+    c->partial.erase(it);
+    return true;
   }
 
   static std::string Str(const json& j, const char* key, const std::string& op) {
@@ -656,18 +794,45 @@ struct RosbridgeServer::Impl {
           throw Error("subscribe " + topic + ": type is " + it->second + ", not " +
                       j["type"].get<std::string>());
       }
-      Subscription s;
+      Request s;
+      s.order = next_request++;
       if (j.contains("throttle_rate") && j["throttle_rate"].is_number())
         s.throttle_ms = j["throttle_rate"].get<double>();
       if (j.contains("queue_length") && j["queue_length"].is_number_integer() &&
           j["queue_length"].get<long long>() > 0)
         s.queue_length = static_cast<size_t>(j["queue_length"].get<long long>());
+      if (j.contains("fragment_size") && j["fragment_size"].is_number_integer() &&
+          j["fragment_size"].get<long long>() > 0)
+        s.fragment_size = static_cast<size_t>(j["fragment_size"].get<long long>());
+      if (j.contains("compression") && j["compression"].is_string()) {
+        const std::string comp = j["compression"].get<std::string>();
+        if (comp == "cbor")
+          s.cbor = true;
+        else if (comp != "none" && comp != "")
+          throw Error("subscribe " + topic + ": compression '" + comp +
+                      "' is not supported (none, cbor)");
+      }
+      const std::string sub_id = id.is_null()     ? ""
+                                 : id.is_string() ? id.get<std::string>()
+                                                  : id.dump();
       std::lock_guard<std::mutex> lock(clients_mutex);
-      c->subs[topic] = s;
+      Subscription& sub = c->subs[topic];
+      sub.requests[sub_id] = s;
+      sub.Merge();
     } else if (op == "unsubscribe") {
+      // with an id: that subscribe request only; without: the whole topic
       std::string topic = Name(j, "topic", op);
       std::lock_guard<std::mutex> lock(clients_mutex);
-      c->subs.erase(topic);
+      auto it = c->subs.find(topic);
+      if (it == c->subs.end()) return;
+      if (!id.is_null()) {
+        it->second.requests.erase(id.is_string() ? id.get<std::string>() : id.dump());
+        if (!it->second.requests.empty()) {
+          it->second.Merge();
+          return;
+        }
+      }
+      c->subs.erase(it);
     } else if (op == "advertise") {
       std::string topic = Name(j, "topic", op), type = Str(j, "type", op);
       auto it = sim_topics.find(topic);

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "partsim/core/error.h"
+#include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
 
 namespace partsim {
@@ -29,10 +30,10 @@ Eigen::VectorXd ToVector(const std::vector<double>& v) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
 }
 
-/// The optical frame of a camera whose pose follows the OpenGL convention (looking down -z,
-/// y up): turned half a turn about x.
+/// The optical frame (x right, y down, z forward) of a camera posed in partsim's convention
+/// (x forward, y left, z up).
 Pose OpticalPose(const Pose& camera) {
-  return camera * Pose(Eigen::Vector3d::Zero(), Eigen::Quaterniond(0, 1, 0, 0));
+  return camera * Pose(Eigen::Vector3d::Zero(), Eigen::Quaterniond(RotationCameraToCv()));
 }
 
 }  // namespace
@@ -49,6 +50,7 @@ struct ServedRobot::Impl {
   std::shared_ptr<JointTrajectoryController> trajectory;
   std::shared_ptr<Controller> active;  // simulation thread only
   double default_path_tolerance = 0.1;
+  Eigen::MatrixX2d limits;  ///< per commanded joint: (lower, upper)
 
   // the running trajectory goal (simulation thread only)
   struct Goal {
@@ -261,6 +263,7 @@ ServedRobot::ServedRobot(SimServer* sim, Scene* scene, ControlLoop* loop, const 
   m.effort = std::make_shared<JointEffortController>(robot, std::vector<std::string>{}, co);
   m.trajectory = std::make_shared<JointTrajectoryController>(robot, std::vector<std::string>{}, co);
   m.default_path_tolerance = m.trajectory->path_tolerance;
+  m.limits = robot.GetQlimits();  // active joints, in the controllers' order
   m.Activate(m.position);
 
   const std::vector<Link> links = robot.GetLinks();
@@ -372,8 +375,11 @@ long long ServedRobot::CommandTrajectory(const TrajectoryCommand& c, const std::
       c.goal_time_tolerance > 0 ? c.goal_time_tolerance : m->trajectory->GetOptions().timeout;
   m->Post(
       [m, c, index, g] {
-        // joints not named hold where they are; a first point after 0 starts from here
-        Eigen::VectorXd here = m->trajectory->GetQpos();
+        // joints not named hold where they are; a first point after 0 starts from here. A joint
+        // a hair outside its limits (contacts, soft limits) is held at the limit, or the
+        // controller would refuse the waypoint.
+        Eigen::VectorXd here =
+            m->trajectory->GetQpos().cwiseMax(m->limits.col(0)).cwiseMin(m->limits.col(1));
         JointTrajectory traj;
         const bool vel = !c.velocities.empty();
         if (c.times.front() > 1e-9) {

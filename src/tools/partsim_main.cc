@@ -45,7 +45,7 @@ usage:
   partsim render [FILE.urdf] --out DIR [options]
   partsim assets generate --out DIR [options]   (see partsim assets --help)
   partsim tasks demo|evaluate [options]         (see partsim tasks --help)
-  partsim serve [SCENE.urdf] [options]          (see partsim serve --help)
+  partsim serve [SCENE] [options]               (see partsim serve --help)
   partsim --help | --version
 
 info       prints the links (name, parent, mass), the joints (name, type, parent -> child,

@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "partsim/assets/default_objects.h"
+#include "partsim/assets/scene_file.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
@@ -24,7 +25,7 @@ namespace partsim::tools {
 namespace {
 
 constexpr char kServeUsage[] = R"(usage:
-  partsim serve [SCENE.urdf] [--port P] [--rate R | --realtime-factor F | --fast]
+  partsim serve [SCENE] [--port P] [--rate R | --realtime-factor F | --fast]
                 [--robot gripper|panda] [--address A] [--duration S] [--camera WxH]
                 [--camera-rate HZ] [--ros1 [--ros1-wall-time]]
 
@@ -43,6 +44,8 @@ With --ros1 (when partsim is built with ROS 1) a roscpp node serves the same top
 services to ROS 1 nodes, plus the action
 /<robot>/joint_trajectory_controller/follow_joint_trajectory (control_msgs); the master is
 ROS_MASTER_URI's, and /use_sim_time is set to true unless --ros1-wall-time.
+SCENE is a URDF file or a PartNet-Mobility folder (placed 1 m ahead of the robot, root fixed),
+or a JSON scene file listing several with their poses (see include/partsim/assets/scene_file.h).
 With no SCENE, a built-in cabinet stands in front of the robot.
   --port P               WebSocket port (default 9090; 0 picks a free one, printed on start)
   --rate R               physics rate in Hz (default 500), stepped in real time
@@ -151,17 +154,22 @@ int RunServeCommand(int argc, char** argv) {
 #endif
 
   try {
-    // the scene: the given URDF or the built-in cabinet, then the robot
+    // the scene: what SCENE names (a URDF or a PartNet-Mobility folder 1 m ahead of the
+    // robot, or a scene file's objects at their poses) or the built-in cabinet; then the robot
     SceneConfig cfg;
     cfg.timestep = 1.0 / rate;
     Scene scene(cfg);
     scene.AddGround(0.0);
-    UrdfLoader loader(&scene);
-    loader.fix_root_link = true;
-    ArticulationDesc object = scene_file.empty() ? loader.Parse(MakeCabinetUrdf(), ".", "cabinet")
-                                                 : loader.ParseFile(scene_file);
-    object.root_pose = Pose(Eigen::Vector3d(1.0, 0, 0));
-    scene.AddArticulation(object);
+    const Pose ahead(Eigen::Vector3d(1.0, 0, 0));
+    if (scene_file.empty()) {
+      UrdfLoader loader(&scene);
+      loader.fix_root_link = true;
+      ArticulationDesc object = loader.Parse(MakeCabinetUrdf(), ".", "cabinet");
+      object.root_pose = ahead;
+      scene.AddArticulation(object);
+    } else {
+      AddSceneObjects(&scene, scene_file, ahead, true);
+    }
     RobotModel model = robot_kind == "panda" ? BuildPanda() : BuildFlyingGripper();
     if (robot_kind == "gripper") model.articulation.root_pose = Pose(Eigen::Vector3d(0, 0, 0.5));
     Articulation robot = scene.AddArticulation(model.articulation);
@@ -207,8 +215,10 @@ int RunServeCommand(int argc, char** argv) {
 #endif
     sim.Start();
     std::printf(
-        "partsim serve: rosbridge on ws://%s:%d, robot /%s (%d joints), %g Hz physics, %s%s\n",
-        address.c_str(), bridge.GetPort(), robot.GetName().c_str(), robot.Dof(), rate,
+        "partsim serve: rosbridge on ws://%s:%d, robot /%s (%d joints), %zu articulations, %g Hz "
+        "physics, %s%s\n",
+        address.c_str(), bridge.GetPort(), robot.GetName().c_str(), robot.Dof(),
+        scene.GetArticulations().size(), rate,
         fast ? "as fast as possible" : ("real-time factor " + std::to_string(factor)).c_str(),
         ros1 ? ", ROS 1 node /partsim" : "");
     std::fflush(stdout);

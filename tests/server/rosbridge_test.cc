@@ -53,6 +53,13 @@ class TestClient {
       // published messages are counted (the clock and the last joint state kept); the others
       // are kept whole
       const std::string& text = m->get_payload();
+      if (m->get_opcode() == websocketpp::frame::opcode::binary) {  // CBOR
+        json j = json::from_cbor(text, true, false);
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!j.is_discarded()) j["cbor"] = true;
+        messages_.push_back(j);
+        return;
+      }
       const size_t at = text.rfind("\"topic\":\"");
       const std::string topic = at == std::string::npos ? "" : text.substr(at + 9);
       std::lock_guard<std::mutex> lock(mutex_);
@@ -493,6 +500,95 @@ TEST_F(RosbridgeTest, EffortCommandIsAcceptedAndAWrongLengthIsRefused) {
   for (const json& m : c.Messages()) EXPECT_NE(m.value("id", ""), "e1") << m.dump();
 }
 
+TEST_F(RosbridgeTest, FragmentedCommandIsReassembledAndBadFragmentsAreRefused) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  const std::string topic = "/" + robot_.GetName() + "/joint_position_controller/command";
+  std::vector<double> q(robot_.Dof(), 0.0);
+  q[2] = 0.6;  // z of the flying gripper
+  const std::string text =
+      json{{"op", "publish"}, {"topic", topic}, {"msg", {{"data", q}}}, {"id", "whole"}}.dump();
+  // three pieces, sent out of order
+  const size_t n = 3, piece = (text.size() + n - 1) / n;
+  for (size_t i : {2u, 0u, 1u})
+    c.Send(json{{"op", "fragment"},
+                {"id", "m1"},
+                {"data", text.substr(i * piece, piece)},
+                {"num", i},
+                {"total", n}});
+  EXPECT_TRUE(WaitFor([&] { return bridge_->GetStats().commands == 1; }));
+  // bad fragments: each answered with an error, nothing applied
+  c.Send(json{{"op", "fragment"}, {"id", "b1"}, {"data", "x"}, {"num", 3}, {"total", 3}});
+  c.Send(json{{"op", "fragment"}, {"id", "b2"}, {"data", 5}, {"num", 0}, {"total", 2}});
+  c.Send(json{{"op", "fragment"}, {"data", "x"}, {"num", 0}, {"total", 2}});
+  c.Send(json{{"op", "fragment"}, {"id", "b4"}, {"data", "{\"op\":"}, {"num", 0}, {"total", 2}});
+  c.Send(json{{"op", "fragment"}, {"id", "b4"}, {"data", "nonsense"}, {"num", 1}, {"total", 2}});
+  for (const char* id : {"b1", "b2"}) {
+    json e = c.WaitMessage([&](const json& m) { return m.value("id", "") == id; });
+    ASSERT_TRUE(IsError(e)) << id << ": " << e.dump();
+    EXPECT_NE(e["msg"].get<std::string>().find("fragment"), std::string::npos) << e["msg"];
+  }
+  json bad = c.WaitMessage([](const json& m) {
+    return IsError(m) && m["msg"].get<std::string>().find("malformed JSON") != std::string::npos;
+  });
+  EXPECT_FALSE(bad.is_null()) << "the reassembled nonsense is reported as malformed JSON";
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(bridge_->GetStats().commands, 1);
+}
+
+TEST_F(RosbridgeTest, SubscriptionWithFragmentSizeGetsPiecesThatRebuildTheMessage) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "subscribe"},
+              {"topic", "/joint_states"},
+              {"fragment_size", 64},
+              {"throttle_rate", 200}});
+  // the pieces of one message: same id, num 0..total-1, each at most 64 characters
+  json first = c.WaitMessage([](const json& m) { return m.value("op", "") == "fragment"; });
+  ASSERT_FALSE(first.is_null());
+  const std::string id = first["id"];
+  const size_t total = first["total"];
+  ASSERT_GT(total, 1u);
+  std::vector<std::string> pieces(total);
+  ASSERT_TRUE(WaitFor([&] {
+    size_t got = 0;
+    for (const json& m : c.Messages())
+      if (m.value("op", "") == "fragment" && m["id"] == id) {
+        pieces[m["num"].get<size_t>()] = m["data"];
+        ++got;
+      }
+    return got == total;
+  }));
+  std::string text;
+  for (const std::string& p : pieces) {
+    EXPECT_LE(p.size(), 64u);
+    text += p;
+  }
+  json whole = json::parse(text, nullptr, false);
+  ASSERT_FALSE(whole.is_discarded()) << text;
+  EXPECT_EQ(whole["topic"], "/joint_states");
+  EXPECT_EQ(whole["msg"]["name"].size(), static_cast<size_t>(robot_.Dof()));
+}
+
+TEST_F(RosbridgeTest, SubscribeRequestsByIdAreUnsubscribedOneByOne) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "subscribe"}, {"topic", "/clock"}, {"id", "a"}});
+  c.Send(json{{"op", "subscribe"}, {"topic", "/clock"}, {"id", "b"}, {"throttle_rate", 100}});
+  ASSERT_TRUE(WaitFor([&] { return c.LastClock() > 0; }));
+  // one message per step whatever the number of requests (the unthrottled one wins)
+  c.Send(json{{"op", "unsubscribe"}, {"topic", "/clock"}, {"id", "a"}});
+  std::this_thread::sleep_for(200ms);
+  double t0 = c.LastClock();
+  std::this_thread::sleep_for(400ms);
+  EXPECT_GT(c.LastClock(), t0) << "request b still subscribes";
+  c.Send(json{{"op", "unsubscribe"}, {"topic", "/clock"}, {"id", "b"}});
+  std::this_thread::sleep_for(300ms);
+  t0 = c.LastClock();
+  std::this_thread::sleep_for(400ms);
+  EXPECT_EQ(c.LastClock(), t0) << "no request left";
+}
+
 TEST_F(RosbridgeTest, HugeMessageIsRejectedAndServerStaysUp) {
   auto watcher = ClockWatcher();
   TestClient big(port_);
@@ -684,6 +780,36 @@ TEST_F(RosbridgeSensorTest, ImageCameraInfoAndPoints) {
   EXPECT_GT(in_front, 1000u);
 }
 
+TEST_F(RosbridgeSensorTest, CborSubscriptionsCarryBytesNotBase64) {
+  Start(64, 48, 0);
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "subscribe"}, {"topic", "/cam/image_raw"}, {"compression", "cbor"}});
+  c.Send(json{{"op", "subscribe"},
+              {"topic", "/joint_states"},
+              {"compression", "cbor"},
+              {"throttle_rate", 100}});
+  json image = c.WaitMessage([](const json& m) {
+    return m.value("cbor", false) && m.value("topic", "") == "/cam/image_raw";
+  });
+  ASSERT_FALSE(image.is_null());
+  ASSERT_TRUE(image["msg"]["data"].is_binary()) << "uint8[] is a CBOR byte string";
+  EXPECT_EQ(image["msg"]["data"].get_binary().size(), 64u * 48u * 3u);
+  EXPECT_EQ(image["msg"]["width"], 64);
+  EXPECT_EQ(image["msg"]["encoding"], "rgb8");
+  json js = c.WaitMessage([](const json& m) {
+    return m.value("cbor", false) && m.value("topic", "") == "/joint_states";
+  });
+  ASSERT_FALSE(js.is_null());
+  EXPECT_EQ(js["op"], "publish");
+  EXPECT_EQ(js["msg"]["position"].size(), static_cast<size_t>(robot_.Dof()));
+  // an unknown compression is refused, naming it
+  c.Send(json{{"op", "subscribe"}, {"topic", "/imu"}, {"compression", "zip"}, {"id", "z"}});
+  json e = c.WaitMessage([](const json& m) { return m.value("id", "") == "z"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("'zip'"), std::string::npos) << e["msg"];
+}
+
 TEST_F(RosbridgeSensorTest, ImuAtRestReadsGravity) {
   Start(32, 24, 10);
   TestClient c(port_);
@@ -751,10 +877,7 @@ TEST_F(RosbridgeSensorTest, TfHoldsTheCameraOpticalFrameAndEveryLink) {
   for (const Link& l : robot_.GetLinks()) EXPECT_FALSE(TfTransform(c, l.GetName()).is_null());
 }
 
-// DISABLED: the optical frame on /tf has the wrong orientation (z points down in the image, not
-// forward); see ServedRobotTest.DISABLED_CameraOpticalFrameLooksAlongTheViewWithYDown and
-// OpticalPose in src/server/served_robot.cc.
-TEST_F(RosbridgeSensorTest, DISABLED_TfCameraOpticalFrameLooksAlongTheViewWithYDown) {
+TEST_F(RosbridgeSensorTest, TfCameraOpticalFrameLooksAlongTheViewWithYDown) {
   Start(32, 24, 10);
   TestClient c(port_);
   ASSERT_TRUE(c.WaitOpen());

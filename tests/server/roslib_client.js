@@ -11,7 +11,7 @@ const fail = (why) => {
   console.log(JSON.stringify(result));
   process.exit(1);
 };
-setTimeout(() => fail('timed out'), 40000);
+setTimeout(() => fail('timed out'), 60000);
 
 const ros = new Ros({ url: `ws://127.0.0.1:${port}` });
 ros.on('error', (e) => fail('connection error: ' + e));
@@ -80,6 +80,42 @@ ros.on('connection', async () => {
   result.trajectory_final_error = err;
   result.trajectory_seconds = (Date.now() - tSend) / 1000;
   if (!(err < 0.01)) fail('trajectory not executed: error ' + err);
+
+  // CBOR subscriptions: binary frames that roslib decodes; uint8[] arrives as bytes
+  const cborStates = new Topic({ ros, name: '/joint_states', messageType: 'sensor_msgs/JointState',
+                                 compression: 'cbor', throttle_rate: 100 });
+  const cborState = await new Promise((res) => cborStates.subscribe(res));
+  cborStates.unsubscribe();
+  if (!Array.isArray(cborState.name) || cborState.position.length !== cborState.name.length)
+    fail('malformed CBOR /joint_states');
+  const image = new Topic({ ros, name: '/front_camera/image_raw', messageType: 'sensor_msgs/Image',
+                            compression: 'cbor' });
+  const im = await new Promise((res) => image.subscribe(res));
+  image.unsubscribe();
+  result.cbor_image = { width: im.width, height: im.height, bytes: im.data.length,
+                        is_bytes: im.data instanceof Uint8Array };
+  if (!(im.data instanceof Uint8Array) || im.data.length !== im.width * im.height * 3)
+    fail('CBOR image data is not width*height*3 bytes');
+
+  // motion planning as a service: the first arm joint turns by 0.3 rad, planned and executed
+  const plan = new Service({ ros, name: `/${robot}/plan`, serviceType: 'partsim_msgs/PlanMotion' });
+  const allNames = last.name.filter((n) => n.startsWith(robot));
+  const target = allNames.map((n) => last.position[last.name.indexOf(n)]);
+  target[0] += 0.3;
+  const planned = await new Promise((res, rej) =>
+    plan.callService({ joint_goal: target, execute: true }, res, rej));
+  result.plan = { success: planned.success, planning_time: planned.planning_time,
+                  points: planned.trajectory.points.length };
+  if (!planned.success) fail('plan failed: ' + planned.message);
+  let planErr = Infinity;
+  const tPlan = Date.now();
+  while (Date.now() - tPlan < 10000) {
+    await sleep(100);
+    planErr = Math.abs(last.position[last.name.indexOf(allNames[0])] - target[0]);
+    if (planErr < 0.01) break;
+  }
+  result.plan_final_error = planErr;
+  if (!(planErr < 0.01)) fail('planned motion not executed: error ' + planErr);
 
   // the server's own counters (command latency in steps)
   const stats = new Service({ ros, name: '/partsim/stats', serviceType: 'std_srvs/Trigger' });

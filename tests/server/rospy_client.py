@@ -144,6 +144,7 @@ check(client.wait_for_result(rospy.Duration(30.0)), "the action finished")
 res = client.get_result()
 result["action_state"] = GoalStatus.to_string(client.get_state()) \
     if hasattr(GoalStatus, "to_string") else client.get_state()
+result["action_error_string"] = res.error_string if res else None
 check(client.get_state() == GoalStatus.SUCCEEDED, "follow_joint_trajectory SUCCEEDED")
 check(res.error_code == FollowJointTrajectoryResult.SUCCESSFUL, "error_code SUCCESSFUL")
 result["action_feedback_messages"] = len(feedback)

@@ -436,16 +436,7 @@ TEST(ServedRobotTest, ZeroEffortHoldsUnderGravityCompensation) {
   EXPECT_EQ(w.served->GetCommandStats().commands, 1);
 }
 
-// DISABLED: an effort command barely moves the robot (10 N moves the x slide 1 mm, where the
-// hand of about 1 kg should accelerate at several m/s^2). The joints' PD drives stay on under the
-// effort controller and hold the robot against the effort: controllers write their drive gains
-// only in their constructors (src/robot/controllers.cc, SetGains in JointEffortController's,
-// JointPositionController's, ... constructors), and ServedRobot builds all four controllers at
-// once (src/server/served_robot.cc, ServedRobot::ServedRobot), the trajectory controller last,
-// so its stiffness 1e4 / damping 1e3 is what every controller runs with; Activate() does not
-// restore the gains of the controller it switches to. The velocity controller runs with that
-// stiffness too (it expects 0).
-TEST(ServedRobotTest, DISABLED_EffortMovesTheJointInTheEffortsDirection) {
+TEST(ServedRobotTest, EffortMovesTheJointInTheEffortsDirection) {
   World w({});
   const size_t n = w.served->GetJointNames().size();
   const VectorXd q0 = w.Qpos();
@@ -609,12 +600,7 @@ TEST(ServedRobotTest, FramesHoldEveryLinkAndTheCameraOpticalFrame) {
   }
 }
 
-// DISABLED: ServedRobot::ReadFrames gives the optical frame the wrong orientation. Camera::GetPose
-// is X_WC in partsim's camera convention (x forward, y left, z up; camera.h, camera_math.h), but
-// OpticalPose (src/server/served_robot.cc, "turned half a turn about x") treats it as an OpenGL
-// pose (looking down -z): the optical frame it publishes has z pointing down in the image and x
-// forward, instead of z forward and y down. X_WO should be X_WC rotated by RotationCameraToCv().
-TEST(ServedRobotTest, DISABLED_CameraOpticalFrameLooksAlongTheViewWithYDown) {
+TEST(ServedRobotTest, CameraOpticalFrameLooksAlongTheViewWithYDown) {
   World w({/*panda=*/false, /*camera=*/true});
   const std::vector<FrameReading> frames = OnSim(*w.sim, [&] { return w.served->ReadFrames(); });
   auto it = std::find_if(frames.begin(), frames.end(),

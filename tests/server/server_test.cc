@@ -4,6 +4,7 @@
 // installs roslib and ws into build/node (or PARTSIM_NODE_DIR); without node or that folder the
 // test is skipped.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -63,7 +64,12 @@ TEST(ServeTest, RoslibClientListsTopicsReceivesStatesAndDrivesATrajectory) {
   EXPECT_GT(r["clock_hz"].get<double>(), 50.0);
   EXPECT_LE(r["joint_states_hz"].get<double>(), 520.0);  // never more than one per step
   EXPECT_LT(r["trajectory_final_error"].get<double>(), 0.01);
-  EXPECT_EQ(r["stats"]["commands"].get<long long>(), 1);
+  EXPECT_TRUE(r["cbor_image"]["is_bytes"].get<bool>()) << out;
+  EXPECT_EQ(r["cbor_image"]["bytes"].get<int>(), 640 * 480 * 3) << out;
+  EXPECT_TRUE(r["plan"]["success"].get<bool>()) << out;
+  EXPECT_LT(r["plan_final_error"].get<double>(), 0.01) << out;
+  // the trajectory and the planned motion
+  EXPECT_EQ(r["stats"]["commands"].get<long long>(), 2);
 }
 
 TEST(ServeTest, RejectsBadArgumentsAndServesForADuration) {
@@ -84,6 +90,49 @@ TEST(ServeTest, RejectsBadArgumentsAndServesForADuration) {
   EXPECT_EQ(code, 0) << out;
   EXPECT_NE(out.find("robot /flying_gripper"), std::string::npos) << out;
   EXPECT_NE(out.find("stopped after"), std::string::npos) << out;
+}
+
+TEST(ServeTest, ServesAPartNetMobilityFolderAndASceneFile) {
+  int code = 0;
+  const fs::path dir = fs::temp_directory_path() / ("partsim_serve_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const std::string cli = std::string("'") + PARTSIM_CLI_PATH + "' ";
+  std::string out =
+      RunShell(cli + "assets generate --categories StorageFurniture --per-category 1 " +
+                   "--seed 3 --out '" + dir.string() + "' 2>&1",
+               &code);
+  ASSERT_EQ(code, 0) << out;
+  fs::path folder;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.path().filename() == "mobility_v2.json") folder = e.path().parent_path();
+  ASSERT_FALSE(folder.empty()) << out;
+  // the folder alone: the cabinet and the robot
+  out =
+      RunShell(cli + "serve '" + folder.string() + "' --fast --port 0 --duration 0.3 2>&1", &code);
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("2 articulations"), std::string::npos) << out;
+  // a scene file with the cabinet twice, side by side
+  const fs::path scene = dir / "two.json";
+  std::FILE* f = std::fopen(scene.string().c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fprintf(f,
+               R"({"objects": [{"path": "%s", "name": "left", "pose": {"position": [1.2, 0.8, 0]}},
+                               {"path": "%s", "name": "right", "pose": {"position": [1.2, -0.8, 0]}}]})",
+               folder.string().c_str(), folder.string().c_str());
+  std::fclose(f);
+  out = RunShell(cli + "serve '" + scene.string() + "' --fast --port 0 --duration 0.3 2>&1", &code);
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("3 articulations"), std::string::npos) << out;
+  // a bad entry: the error names the file and the field
+  f = std::fopen(scene.string().c_str(), "w");
+  std::fprintf(f, R"({"objects": [{"path": "%s", "pose": {"position": [1, 2]}}]})",
+               folder.string().c_str());
+  std::fclose(f);
+  out = RunShell(cli + "serve '" + scene.string() + "' --fast --port 0 --duration 0.3 2>&1", &code);
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_NE(out.find("two.json"), std::string::npos) << out;
+  EXPECT_NE(out.find("objects[0].pose.position"), std::string::npos) << out;
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -68,6 +68,11 @@ class Controller {
   int Period() const;
   /// Called by ControlLoop every Period() steps, before the physics steps.
   virtual void Update() = 0;
+  /// Writes this controller's drive gains to its joints: PD (stiffness, damping) for position
+  /// control, damping only for velocity control, none for efforts. The constructor and
+  /// ControlLoop::Add call it, so that switching between controllers of the same joints
+  /// switches the drives too.
+  virtual void ConfigureDrives();
 
   /// Current positions and velocities of the controlled joints.
   Eigen::VectorXd GetQpos() const;
@@ -94,6 +99,7 @@ class JointEffortController : public Controller {
                         const JointControllerOptions& options);
   void SetTarget(const Eigen::VectorXd& effort);
   void Update() override;
+  void ConfigureDrives() override;
 
  private:
   Eigen::VectorXd effort_;
@@ -123,6 +129,7 @@ class JointVelocityController : public Controller {
                           const JointControllerOptions& options);
   void SetTarget(const Eigen::VectorXd& qd);
   void Update() override;
+  void ConfigureDrives() override;
 
  private:
   Eigen::VectorXd target_;
