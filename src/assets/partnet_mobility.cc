@@ -154,9 +154,10 @@ int FindLink(const ArticulationDesc& desc, const std::string& name) {
   return -1;
 }
 
-// Checks one link's URDF joint(s) against its mobility_v2.json entry.
+// Checks one link's URDF joint(s) against its mobility_v2.json entry. `scale` is the loader's:
+// the URDF was read scaled, mobility_v2.json's lengths are not.
 void CheckLink(const PartNetLink& e, const ArticulationDesc& desc, const std::vector<Pose>& X,
-               const fs::path& folder) {
+               const fs::path& folder, double scale) {
   const fs::path urdf = folder / "mobility.urdf";
   std::string link_name = "link_" + std::to_string(e.id);
   std::string where = "link_" + std::to_string(e.id) + " ('" + e.semantic_label + "')";
@@ -189,12 +190,16 @@ void CheckLink(const PartNetLink& e, const ArticulationDesc& desc, const std::ve
   double dot = d.dot(e.axis_direction);
   if ((d.cross(e.axis_direction)).norm() > kAxisTolerance)
     Fail(urdf, where + ": joint axis differs from mobility_v2.json's direction");
-  if (e.joint == "hinge" && (e.axis_origin - X_FJ.p).cross(d).norm() > kAxisTolerance)
+  if (e.joint == "hinge" &&
+      (e.axis_origin * scale - X_FJ.p).cross(d).norm() > kAxisTolerance * scale)
     Fail(urdf, where + ": mobility_v2.json's axis origin is not on the joint's axis");
   // limits, flipped when the file's axis points the other way
   if (!e.no_limit) {
     double lo = std::min(e.limit_a, e.limit_b), hi = std::max(e.limit_a, e.limit_b);
-    if (e.joint == "hinge") lo = Radians(lo), hi = Radians(hi);
+    if (e.joint == "hinge")
+      lo = Radians(lo), hi = Radians(hi);
+    else
+      lo *= scale, hi *= scale;  // slider limits are lengths
     if (dot < 0) std::swap(lo, hi), lo = -lo, hi = -hi;
     if (std::abs(m.joint.lower - lo) > kLimitTolerance ||
         std::abs(m.joint.upper - hi) > kLimitTolerance) {
@@ -327,7 +332,7 @@ PartNetMobilityObject PartNetMobilityLoader::Parse(const std::string& folder_in)
   u.fix_root_link = urdf.fix_root_link;
   obj.articulation = u.ParseFile(urdf_file.string());
   std::vector<Pose> X = RestPoses(obj.articulation);
-  for (const PartNetLink& l : obj.links) CheckLink(l, obj.articulation, X, folder);
+  for (const PartNetLink& l : obj.links) CheckLink(l, obj.articulation, X, folder, u.scale);
   for (const PartNetLink& l : obj.links)
     for (const PartNetPart& p : l.parts)
       if (obj.PartVisuals(l.id, p.name).empty())

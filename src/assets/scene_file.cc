@@ -185,12 +185,9 @@ Prepared Prepare(const std::string& path, const Pose& pose, bool fix_root, doubl
       loader.scale = scale;
       out.desc = loader.ParseFile(path);
     } else {
-      // PartNetMobilityLoader checks mobility.urdf against the unscaled mobility_v2.json
-      if (scale != 1.0)
-        throw Error("scale: " + Number(scale) +
-                    " is not supported for PartNet-Mobility folders (only 1)");
       PartNetMobilityLoader loader;
       loader.urdf.fix_root_link = fix_root;
+      loader.urdf.scale = scale;
       out.desc = loader.Parse(path).articulation;
     }
     if (out.desc.name.empty()) out.desc.name = fs::path(path).stem().string();

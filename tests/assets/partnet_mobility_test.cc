@@ -78,6 +78,22 @@ TEST(PartNetMobilityTest, LoadsZUpWithTheFilesAxes) {
   EXPECT_NEAR(drawer_pose.p.y(), -0.2, 0.01);  // slid out to the front (world -y)
 }
 
+TEST(PartNetMobilityTest, ScaledFolderPassesItsChecksWithScaledAxesAndSliderLimits) {
+  Folder f("scaled");
+  PartNetMobilityObject one = PartNetMobilityLoader().Parse(f.Path());
+  PartNetMobilityLoader loader;
+  loader.urdf.scale = 2.0;  // checked against mobility_v2.json's unscaled axis origins
+  PartNetMobilityObject two = loader.Parse(f.Path());
+  const LinkDesc &door1 = one.articulation.links[one.LinkIndex(0)],
+                 &door2 = two.articulation.links[two.LinkIndex(0)];
+  EXPECT_LT((door2.joint.pose_in_parent.p - 2.0 * door1.joint.pose_in_parent.p).norm(), 1e-12);
+  EXPECT_NEAR(door2.joint.lower, door1.joint.lower, 1e-12);  // angles do not scale
+  const LinkDesc &drawer1 = one.articulation.links[one.LinkIndex(1)],
+                 &drawer2 = two.articulation.links[two.LinkIndex(1)];
+  EXPECT_NEAR(drawer2.joint.upper, 2.0 * drawer1.joint.upper, 1e-12);  // lengths do
+  EXPECT_GT(drawer1.joint.upper, 0.0);
+}
+
 TEST(PartNetMobilityTest, MissingFileIsNamed) {
   Folder f("missing");
   fs::remove(f.dir / "semantics.txt");

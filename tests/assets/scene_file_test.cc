@@ -279,8 +279,6 @@ TEST_F(SceneFileTest, BadScenesNameTheFileEntryAndFieldAndLeaveTheSceneWorking) 
       {R"({"objects": [{"path": "lid_box.urdf", "scale": -1}]})", {"objects[0].scale", "> 0"}},
       {R"({"objects": [{"path": "lid_box.urdf", "scale": "big"}]})",
        {"objects[0].scale", "must be a number"}},
-      {R"({"objects": [)" + good + R"(, {"path": "cabinet", "scale": 2}]})",
-       {"objects[1]", "scale", "not supported"}},
       {R"({"objects": [)" + good + R"(, {"path": "lid_box.urdf", "name": "fine"}]})",
        {"objects[1].name", "'fine'", "earlier entry"}},
       {R"({"objects": [{"path": "lid_box.urdf", "name": "lid_box"}]})",
