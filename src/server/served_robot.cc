@@ -96,6 +96,21 @@ struct ServedRobot::Impl {
     });
   }
 
+  /// Checks a target of one value per joint, then sets it on `controller` and makes that the
+  /// active controller, between two steps.
+  template <class C>
+  void Command(const std::shared_ptr<C>& controller, const std::vector<double>& values,
+               const std::string& what, ErrorSink on_error) {
+    CheckValues(values, joint_names.size(), what);
+    Eigen::VectorXd v = ToVector(values);
+    Post(
+        [this, controller, v] {
+          controller->SetTarget(v);
+          Activate(controller);
+        },
+        std::move(on_error));
+  }
+
   /// Ends the running goal, if any (simulation thread).
   void Finish(TrajectoryOutcome outcome, const std::string& message) {
     if (!goal) return;
@@ -297,41 +312,17 @@ const std::vector<std::string>& ServedRobot::GetJointNames() const { return impl
 
 void ServedRobot::CommandPositions(const std::vector<double>& values, const std::string& what,
                                    ErrorSink on_error) {
-  CheckValues(values, impl_->joint_names.size(), what);
-  Eigen::VectorXd v = ToVector(values);
-  Impl* m = impl_.get();
-  m->Post(
-      [m, v] {
-        m->position->SetTarget(v);
-        m->Activate(m->position);
-      },
-      std::move(on_error));
+  impl_->Command(impl_->position, values, what, std::move(on_error));
 }
 
 void ServedRobot::CommandVelocities(const std::vector<double>& values, const std::string& what,
                                     ErrorSink on_error) {
-  CheckValues(values, impl_->joint_names.size(), what);
-  Eigen::VectorXd v = ToVector(values);
-  Impl* m = impl_.get();
-  m->Post(
-      [m, v] {
-        m->velocity->SetTarget(v);
-        m->Activate(m->velocity);
-      },
-      std::move(on_error));
+  impl_->Command(impl_->velocity, values, what, std::move(on_error));
 }
 
 void ServedRobot::CommandEfforts(const std::vector<double>& values, const std::string& what,
                                  ErrorSink on_error) {
-  CheckValues(values, impl_->joint_names.size(), what);
-  Eigen::VectorXd v = ToVector(values);
-  Impl* m = impl_.get();
-  m->Post(
-      [m, v] {
-        m->effort->SetTarget(v);
-        m->Activate(m->effort);
-      },
-      std::move(on_error));
+  impl_->Command(impl_->effort, values, what, std::move(on_error));
 }
 
 void ServedRobot::CheckTrajectory(const TrajectoryCommand& c, const std::string& what) const {
