@@ -450,8 +450,8 @@ class Camera:
     def set_pose(self, pose: Pose) -> None:
         """Same as set_local_pose: the world pose of a free camera, the pose in the mount's frame of a mounted one."""
         ...
-    def take_picture(self) -> None:
-        """Renders the scene as of the last update_render() (the first picture of a scene updates it first). The GIL is released meanwhile."""
+    def take_picture(self, outputs: typing.Optional[typing.List[str]] = ...) -> None:
+        """Renders the scene as of the last update_render() (the first picture of a scene updates it first). The GIL is released meanwhile. `outputs`: the pictures to render (e.g. ['Color', 'Position']), None for all; get_picture of another one raises. Color and Position alone take the rasterizer's faster forward pass."""
         ...
     @property
     def width(self) -> int:
@@ -2473,7 +2473,7 @@ def find_task_objects(type: TaskType, count: int, dataset_seed: int = ...) -> ty
     ...
 
 def get_point_cloud(camera: Camera, frame: str = ...) -> dict:
-    """Points of the camera's last picture that see a surface, in the 'camera' (OpenGL: x right, y up, z backward) or 'world' frame: dict of positions float32 (N, 3) m, colors uint8 (N, 4) sRGB, visual_ids and entity_ids uint32 (N,)."""
+    """Points of the camera's last picture that see a surface, in the 'camera' (OpenGL: x right, y up, z backward) or 'world' frame: dict of positions float32 (N, 3) m, colors uint8 (N, 4) sRGB, visual_ids and entity_ids uint32 (N,); colors (0, 4) and ids (0,) when the picture did not take Color or Segmentation."""
     ...
 
 def get_segmentation_color(id: int) -> typing.List[int]:

@@ -173,9 +173,22 @@ void BindCamera(py::module_& m) {
       .def("get_local_pose", &Camera::GetLocalPose)
       .def("set_local_pose", &Camera::SetLocalPose, py::arg("pose"),
            "World pose of a free camera, or pose in the mount's frame of a mounted one.")
-      .def("take_picture", &Camera::TakePicture, py::call_guard<py::gil_scoped_release>(),
-           "Renders the scene as of the last update_render() (the first picture of a scene "
-           "updates it first). The GIL is released meanwhile.")
+      .def(
+          "take_picture",
+          [](Camera& self, const std::optional<std::vector<std::string>>& outputs) {
+            unsigned mask = kAllOutputs;
+            if (outputs) {
+              mask = 0;
+              for (const std::string& name : *outputs) mask |= PictureOutputFromName(name);
+            }
+            py::gil_scoped_release release;
+            self.TakePicture(mask);
+          },
+          py::arg("outputs") = py::none(),
+          "Renders the scene as of the last update_render() (the first picture of a scene "
+          "updates it first). The GIL is released meanwhile. `outputs`: the pictures to render "
+          "(e.g. ['Color', 'Position']), None for all; get_picture of another one raises. Color "
+          "and Position alone take the rasterizer's faster forward pass.")
       .def("get_picture", &PictureView, py::arg("name"),
            "'Color', 'Albedo', 'Normal', 'Position': float32 (h, w, 4); 'Segmentation': uint32 "
            "(h, w, 2) (visual id, actor/link id). A read-only view, no copy.")
@@ -189,6 +202,7 @@ void BindCamera(py::module_& m) {
           "get_depth",
           [](const Camera& self) {
             // the w channel of Position, viewed with a stride
+            self.GetFloatPicture("Position");  // throws when it was not taken
             PictureRef picture = self.GetSharedPicture();
             ssize_t h = picture->height, w = picture->width, s = sizeof(float);
             return ReadOnlyView<float>({h, w}, {w * 4 * s, 4 * s}, picture->position.data() + 3,
@@ -254,15 +268,19 @@ void BindImageIo(py::module_& m) {
         ssize_t n = static_cast<ssize_t>(c.Size());
         py::dict out;
         out["positions"] = Owned(std::move(c.positions), {n, 3});
-        out["colors"] = Owned(std::move(c.colors), {n, 4});
-        out["visual_ids"] = Owned(std::move(c.visual_ids), {n});
-        out["entity_ids"] = Owned(std::move(c.entity_ids), {n});
+        // colours and ids are empty when the picture did not take them
+        ssize_t nc = static_cast<ssize_t>(c.colors.size() / 4);
+        ssize_t ni = static_cast<ssize_t>(c.visual_ids.size());
+        out["colors"] = Owned(std::move(c.colors), {nc, 4});
+        out["visual_ids"] = Owned(std::move(c.visual_ids), {ni});
+        out["entity_ids"] = Owned(std::move(c.entity_ids), {ni});
         return out;
       },
       py::arg("camera"), py::arg("frame") = "camera",
       "Points of the camera's last picture that see a surface, in the 'camera' (OpenGL: x "
       "right, y up, z backward) or 'world' frame: dict of positions float32 (N, 3) m, colors "
-      "uint8 (N, 4) sRGB, visual_ids and entity_ids uint32 (N,).");
+      "uint8 (N, 4) sRGB, visual_ids and entity_ids uint32 (N,); colors (0, 4) and ids (0,) "
+      "when the picture did not take Color or Segmentation.");
   m.def(
       "write_png",
       [](const std::string& path, const CArray<uint8_t>& image) {

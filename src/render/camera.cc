@@ -6,11 +6,13 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
 #include "physics/scene_internal.h"
+#include "render/picture_internal.h"
 
 namespace partsim {
 
@@ -39,10 +41,42 @@ const Picture& PictureOf(const SceneImpl::CameraEntry& c) {
   return *c.picture;
 }
 
+// the last picture, checked to hold output `bit` (named `name`)
+const Picture& PictureWith(const SceneImpl::CameraEntry& c, unsigned bit, const char* name) {
+  const Picture& p = PictureOf(c);
+  if (!(p.outputs & bit))
+    throw Error("camera '" + c.name + "': picture '" + name +
+                "' was not taken: TakePicture was asked for " + PictureOutputNames(p.outputs));
+  return p;
+}
+
+constexpr std::pair<unsigned, const char*> kOutputNames[] = {{kColor, "Color"},
+                                                             {kAlbedo, "Albedo"},
+                                                             {kNormal, "Normal"},
+                                                             {kPosition, "Position"},
+                                                             {kSegmentation, "Segmentation"}};
+
 }  // namespace
+
+std::string PictureOutputNames(unsigned outputs) {
+  std::string names;
+  for (const auto& [bit, name] : kOutputNames) {
+    if (!(outputs & bit)) continue;
+    if (!names.empty()) names += ", ";
+    names += name;
+  }
+  return names.empty() ? "none" : names;
+}
 
 bool IsFloatPictureName(const std::string& name) {
   return name == "Color" || name == "Albedo" || name == "Normal" || name == "Position";
+}
+
+unsigned PictureOutputFromName(const std::string& name) {
+  for (const auto& [bit, known] : kOutputNames)
+    if (name == known) return bit;
+  throw Error("unknown picture name '" + name +
+              "' (expected Color, Albedo, Normal, Position or Segmentation)");
 }
 
 const std::string& Camera::GetName() const { return Entry(scene_, id_).name; }
@@ -147,8 +181,12 @@ void Camera::SetLocalPose(const Pose& pose) {
 
 Pose Camera::GetLocalPose() const { return Entry(scene_, id_).local_pose; }
 
-void Camera::TakePicture() {
+void Camera::TakePicture(unsigned outputs) {
   SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  if (outputs == 0 || (outputs & ~unsigned{kAllOutputs}) != 0)
+    throw Error("camera '" + c.name + "': take_picture outputs must name at least one of " +
+                "Color, Albedo, Normal, Position, Segmentation (PictureOutput bits 1 to 31), got " +
+                std::to_string(outputs));
   SceneImpl& s = scene_->impl();
   // the first picture of a scene needs a render world: build it now
   if (!s.render_world_built) scene_->UpdateRender();
@@ -160,17 +198,23 @@ void Camera::TakePicture() {
   picture->width = c.width;
   picture->height = c.height;
   try {
-    backend.Render(s.render_world, params, picture.get());
+    backend.Render(s.render_world, params, picture.get(), outputs);
   } catch (...) {
     // a half-written picture is not the last picture
     if (picture == c.picture) c.picture.reset();
     throw;
   }
-  // a backend that fills the wrong sizes is a bug: refuse its picture
+  // a backend that fills the wrong sizes is a bug: refuse its picture; outputs not asked for
+  // are dropped whatever the backend filled
+  internal::KeepOutputs(outputs, picture.get());
   size_t n = static_cast<size_t>(c.width) * static_cast<size_t>(c.height);
-  if (picture->width != c.width || picture->height != c.height || picture->color.size() != 4 * n ||
-      picture->albedo.size() != 4 * n || picture->normal.size() != 4 * n ||
-      picture->position.size() != 4 * n || picture->segmentation.size() != 2 * n) {
+  auto sized = [&](const auto& v, unsigned bit, size_t channels) {
+    return !(outputs & bit) || v.size() == channels * n;
+  };
+  if (picture->width != c.width || picture->height != c.height ||
+      !sized(picture->color, kColor, 4) || !sized(picture->albedo, kAlbedo, 4) ||
+      !sized(picture->normal, kNormal, 4) || !sized(picture->position, kPosition, 4) ||
+      !sized(picture->segmentation, kSegmentation, 2)) {
     if (picture == c.picture) c.picture.reset();
     throw Error("camera '" + c.name + "': backend '" + backend.Name() +
                 "' returned a picture of the wrong size");
@@ -192,7 +236,7 @@ const std::vector<float>& Camera::GetFloatPicture(const std::string& name) const
   if (!IsFloatPictureName(name))
     throw Error("camera '" + c.name + "': unknown picture name '" + name +
                 "' (float pictures: Color, Albedo, Normal, Position; uint32: Segmentation)");
-  const Picture& p = PictureOf(c);
+  const Picture& p = PictureWith(c, PictureOutputFromName(name), name.c_str());
   if (name == "Color") return p.color;
   if (name == "Albedo") return p.albedo;
   if (name == "Normal") return p.normal;
@@ -204,12 +248,16 @@ const std::vector<uint32_t>& Camera::GetUintPicture(const std::string& name) con
   if (name != "Segmentation")
     throw Error("camera '" + c.name + "': unknown picture name '" + name +
                 "' (uint32 pictures: Segmentation; float: Color, Albedo, Normal, Position)");
-  return PictureOf(c).segmentation;
+  return PictureWith(c, kSegmentation, "Segmentation").segmentation;
 }
 
-std::vector<uint8_t> Camera::GetColorRGBA8() const { return ToRgba8(GetPictureData().color); }
+std::vector<uint8_t> Camera::GetColorRGBA8() const {
+  return ToRgba8(PictureWith(Entry(scene_, id_), kColor, "Color").color);
+}
 
-std::vector<float> Camera::GetDepth() const { return DepthImage(GetPictureData()); }
+std::vector<float> Camera::GetDepth() const {
+  return DepthImage(PictureWith(Entry(scene_, id_), kPosition, "Position"));
+}
 
 CameraParams Camera::GetParams() const {
   const SceneImpl::CameraEntry& c = Entry(scene_, id_);

@@ -73,22 +73,4 @@ struct Image8 {
 /// naming the file when it is missing or cannot be decoded.
 Image8 LoadImageRgba8(const std::string& path);
 
-/// Which outputs the rasterizer reads back (all by default). Only benchmarks change it, to compare
-/// like for like with a program that reads back less; bits of ReadbackOutput.
-enum ReadbackOutput : unsigned {
-  kReadColor = 1,
-  kReadAlbedo = 2,
-  kReadNormal = 4,
-  kReadPosition = 8,
-  kReadSegmentation = 16,
-  kReadAll = 31,
-};
-
-class RasterBackendControl {
- public:
-  virtual ~RasterBackendControl() = default;
-  /// Restricts read back to `mask` (ReadbackOutput bits); outputs not read keep old contents.
-  virtual void SetReadbackMask(unsigned mask) = 0;
-};
-
 }  // namespace partsim::internal

@@ -50,11 +50,18 @@ void CheckSize(const char* what, int width, int height) {
                 std::to_string(width) + " x " + std::to_string(height));
 }
 
-void CheckPicture(const char* what, const Picture& p) {
+// checks that the picture holds the outputs in `needs` (PictureOutput bits) at its size
+void CheckPicture(const char* what, const Picture& p, unsigned needs) {
   CheckSize(what, p.width, p.height);
+  if ((p.outputs & needs) != needs)
+    throw Error(std::string(what) + ": needs picture output(s) " + PictureOutputNames(needs) +
+                ", but the picture was taken with " + PictureOutputNames(p.outputs));
   size_t n = static_cast<size_t>(p.width) * static_cast<size_t>(p.height);
-  if (p.color.size() != 4 * n || p.normal.size() != 4 * n || p.position.size() != 4 * n ||
-      p.segmentation.size() != 2 * n)
+  auto bad = [&](const auto& v, unsigned bit, size_t channels) {
+    return (needs & bit) && v.size() != channels * n;
+  };
+  if (bad(p.color, kColor, 4) || bad(p.normal, kNormal, 4) || bad(p.position, kPosition, 4) ||
+      bad(p.segmentation, kSegmentation, 2))
     throw Error(std::string(what) + ": picture buffers do not match its size " +
                 std::to_string(p.width) + " x " + std::to_string(p.height));
 }
@@ -137,7 +144,10 @@ std::vector<float> DepthImage(const Picture& picture) {
 }
 
 PointCloud MakePointCloud(const Picture& picture, PointCloudFrame frame, const Pose& X_WC) {
-  CheckPicture("point_cloud", picture);
+  CheckPicture("point_cloud", picture, kPosition);
+  // colours and ids when the picture has them
+  bool has_color = (picture.outputs & kColor) && !picture.color.empty();
+  bool has_ids = (picture.outputs & kSegmentation) && !picture.segmentation.empty();
   // world from OpenGL camera frame
   Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
   Eigen::Vector3f t = Eigen::Vector3f::Zero();
@@ -147,7 +157,9 @@ PointCloud MakePointCloud(const Picture& picture, PointCloudFrame frame, const P
     t = X_WC.p.cast<float>();
   }
   size_t n = static_cast<size_t>(picture.width) * static_cast<size_t>(picture.height);
-  std::vector<uint8_t> rgba = ToRgba8(picture.color);
+  std::vector<uint8_t> rgba = has_color ? ToRgba8(picture.color) : std::vector<uint8_t>();
+  if (has_color && rgba.size() != 4 * n) has_color = false;
+  if (has_ids && picture.segmentation.size() != 2 * n) has_ids = false;
   PointCloud cloud;
   // pixels that see a surface have a depth > 0
   for (size_t i = 0; i < n; ++i) {
@@ -156,9 +168,12 @@ PointCloud MakePointCloud(const Picture& picture, PointCloudFrame frame, const P
                       picture.position[4 * i + 2]);
     p = R * p + t;
     cloud.positions.insert(cloud.positions.end(), {p.x(), p.y(), p.z()});
-    cloud.colors.insert(cloud.colors.end(), rgba.begin() + 4 * i, rgba.begin() + 4 * i + 4);
-    cloud.visual_ids.push_back(picture.segmentation[2 * i]);
-    cloud.entity_ids.push_back(picture.segmentation[2 * i + 1]);
+    if (has_color)
+      cloud.colors.insert(cloud.colors.end(), rgba.begin() + 4 * i, rgba.begin() + 4 * i + 4);
+    if (has_ids) {
+      cloud.visual_ids.push_back(picture.segmentation[2 * i]);
+      cloud.entity_ids.push_back(picture.segmentation[2 * i + 1]);
+    }
   }
   return cloud;
 }
@@ -245,7 +260,7 @@ void WritePng16(const std::string& path, int width, int height, const uint16_t* 
 }
 
 void WriteColorPng(const std::string& path, const Picture& picture) {
-  CheckPicture("write_color_png", picture);
+  CheckPicture("write_color_png", picture, kColor);
   std::vector<uint8_t> rgba = ToRgba8(picture.color);
   WritePng(path, picture.width, picture.height, 4, rgba.data());
 }
@@ -263,13 +278,13 @@ void WriteDepthPng(const std::string& path, int width, int height, const float* 
 }
 
 void WriteDepthPng(const std::string& path, const Picture& picture) {
-  CheckPicture("write_depth_png", picture);
+  CheckPicture("write_depth_png", picture, kPosition);
   std::vector<float> depth = DepthImage(picture);
   WriteDepthPng(path, picture.width, picture.height, depth.data());
 }
 
 void WriteNormalPng(const std::string& path, const Picture& picture) {
-  CheckPicture("write_normal_png", picture);
+  CheckPicture("write_normal_png", picture, kNormal | kPosition);
   size_t n = static_cast<size_t>(picture.width) * static_cast<size_t>(picture.height);
   std::vector<uint8_t> rgb(3 * n, 0);
   for (size_t i = 0; i < n; ++i) {
@@ -297,7 +312,7 @@ void WriteSegmentationPng(const std::string& path, int width, int height, const 
 }
 
 void WriteSegmentationPng(const std::string& path, const Picture& picture, int channel) {
-  CheckPicture("write_segmentation_png", picture);
+  CheckPicture("write_segmentation_png", picture, kSegmentation);
   if (channel != 0 && channel != 1)
     throw Error(
         "write_segmentation_png: channel must be 0 (visual ids) or 1 (actor/link ids), "

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "partsim/render/backend.h"
+#include "render/picture_internal.h"
 
 namespace partsim {
 namespace {
@@ -14,7 +15,8 @@ class NullBackend : public RenderBackend {
   std::string Name() const override { return "null"; }
   std::string Device() const override { return "none (null backend: renders nothing)"; }
 
-  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out) override {
+  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
+              unsigned outputs = kAllOutputs) override {
     size_t n = static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height);
     out->width = camera.width;
     out->height = camera.height;
@@ -25,6 +27,7 @@ class NullBackend : public RenderBackend {
     }
     out->segmentation.resize(2 * n);
     std::fill(out->segmentation.begin(), out->segmentation.end(), 0u);
+    internal::KeepOutputs(outputs, out);
   }
 };
 

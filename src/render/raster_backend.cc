@@ -7,8 +7,16 @@
 //   3. lighting pass: a full-screen triangle reads the G-buffer and shades every pixel
 //      (Oren-Nayar diffuse + GGX specular, ambient, directional, point and spot lights, PCF
 //      shadows) into the colour target.
-// Then glReadPixels copies each target into the Picture. The projection is flipped vertically so
-// that framebuffer row 0 is the top row of the image: the read-back needs no flip.
+// Then glReadPixels copies each target asked for into the Picture.
+// Pictures that ask only for Color and Position (with the built-in shaders) take a forward path
+// instead of steps 2 and 3: one pass draws every instance with the G-buffer vertex shader and a
+// fragment shader that computes the G-buffer's material inputs and shades them with the lighting
+// pass's code, writing the lit colour and the depth buffer; Position is rebuilt from the depth
+// buffer and the projection on the CPU. This spares the five-target G-buffer and the full-screen
+// pass. (A second float target for the view depth made the pass markedly slower on llvmpipe:
+// bench/README.md.)
+// The projection is flipped vertically so that framebuffer row 0 is the top row of the image:
+// the read-back needs no flip.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -21,6 +29,7 @@
 #include "partsim/core/error.h"
 #include "partsim/render/backend.h"
 #include "render/gl_util.h"
+#include "render/picture_internal.h"
 
 namespace partsim {
 namespace {
@@ -85,17 +94,13 @@ void main() {
 }
 )";
 
-// the built-in lighting pass; "#version 450 core" and "#define LIGHTS ..." go before it: one
-// Light(index, type, shadow layer) call per light with literal arguments, so that the compiler
-// drops the branches a light does not need (software rasterizers run both sides of a branch)
-const char* kLightingFragment = R"(
+// the shading shared by the lighting pass and the forward pass; "#version 450 core" and
+// "#define LIGHTS ..." go before it: one Light(index, type, shadow layer) call per light with
+// literal arguments, so that the compiler drops the branches a light does not need (software
+// rasterizers run both sides of a branch)
+const char* kShading = R"(
 #define MAX_LIGHTS 32
 #define MAX_SHADOWS 4
-uniform sampler2D u_albedo;
-uniform sampler2D u_normal;
-uniform sampler2D u_position;
-uniform usampler2D u_segmentation;
-uniform sampler2D u_material;
 uniform sampler2DArrayShadow u_shadow_maps;
 uniform vec3 u_ambient;
 uniform int u_num_lights;
@@ -107,7 +112,6 @@ uniform vec2 u_light_cos_cone[MAX_LIGHTS];   // spot: cos(inner), cos(outer)
 uniform int u_light_shadow[MAX_LIGHTS];      // shadow map layer, -1 for none
 uniform mat4 u_shadow_matrix[MAX_SHADOWS];   // OpenGL camera frame -> shadow map [0,1]^3
 uniform vec2 u_shadow_texel[MAX_SHADOWS];    // texel size (m) = x + y * distance to the light
-layout(location = 0) out vec4 o_color;
 
 const float PI = 3.14159265358979;
 
@@ -167,19 +171,15 @@ vec3 Light(int i, int type, int layer) {
   return (diffuse + specular) * (n_l * attenuation) * u_light_color[i];
 }
 
-void main() {
-  ivec2 px = ivec2(gl_FragCoord.xy);
-  vec4 position = texelFetch(u_position, px, 0);
-  if (position.w <= 0.0) {  // background
-    o_color = vec4(0.0);
-    return;
-  }
-  albedo = texelFetch(u_albedo, px, 0).rgb;
-  n = normalize(texelFetch(u_normal, px, 0).xyz);
-  vec4 material = texelFetch(u_material, px, 0);
-  float roughness = clamp(material.x, 0.05, 1.0);
-  metallic = clamp(material.y, 0.0, 1.0);
-  p = position.xyz;
+// lit colour of a surface point: albedo (linear RGB), unit normal and position (OpenGL camera
+// frame), roughness and metallic as the G-buffer stores them
+vec3 Shade(vec3 surface_albedo, vec3 normal, vec3 position, float surface_roughness,
+           float surface_metallic) {
+  albedo = surface_albedo;
+  n = normal;
+  float roughness = clamp(surface_roughness, 0.05, 1.0);
+  metallic = clamp(surface_metallic, 0.0, 1.0);
+  p = position;
   v = normalize(-p);
   n_v = max(dot(n, v), 1e-4);
   float sigma2 = roughness * roughness;
@@ -192,7 +192,54 @@ void main() {
   // ambient: a uniform environment of radiance u_ambient, unoccluded
   vec3 color = albedo * u_ambient * (1.0 - metallic) + f0 * u_ambient * metallic;
   LIGHTS
-  o_color = vec4(clamp(color, 0.0, 1.0), 1.0);
+  return clamp(color, 0.0, 1.0);
+}
+)";
+
+// the built-in lighting pass: kShading, then this
+const char* kLightingMain = R"(
+uniform sampler2D u_albedo;
+uniform sampler2D u_normal;
+uniform sampler2D u_position;
+uniform usampler2D u_segmentation;
+uniform sampler2D u_material;
+layout(location = 0) out vec4 o_color;
+void main() {
+  ivec2 px = ivec2(gl_FragCoord.xy);
+  vec4 position = texelFetch(u_position, px, 0);
+  if (position.w <= 0.0) {  // background
+    o_color = vec4(0.0);
+    return;
+  }
+  vec4 material = texelFetch(u_material, px, 0);
+  o_color = vec4(Shade(texelFetch(u_albedo, px, 0).rgb, normalize(texelFetch(u_normal, px, 0).xyz),
+                       position.xyz, material.x, material.y),
+                 1.0);
+}
+)";
+
+// the forward pass's fragment shader (after kGbufferVertex): kShading, then this. The material
+// inputs are those kGbufferFragment writes, roughness and metallic rounded to 8 bits as its
+// RGBA8 target stores them, so that both paths shade the same numbers.
+const char* kForwardMain = R"(
+in vec3 v_position;
+in vec3 v_normal;
+in vec2 v_uv;
+uniform vec4 u_base_color;   // linear RGBA
+uniform float u_roughness;
+uniform float u_metallic;
+uniform bool u_has_texture;
+uniform sampler2D u_diffuse;  // sRGB texture, sampled as linear
+layout(location = 0) out vec4 o_color;
+float Unorm8(float x) { return round(clamp(x, 0.0, 1.0) * 255.0) / 255.0; }
+void main() {
+  vec4 surface_albedo = u_base_color;
+  if (u_has_texture) surface_albedo *= texture(u_diffuse, v_uv);
+  vec3 normal = normalize(v_normal);
+  if (!gl_FrontFacing) normal = -normal;  // two-sided: thin surfaces seen from behind
+  o_color = vec4(Shade(surface_albedo.rgb, normalize(normal), v_position, Unorm8(u_roughness),
+                       Unorm8(u_metallic)),
+                 1.0);
 }
 )";
 
@@ -228,6 +275,15 @@ struct LightingLocations {
   GLint ambient = -1, num_lights = -1, light_type = -1, light_color = -1, light_position = -1,
         light_direction = -1, light_cos_cone = -1, light_shadow = -1, shadow_matrix = -1,
         shadow_texel = -1;
+};
+
+// the lights of a picture in the OpenGL camera frame, and the program defines for them
+struct LightUniforms {
+  int n = 0;
+  std::array<GLint, kMaxLights> type{}, shadow{};
+  std::array<Eigen::Vector3f, kMaxLights> color, position, direction;
+  std::array<Eigen::Vector2f, kMaxLights> cone;
+  std::string defines;  // "#define LIGHTS ..." and a newline
 };
 
 // texture units of the lighting pass
@@ -280,7 +336,7 @@ Eigen::Matrix4d Perspective(double fovy, double n, double f) {
   return p;
 }
 
-class RasterBackend final : public RenderBackend, public internal::RasterBackendControl {
+class RasterBackend final : public RenderBackend {
  public:
   explicit RasterBackend(const RasterOptions& options) : options_(options) {
     if (options_.shadow_map_size < 16 || options_.shadow_map_size > 16384) {
@@ -318,9 +374,8 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
 
   std::string Name() const override { return "rasterizer"; }
   std::string Device() const override { return context_->Renderer(); }
-  void SetReadbackMask(unsigned mask) override { readback_mask_ = mask; }
-
-  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out) override {
+  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
+              unsigned outputs = kAllOutputs) override {
     internal::CurrentContextScope current(*context_);
     EnsureTargets(camera.width, camera.height);
     SyncResources(world);
@@ -343,13 +398,32 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
       if (!box.isEmpty()) scene_box.extend(box);
     }
 
-    int num_shadows = RenderShadowMaps(world, camera, scene_box);
-    RenderGbuffer(world, camera);
-    RenderLighting(world, camera, num_shadows);
-    ReadBack(camera.width, camera.height, out);
+    // shadows and lights only matter for colour
+    int num_shadows = 0;
+    if (outputs & kColor) {
+      num_shadows = RenderShadowMaps(world, camera, scene_box);
+    } else {
+      shadow_layer_.assign(world.lights.size(), -1);
+    }
+    LightUniforms lights = PrepareLights(world, camera);
+    if (UsesForwardPath(outputs)) {
+      RenderForward(world, camera, lights, num_shadows);
+      ReadBackForward(camera, outputs, out);
+    } else {
+      RenderGbuffer(world, camera);
+      if (outputs & kColor) RenderLighting(world, lights, num_shadows);
+      ReadBack(camera.width, camera.height, outputs, out);
+    }
   }
 
  private:
+  // the forward path: only Color and Position asked for, and the built-in shaders
+  bool UsesForwardPath(unsigned outputs) const {
+    return (outputs & ~unsigned{kColor | kPosition}) == 0 &&
+           options_.gbuffer_vertex_shader.empty() && options_.gbuffer_fragment_shader.empty() &&
+           options_.lighting_fragment_shader.empty();
+  }
+
   void BuildPrograms() {
     bool custom_vs = !options_.gbuffer_vertex_shader.empty();
     bool custom_fs = !options_.gbuffer_fragment_shader.empty();
@@ -363,19 +437,69 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
     LightingProgram(custom_ls ? "" : "#define LIGHTS\n");
     shadow_program_ = internal::BuildProgram("shadow", kShadowVertex, "built-in", "", "none");
 
-    auto g = [&](const char* name) { return glGetUniformLocation(gbuffer_program_, name); };
-    gl_.model_view = g("u_model_view");
-    gl_.normal_matrix = g("u_normal_matrix");
-    gl_.projection = g("u_projection");
-    gl_.base_color = g("u_base_color");
-    gl_.roughness = g("u_roughness");
-    gl_.metallic = g("u_metallic");
-    gl_.has_texture = g("u_has_texture");
-    gl_.diffuse = g("u_diffuse");
-    gl_.ids = g("u_ids");
-    if (gl_.diffuse >= 0) glProgramUniform1i(gbuffer_program_, gl_.diffuse, 0);
-
+    gl_ = GbufferUniforms(gbuffer_program_);
     shadow_mvp_ = glGetUniformLocation(shadow_program_, "u_mvp");
+  }
+
+  // locations of the G-buffer pass's uniforms in `program`; the diffuse texture on unit 0
+  static GbufferLocations GbufferUniforms(GLuint program) {
+    GbufferLocations out;
+    auto g = [&](const char* name) { return glGetUniformLocation(program, name); };
+    out.model_view = g("u_model_view");
+    out.normal_matrix = g("u_normal_matrix");
+    out.projection = g("u_projection");
+    out.base_color = g("u_base_color");
+    out.roughness = g("u_roughness");
+    out.metallic = g("u_metallic");
+    out.has_texture = g("u_has_texture");
+    out.diffuse = g("u_diffuse");
+    out.ids = g("u_ids");
+    if (out.diffuse >= 0) glProgramUniform1i(program, out.diffuse, 0);
+    return out;
+  }
+
+  // locations of the lighting uniforms in `program`; samplers bound to their units
+  static LightingLocations LightingUniforms(GLuint program) {
+    LightingLocations out;
+    auto l = [&](const char* name) { return glGetUniformLocation(program, name); };
+    out.ambient = l("u_ambient");
+    out.num_lights = l("u_num_lights");
+    out.light_type = l("u_light_type");
+    out.light_color = l("u_light_color");
+    out.light_position = l("u_light_position");
+    out.light_direction = l("u_light_direction");
+    out.light_cos_cone = l("u_light_cos_cone");
+    out.light_shadow = l("u_light_shadow");
+    out.shadow_matrix = l("u_shadow_matrix");
+    out.shadow_texel = l("u_shadow_texel");
+    const std::pair<const char*, GLint> samplers[] = {
+        {"u_albedo", kUnitAlbedo},     {"u_normal", kUnitNormal},
+        {"u_position", kUnitPosition}, {"u_segmentation", kUnitSegmentation},
+        {"u_material", kUnitMaterial}, {"u_shadow_maps", kUnitShadow}};
+    for (const auto& [name, unit] : samplers) {
+      GLint loc = l(name);
+      if (loc >= 0) glProgramUniform1i(program, loc, unit);
+    }
+    return out;
+  }
+
+  // the forward program for a set of lights (`defines`, as for the lighting pass), compiled on
+  // first use
+  struct Forward {
+    GLuint program = 0;
+    GbufferLocations gbuffer;
+    LightingLocations lighting;
+  };
+  const Forward& ForwardProgram(const std::string& defines) {
+    auto it = forward_.find(defines);
+    if (it != forward_.end()) return it->second;
+    Forward out;
+    out.program = internal::BuildProgram(
+        "forward", kGbufferVertex, "built-in",
+        std::string("#version 450 core\n") + defines + kShading + kForwardMain, "built-in");
+    out.gbuffer = GbufferUniforms(out.program);
+    out.lighting = LightingUniforms(out.program);
+    return forward_.emplace(defines, out).first->second;
   }
 
   // the lighting program for a set of lights (`defines`, after the #version line), compiled on
@@ -393,27 +517,9 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
     out.program = internal::BuildProgram(
         "lighting", kFullscreenVertex, "built-in",
         custom ? options_.lighting_fragment_shader
-               : std::string("#version 450 core\n") + defines + kLightingFragment,
+               : std::string("#version 450 core\n") + defines + kShading + kLightingMain,
         custom ? "custom RasterOptions::lighting_fragment_shader" : "built-in");
-    auto l = [&](const char* name) { return glGetUniformLocation(out.program, name); };
-    out.loc.ambient = l("u_ambient");
-    out.loc.num_lights = l("u_num_lights");
-    out.loc.light_type = l("u_light_type");
-    out.loc.light_color = l("u_light_color");
-    out.loc.light_position = l("u_light_position");
-    out.loc.light_direction = l("u_light_direction");
-    out.loc.light_cos_cone = l("u_light_cos_cone");
-    out.loc.light_shadow = l("u_light_shadow");
-    out.loc.shadow_matrix = l("u_shadow_matrix");
-    out.loc.shadow_texel = l("u_shadow_texel");
-    const std::pair<const char*, GLint> samplers[] = {
-        {"u_albedo", kUnitAlbedo},     {"u_normal", kUnitNormal},
-        {"u_position", kUnitPosition}, {"u_segmentation", kUnitSegmentation},
-        {"u_material", kUnitMaterial}, {"u_shadow_maps", kUnitShadow}};
-    for (const auto& [name, unit] : samplers) {
-      GLint loc = l(name);
-      if (loc >= 0) glProgramUniform1i(out.program, loc, unit);
-    }
+    out.loc = LightingUniforms(out.program);
     return lighting_.emplace(key, out).first->second;
   }
 
@@ -430,6 +536,8 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
     glDeleteProgram(gbuffer_program_);
     for (auto& [key, lighting] : lighting_) glDeleteProgram(lighting.program);
     lighting_.clear();
+    for (auto& [key, forward] : forward_) glDeleteProgram(forward.program);
+    forward_.clear();
     glDeleteProgram(shadow_program_);
     shadow_maps_ = white_texture_ = shadow_fbo_ = empty_vao_ = 0;
     gbuffer_program_ = shadow_program_ = 0;
@@ -444,9 +552,10 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
   void DeleteTargets() {
     glDeleteFramebuffers(1, &gbuffer_fbo_);
     glDeleteFramebuffers(1, &color_fbo_);
+    glDeleteFramebuffers(1, &forward_fbo_);
     glDeleteTextures(static_cast<GLsizei>(targets_.size()), targets_.data());
     glDeleteTextures(1, &depth_);
-    gbuffer_fbo_ = color_fbo_ = depth_ = 0;
+    gbuffer_fbo_ = color_fbo_ = forward_fbo_ = depth_ = 0;
     targets_.fill(0);
     width_ = height_ = 0;
   }
@@ -477,9 +586,16 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
     CheckFramebuffer(gbuffer_fbo_, "G-buffer");
 
     glCreateFramebuffers(1, &color_fbo_);
-    glNamedFramebufferTexture(color_fbo_, GL_COLOR_ATTACHMENT0, targets_[kColor], 0);
+    glNamedFramebufferTexture(color_fbo_, GL_COLOR_ATTACHMENT0, targets_[kTargetColor], 0);
     glNamedFramebufferDrawBuffer(color_fbo_, GL_COLOR_ATTACHMENT0);
     CheckFramebuffer(color_fbo_, "colour");
+
+    // forward path: lit colour, the G-buffer's depth buffer
+    glCreateFramebuffers(1, &forward_fbo_);
+    glNamedFramebufferTexture(forward_fbo_, GL_COLOR_ATTACHMENT0, targets_[kTargetColor], 0);
+    glNamedFramebufferTexture(forward_fbo_, GL_DEPTH_ATTACHMENT, depth_, 0);
+    glNamedFramebufferDrawBuffer(forward_fbo_, GL_COLOR_ATTACHMENT0);
+    CheckFramebuffer(forward_fbo_, "forward");
     width_ = width;
     height_ = height;
   }
@@ -750,7 +866,7 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
     const GLuint uzeros[4] = {0, 0, 0, 0};
     const float one = 1.0f;
     for (int i = 0; i < kNumGbuffer; ++i) {
-      if (i == kSegmentation) {
+      if (i == kTargetSegmentation) {
         glClearNamedFramebufferuiv(gbuffer_fbo_, GL_COLOR, i, uzeros);
       } else {
         glClearNamedFramebufferfv(gbuffer_fbo_, GL_COLOR, i, zeros);
@@ -765,11 +881,22 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
     // the vertical flip of the projection reverses the winding of front faces
     glFrontFace(GL_CW);
     glUseProgram(gbuffer_program_);
+    DrawInstances(world, camera, gl_);
+    glFrontFace(GL_CCW);
+  }
 
+  // the projection of the passes, rows flipped so that framebuffer row 0 is the image's top row
+  static Eigen::Matrix4d FlippedProjection(const CameraParams& camera) {
     Eigen::Matrix4d flip = Eigen::Matrix4d::Identity();
     flip(1, 1) = -1;
-    Eigen::Matrix4f projection = ToFloat(flip * camera.projection);
-    glUniformMatrix4fv(gl_.projection, 1, GL_FALSE, projection.data());
+    return flip * camera.projection;
+  }
+
+  // every instance with the current program (the G-buffer vertex shader's uniforms at `loc`)
+  void DrawInstances(const RenderWorld& world, const CameraParams& camera,
+                     const GbufferLocations& loc) {
+    Eigen::Matrix4f projection = ToFloat(FlippedProjection(camera));
+    glUniformMatrix4fv(loc.projection, 1, GL_FALSE, projection.data());
     // front to back (by the nearest point of each bounding box), so that the early depth test
     // spares hidden G-buffer writes
     draw_order_.clear();
@@ -788,71 +915,104 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
       Eigen::Matrix4d mv = camera.view * inst.X_WV;
       Eigen::Matrix4f mv_f = ToFloat(mv);
       Eigen::Matrix3f normal_matrix = mv.topLeftCorner<3, 3>().inverse().transpose().cast<float>();
-      glUniformMatrix4fv(gl_.model_view, 1, GL_FALSE, mv_f.data());
-      glUniformMatrix3fv(gl_.normal_matrix, 1, GL_FALSE, normal_matrix.data());
-      glUniform4fv(gl_.base_color, 1, inst.material.base_color.data());
-      glUniform1f(gl_.roughness, inst.material.roughness);
-      glUniform1f(gl_.metallic, inst.material.metallic);
+      glUniformMatrix4fv(loc.model_view, 1, GL_FALSE, mv_f.data());
+      glUniformMatrix3fv(loc.normal_matrix, 1, GL_FALSE, normal_matrix.data());
+      glUniform4fv(loc.base_color, 1, inst.material.base_color.data());
+      glUniform1f(loc.roughness, inst.material.roughness);
+      glUniform1f(loc.metallic, inst.material.metallic);
       GLuint tex = draw_textures_[i];
-      glUniform1i(gl_.has_texture, tex != 0);
+      glUniform1i(loc.has_texture, tex != 0);
       if (tex != bound_texture) {
         glBindTextureUnit(0, tex != 0 ? tex : white_texture_);
         bound_texture = tex;
       }
-      glUniform2ui(gl_.ids, inst.visual_id, inst.entity_id);
+      glUniform2ui(loc.ids, inst.visual_id, inst.entity_id);
       glBindVertexArray(mesh->vao);
       glDrawElements(GL_TRIANGLES, mesh->index_count, GL_UNSIGNED_INT, nullptr);
     }
+  }
+
+  // the forward path: every instance shaded straight into the colour target and depth buffer
+  void RenderForward(const RenderWorld& world, const CameraParams& camera,
+                     const LightUniforms& lights, int num_shadows) {
+    glBindFramebuffer(GL_FRAMEBUFFER, forward_fbo_);
+    glViewport(0, 0, camera.width, camera.height);
+    const float zeros[4] = {0, 0, 0, 0};
+    const float one = 1.0f;
+    glClearNamedFramebufferfv(forward_fbo_, GL_COLOR, 0, zeros);
+    glClearNamedFramebufferfv(forward_fbo_, GL_DEPTH, 0, &one);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glFrontFace(GL_CW);  // the flipped projection, as in the G-buffer pass
+    const Forward& forward = ForwardProgram(lights.defines);
+    glUseProgram(forward.program);
+    EnsureShadowMaps();  // the sampler needs a texture even without shadows
+    glBindTextureUnit(kUnitShadow, shadow_maps_);
+    UploadLights(forward.lighting, world, lights, num_shadows);
+    DrawInstances(world, camera, forward.gbuffer);
     glFrontFace(GL_CCW);
   }
 
-  void RenderLighting(const RenderWorld& world, const CameraParams& camera, int num_shadows) {
-    glBindFramebuffer(GL_FRAMEBUFFER, color_fbo_);
-    glViewport(0, 0, camera.width, camera.height);
-    glDisable(GL_DEPTH_TEST);
-    glDepthMask(GL_FALSE);
-    for (int u = 0; u < kNumGbuffer; ++u) glBindTextureUnit(u, targets_[u]);
-    EnsureShadowMaps();  // the sampler needs a texture even without shadows
-    glBindTextureUnit(kUnitShadow, shadow_maps_);
-
-    // lights into the OpenGL camera frame
+  LightUniforms PrepareLights(const RenderWorld& world, const CameraParams& camera) const {
+    LightUniforms out;
     int n = std::min<int>(static_cast<int>(world.lights.size()), kMaxLights);
-    std::array<GLint, kMaxLights> type{}, shadow{};
-    std::array<Eigen::Vector3f, kMaxLights> color, position, direction;
-    std::array<Eigen::Vector2f, kMaxLights> cone;
+    out.n = n;
     Eigen::Matrix3d R_GW = camera.view.topLeftCorner<3, 3>();
-    std::string defines = "#define LIGHTS ";
+    out.defines = "#define LIGHTS ";
     for (int i = 0; i < n; ++i) {
       const LightDesc& light = world.lights[i];
-      type[i] = light.type == LightType::kDirectional ? 0 : light.type == LightType::kPoint ? 1 : 2;
-      color[i] = light.color;
-      position[i] = (camera.view * light.position.homogeneous()).head<3>().cast<float>();
+      out.type[i] = light.type == LightType::kDirectional ? 0
+                    : light.type == LightType::kPoint     ? 1
+                                                          : 2;
+      out.color[i] = light.color;
+      out.position[i] = (camera.view * light.position.homogeneous()).head<3>().cast<float>();
       Eigen::Vector3d d = R_GW * light.direction;
-      direction[i] = (d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : d).cast<float>();
+      out.direction[i] = (d.norm() > 0 ? Eigen::Vector3d(d.normalized()) : d).cast<float>();
       double inner = std::min(light.inner_angle, light.outer_angle);
       double outer = std::max(light.outer_angle, inner + 1e-4);
-      cone[i] = Eigen::Vector2f(std::cos(inner), std::cos(outer));
-      shadow[i] = shadow_layer_[i];
-      defines += "color += Light(" + std::to_string(i) + ", " + std::to_string(type[i]) + ", " +
-                 std::to_string(shadow[i]) + "); ";
+      out.cone[i] = Eigen::Vector2f(std::cos(inner), std::cos(outer));
+      out.shadow[i] = shadow_layer_[i];
+      out.defines += "color += Light(" + std::to_string(i) + ", " + std::to_string(out.type[i]) +
+                     ", " + std::to_string(out.shadow[i]) + "); ";
     }
-    const Lighting& lighting = LightingProgram(defines + "\n");
-    const LightingLocations& loc = lighting.loc;
-    glUseProgram(lighting.program);
+    out.defines += "\n";
+    return out;
+  }
+
+  // the lights, ambient and shadow matrices into the current program's uniforms at `loc`
+  void UploadLights(const LightingLocations& loc, const RenderWorld& world,
+                    const LightUniforms& lights, int num_shadows) {
+    int n = lights.n;
     glUniform3fv(loc.ambient, 1, world.ambient.data());
     glUniform1i(loc.num_lights, n);
     if (n > 0) {
-      glUniform1iv(loc.light_type, n, type.data());
-      glUniform3fv(loc.light_color, n, color[0].data());
-      glUniform3fv(loc.light_position, n, position[0].data());
-      glUniform3fv(loc.light_direction, n, direction[0].data());
-      glUniform2fv(loc.light_cos_cone, n, cone[0].data());
-      glUniform1iv(loc.light_shadow, n, shadow.data());
+      glUniform1iv(loc.light_type, n, lights.type.data());
+      glUniform3fv(loc.light_color, n, lights.color[0].data());
+      glUniform3fv(loc.light_position, n, lights.position[0].data());
+      glUniform3fv(loc.light_direction, n, lights.direction[0].data());
+      glUniform2fv(loc.light_cos_cone, n, lights.cone[0].data());
+      glUniform1iv(loc.light_shadow, n, lights.shadow.data());
     }
     if (num_shadows > 0) {
       glUniformMatrix4fv(loc.shadow_matrix, num_shadows, GL_FALSE, shadow_matrix_[0].data());
       glUniform2fv(loc.shadow_texel, num_shadows, shadow_texel_[0].data());
     }
+  }
+
+  void RenderLighting(const RenderWorld& world, const LightUniforms& lights, int num_shadows) {
+    glBindFramebuffer(GL_FRAMEBUFFER, color_fbo_);
+    glViewport(0, 0, width_, height_);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    for (int u = 0; u < kNumGbuffer; ++u) glBindTextureUnit(u, targets_[u]);
+    EnsureShadowMaps();  // the sampler needs a texture even without shadows
+    glBindTextureUnit(kUnitShadow, shadow_maps_);
+    const Lighting& lighting = LightingProgram(lights.defines);
+    glUseProgram(lighting.program);
+    UploadLights(lighting.loc, world, lights, num_shadows);
     const float zeros[4] = {0, 0, 0, 0};
     glClearNamedFramebufferfv(color_fbo_, GL_COLOR, 0, zeros);
     glBindVertexArray(empty_vao_);
@@ -860,40 +1020,140 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
     glDepthMask(GL_TRUE);
   }
 
-  void ReadBack(int width, int height, Picture* out) {
+  // one target of `fbo` into `dst` (`bytes` long)
+  void Read(GLuint fbo, GLenum attachment, GLenum format, GLenum type, void* dst, size_t bytes) {
+    glNamedFramebufferReadBuffer(fbo, attachment);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glReadnPixels(0, 0, width_, height_, format, type, static_cast<GLsizei>(bytes), dst);
+  }
+
+  // the outputs of the forward path: colour, and Position rebuilt from the depth buffer
+  void ReadBackForward(const CameraParams& camera, unsigned outputs, Picture* out) {
+    size_t n = static_cast<size_t>(width_) * height_;
+    out->width = width_;
+    out->height = height_;
+    internal::KeepOutputs(outputs, out);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    if (outputs & kColor) {
+      out->color.resize(n * 4);
+      Read(forward_fbo_, GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, out->color.data(),
+           out->color.size() * sizeof(float));
+    }
+    if (outputs & kPosition) {
+      window_depth_.resize(n);
+      Read(forward_fbo_, GL_COLOR_ATTACHMENT0, GL_DEPTH_COMPONENT, GL_FLOAT, window_depth_.data(),
+           window_depth_.size() * sizeof(float));
+      out->position.resize(n * 4);
+      PositionFromDepth(FlippedProjection(camera), window_depth_, out->position.data());
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    GLenum err = glGetError();
+    if (err == GL_OUT_OF_MEMORY) throw Error("rasterizer: out of GPU memory");
+  }
+
+  // Position (xyz in the OpenGL camera frame, w = depth along the view axis; zeros where the
+  // depth buffer holds its clear value 1) of every pixel from its depth buffer value and the
+  // (flipped) projection P: the point whose projection is the pixel's centre at that depth,
+  // solved in double. Its error is the depth buffer's resolution, about z^2 / near * 6e-8 m
+  // (5e-6 m at 2 m with near = 0.05 m).
+  void PositionFromDepth(const Eigen::Matrix4d& P, const std::vector<float>& depth,
+                         float* position) const {
+    const int w = width_, h = height_;
+    auto ndc = [](int i, int size) { return (i + 0.5) * 2.0 / size - 1.0; };
+    auto write = [](float* out, double x, double y, double z) {
+      out[0] = static_cast<float>(x);
+      out[1] = static_cast<float>(y);
+      out[2] = static_cast<float>(z);
+      out[3] = static_cast<float>(-z);
+    };
+    bool perspective = P(3, 0) == 0 && P(3, 1) == 0 && P(2, 0) == 0 && P(2, 1) == 0;
+    if (perspective) {
+      // rows 0 and 1 of P (x, y, z, 1) equal the NDC times row 3 of P (x, y, z, 1), and row 2
+      // gives z alone: A [x y]^T = z * b1 + b0, with A constant and each b's row depending on
+      // the column (row 0) or the image row (row 1) alone
+      Eigen::Matrix2d A;
+      A << P(0, 0), P(0, 1), P(1, 0), P(1, 1);
+      Eigen::Matrix2d A_inv = A.inverse();
+      std::vector<double> c1(w), c0(w), r1(h), r0(h);
+      for (int u = 0; u < w; ++u) {
+        c1[u] = ndc(u, w) * P(3, 2) - P(0, 2);
+        c0[u] = ndc(u, w) * P(3, 3) - P(0, 3);
+      }
+      for (int v = 0; v < h; ++v) {
+        r1[v] = ndc(v, h) * P(3, 2) - P(1, 2);
+        r0[v] = ndc(v, h) * P(3, 3) - P(1, 3);
+      }
+      for (int v = 0; v < h; ++v) {
+        for (int u = 0; u < w; ++u) {
+          size_t i = static_cast<size_t>(v) * w + u;
+          float* out = position + 4 * i;
+          if (!(depth[i] < 1.0f)) {
+            out[0] = out[1] = out[2] = out[3] = 0.0f;
+            continue;
+          }
+          double z_ndc = 2.0 * depth[i] - 1.0;
+          double z = (z_ndc * P(3, 3) - P(2, 3)) / (P(2, 2) - z_ndc * P(3, 2));
+          Eigen::Vector2d xy = A_inv * Eigen::Vector2d(z * c1[u] + c0[u], z * r1[v] + r0[v]);
+          write(out, xy.x(), xy.y(), z);
+        }
+      }
+      return;
+    }
+    // any other P: a 3 x 3 solve per pixel
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        size_t i = static_cast<size_t>(v) * w + u;
+        float* out = position + 4 * i;
+        if (!(depth[i] < 1.0f)) {
+          out[0] = out[1] = out[2] = out[3] = 0.0f;
+          continue;
+        }
+        Eigen::Vector3d p_ndc(ndc(u, w), ndc(v, h), 2.0 * depth[i] - 1.0);
+        Eigen::Matrix3d A;
+        Eigen::Vector3d b;
+        for (int r = 0; r < 3; ++r) {
+          Eigen::Vector4d row = P.row(r).transpose() - p_ndc(r) * P.row(3).transpose();
+          A.row(r) = row.head<3>().transpose();
+          b(r) = -row(3);
+        }
+        Eigen::Vector3d p = A.partialPivLu().solve(b);
+        write(out, p.x(), p.y(), p.z());
+      }
+    }
+  }
+
+  // the outputs of the deferred path asked for, from the G-buffer and colour targets
+  void ReadBack(int width, int height, unsigned outputs, Picture* out) {
     size_t n = static_cast<size_t>(width) * height;
     out->width = width;
     out->height = height;
-    out->color.resize(n * 4);
-    out->albedo.resize(n * 4);
-    out->normal.resize(n * 4);
-    out->position.resize(n * 4);
-    out->segmentation.resize(n * 2);
+    internal::KeepOutputs(outputs, out);
+    if (outputs & kColor) out->color.resize(n * 4);
+    if (outputs & kAlbedo) out->albedo.resize(n * 4);
+    if (outputs & kNormal) out->normal.resize(n * 4);
+    if (outputs & kPosition) out->position.resize(n * 4);
+    if (outputs & kSegmentation) out->segmentation.resize(n * 2);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     auto read = [&](GLuint fbo, GLenum attachment, GLenum format, GLenum type, void* dst,
-                    size_t bytes) {
-      glNamedFramebufferReadBuffer(fbo, attachment);
-      glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-      glReadnPixels(0, 0, width, height, format, type, static_cast<GLsizei>(bytes), dst);
-    };
-    if (readback_mask_ & internal::kReadColor) {
+                    size_t bytes) { Read(fbo, attachment, format, type, dst, bytes); };
+    if (outputs & kColor) {
       read(color_fbo_, GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, out->color.data(),
            out->color.size() * sizeof(float));
     }
-    if (readback_mask_ & internal::kReadAlbedo) {
-      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kAlbedo, GL_RGBA, GL_FLOAT, out->albedo.data(),
-           out->albedo.size() * sizeof(float));
+    if (outputs & kAlbedo) {
+      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetAlbedo, GL_RGBA, GL_FLOAT,
+           out->albedo.data(), out->albedo.size() * sizeof(float));
     }
-    if (readback_mask_ & internal::kReadNormal) {
-      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kNormal, GL_RGBA, GL_FLOAT, out->normal.data(),
-           out->normal.size() * sizeof(float));
+    if (outputs & kNormal) {
+      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetNormal, GL_RGBA, GL_FLOAT,
+           out->normal.data(), out->normal.size() * sizeof(float));
     }
-    if (readback_mask_ & internal::kReadPosition) {
-      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kPosition, GL_RGBA, GL_FLOAT, out->position.data(),
-           out->position.size() * sizeof(float));
+    if (outputs & kPosition) {
+      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetPosition, GL_RGBA, GL_FLOAT,
+           out->position.data(), out->position.size() * sizeof(float));
     }
-    if (readback_mask_ & internal::kReadSegmentation) {
-      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kSegmentation, GL_RG_INTEGER, GL_UNSIGNED_INT,
+    if (outputs & kSegmentation) {
+      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER, GL_UNSIGNED_INT,
            out->segmentation.data(), out->segmentation.size() * sizeof(uint32_t));
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -902,21 +1162,30 @@ class RasterBackend final : public RenderBackend, public internal::RasterBackend
   }
 
   // render targets: G-buffer attachments 0..4, then the lit colour
-  enum Target { kAlbedo = 0, kNormal, kPosition, kSegmentation, kMaterial, kColor, kNumTargets };
+  enum Target {
+    kTargetAlbedo = 0,
+    kTargetNormal,
+    kTargetPosition,
+    kTargetSegmentation,
+    kTargetMaterial,
+    kTargetColor,
+    kNumTargets
+  };
   static constexpr int kNumGbuffer = 5;
 
   RasterOptions options_;
   std::unique_ptr<internal::EglContext> context_;
-  unsigned readback_mask_ = internal::kReadAll;
 
   GLuint gbuffer_program_ = 0, shadow_program_ = 0;
   GbufferLocations gl_;
   std::unordered_map<std::string, Lighting> lighting_;
+  std::unordered_map<std::string, Forward> forward_;
   GLint shadow_mvp_ = -1;
 
   int width_ = 0, height_ = 0;
   std::array<GLuint, kNumTargets> targets_{};
-  GLuint depth_ = 0, gbuffer_fbo_ = 0, color_fbo_ = 0;
+  GLuint depth_ = 0, gbuffer_fbo_ = 0, color_fbo_ = 0, forward_fbo_ = 0;
+  std::vector<float> window_depth_;  // forward path: the depth buffer read back
   GLuint empty_vao_ = 0, white_texture_ = 0;
   GLuint shadow_fbo_ = 0, shadow_maps_ = 0;
   std::array<Eigen::Matrix4f, kMaxShadows> shadow_matrix_;

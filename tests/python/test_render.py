@@ -279,3 +279,40 @@ def test_a_real_backend_sees_a_box_where_it_is(scene, backend):
     np.testing.assert_allclose(cloud["positions"][:, 0], 0.1, atol=1e-3)
     assert (cloud["entity_ids"] == crate_id).all()
     assert box.get_id() == {e.name: e.actor_id for e in scene.get_render_entities()}["crate"]
+
+
+@pytest.mark.parametrize("backend", ["null", "rasterizer"])
+def test_take_picture_of_some_outputs(scene, backend):
+    # Color and Position alone (the rasterizer's forward path): the same colour and depth as a
+    # picture of every output; the others raise naming themselves
+    scene.set_render_backend(backend)
+    build_box(scene, half=0.1, z=0.0, name="crate")
+    scene.add_directional_light([0.3, 0.2, -1], [1, 1, 1], shadow=True)
+    scene.add_point_light([1, 1, 1], [0.5, 0.5, 0.5])
+    cam = scene.add_camera("c", 32, 24, 0.8, 0.05, 10.0)
+    cam.set_pose(look_at([1.5, 0.3, 0.4], [0, 0, 0]))
+    scene.update_render()
+    cam.take_picture()
+    color, depth = cam.get_picture("Color").copy(), cam.get_depth().copy()
+    cam.take_picture(outputs=["Color", "Position"])
+    assert cam.get_picture("Color").shape == (24, 32, 4)
+    np.testing.assert_allclose(cam.get_picture("Color"), color, atol=2 / 255)
+    np.testing.assert_allclose(cam.get_depth(), depth, atol=1e-4)
+    for name in ("Normal", "Albedo", "Segmentation"):
+        with pytest.raises(partsim.PartsimError,
+                           match="picture '%s' was not taken: TakePicture was asked for "
+                                 "Color, Position" % name):
+            cam.get_picture(name)
+    cloud = partsim.get_point_cloud(cam, "camera")
+    assert cloud["positions"].shape == ((depth > 0).sum(), 3)
+    assert cloud["colors"].shape == ((depth > 0).sum(), 4)
+    assert cloud["entity_ids"].shape == (0,)
+    cam.take_picture(["Segmentation"])
+    with pytest.raises(partsim.PartsimError, match="'Position' was not taken"):
+        cam.get_depth()
+    with pytest.raises(partsim.PartsimError, match="unknown picture name 'Depth'"):
+        cam.take_picture(["Depth"])
+    with pytest.raises(partsim.PartsimError, match="at least one"):
+        cam.take_picture([])
+    cam.take_picture(None)
+    assert cam.get_picture("Normal").shape == (24, 32, 4)

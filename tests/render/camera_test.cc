@@ -7,6 +7,7 @@
 #include <random>
 
 #include "partsim/render/camera_math.h"
+#include "partsim/render/image_io.h"
 #include "render/render_test_util.h"
 
 namespace partsim {
@@ -240,6 +241,60 @@ TEST_F(CameraTest, ColorIsSrgbEncodedAndDepthIsPositionW) {
   EXPECT_FLOAT_EQ(depth[1], 1.5f);
   EXPECT_EQ(depth[0], 0.0f);
   EXPECT_EQ(cam.GetUintPicture("Segmentation")[2 * 1 + 1], 3u);
+}
+
+TEST_F(CameraTest, PictureOfSomeOutputsThrowsNamingAnOutputNotTaken) {
+  auto backend = std::make_unique<PlaneBackend>(1.5, 0.5f);
+  PlaneBackend* plane = backend.get();
+  scene_.SetRenderBackend(std::move(backend));
+  Camera cam = scene_.AddCamera("c", 6, 4, 1.0, 0.1, 10.0);
+  cam.TakePicture(kColor | kPosition);
+  // the backend was asked for the mask; what it filled beyond it is dropped
+  EXPECT_EQ(plane->last_outputs, unsigned{kColor | kPosition});
+  EXPECT_EQ(cam.GetPictureData().outputs, unsigned{kColor | kPosition});
+  EXPECT_EQ(cam.GetFloatPicture("Color").size(), 6u * 4 * 4);
+  EXPECT_EQ(cam.GetFloatPicture("Position").size(), 6u * 4 * 4);
+  EXPECT_FLOAT_EQ(cam.GetDepth()[1], 1.5f);
+  EXPECT_EQ(cam.GetColorRGBA8()[4 * 1], 188);
+  EXPECT_TRUE(cam.GetPictureData().normal.empty());
+  EXPECT_TRUE(cam.GetPictureData().segmentation.empty());
+  for (const char* name : {"Normal", "Albedo"}) {
+    try {
+      cam.GetFloatPicture(name);
+      ADD_FAILURE() << name << " did not throw";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()), std::string("camera 'c': picture '") + name +
+                                           "' was not taken: TakePicture was asked for Color, "
+                                           "Position");
+    }
+  }
+  EXPECT_THROW(cam.GetUintPicture("Segmentation"), Error);
+  // a point cloud needs Position only: colours come along, ids do not
+  PointCloud cloud = MakePointCloud(cam);
+  EXPECT_EQ(cloud.Size(), 5u * 4);  // the left column sees nothing
+  EXPECT_EQ(cloud.colors.size(), 4 * cloud.Size());
+  EXPECT_TRUE(cloud.visual_ids.empty());
+  // Position alone: colour is not there
+  cam.TakePicture(kPosition);
+  EXPECT_THROW(cam.GetColorRGBA8(), Error);
+  EXPECT_EQ(cam.GetDepth().size(), 6u * 4);
+  cam.TakePicture(kSegmentation);
+  try {
+    cam.GetDepth();
+    ADD_FAILURE() << "GetDepth did not throw";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("picture 'Position' was not taken"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("asked for Segmentation"), std::string::npos) << e.what();
+  }
+  // all outputs again by default; an empty or unknown mask is refused
+  cam.TakePicture();
+  EXPECT_EQ(cam.GetFloatPicture("Normal").size(), 6u * 4 * 4);
+  EXPECT_THROW(cam.TakePicture(0), Error);
+  EXPECT_THROW(cam.TakePicture(64), Error);
+  EXPECT_EQ(PictureOutputFromName("Segmentation"), unsigned{kSegmentation});
+  EXPECT_THROW(PictureOutputFromName("Depth"), Error);
+  EXPECT_EQ(PictureOutputNames(kAllOutputs), "Color, Albedo, Normal, Position, Segmentation");
 }
 
 TEST_F(CameraTest, SharedPictureSurvivesTheNextPicture) {

@@ -598,6 +598,132 @@ TEST(RasterTest, JpegTextureIsDecoded) {
   std::remove(path.c_str());
 }
 
+// Color and Position alone take the forward path: the same colours (within 2/255 at >= 99.5%
+// of pixels) and positions (1e-4 m) as the deferred path, under a shadowing sun, a point light
+// and a spot light, with textured and untextured materials of any roughness and metalness
+TEST(RasterTest, ForwardPathMatchesDeferredPath) {
+  std::string path = ::testing::TempDir() + "/partsim_raster_forward_texture.png";
+  std::vector<uint8_t> rgb;
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      bool odd = (x / 2 + y / 2) % 2;
+      rgb.insert(rgb.end(), {uint8_t(odd ? 220 : 40), uint8_t(odd ? 180 : 90), uint8_t(60)});
+    }
+  }
+  WriteRgbPng(path, 8, 8, rgb);
+  RenderWorld world;
+  // ground, boxes of several materials, textured quads on the ground and facing the camera
+  world.instances.push_back(Instance(Quad(2.0f), {1.5, 0, 0}, {0.9f, 0.9f, 0.9f, 1}, 1, 1));
+  world.instances[0].material.roughness = 0.83f;
+  world.instances.push_back(Instance(Quad(0.2f), {0.9, -0.4, 0.001}, {1, 1, 1, 1}, 6, 6));
+  world.instances.back().material.diffuse_texture = path;
+  const Eigen::Vector3d boxes[] = {{1.3, 0.3, 0.15}, {1.7, -0.2, 0.1}, {1.4, -0.5, 0.2}};
+  const float roughness[] = {0.12f, 0.5f, 0.937f}, metallic[] = {0.0f, 0.71f, 0.33f};
+  for (int i = 0; i < 3; ++i) {
+    float h = static_cast<float>(boxes[i].z());
+    world.instances.push_back(Instance(Box({0.12f, 0.1f, h}), boxes[i],
+                                       {0.8f - 0.2f * i, 0.3f + 0.2f * i, 0.5f, 1}, 2 + i, 2 + i));
+    world.instances.back().material.roughness = roughness[i];
+    world.instances.back().material.metallic = metallic[i];
+  }
+  world.instances.push_back(
+      Instance(Quad(0.15f), {1.9, 0.4, 0.3}, {1, 1, 1, 1}, 5, 5, FacingCamera()));
+  world.instances.back().material.diffuse_texture = path;
+  world.lights.push_back(Directional({-0.2, 0.6, -1}, true));
+  LightDesc point;
+  point.type = LightType::kPoint;
+  point.position = {1.0, 0.5, 1.0};
+  point.color = Eigen::Vector3f(1.5f, 1.2f, 1.0f);
+  world.lights.push_back(point);
+  LightDesc spot;
+  spot.type = LightType::kSpot;
+  spot.position = {1.6, -0.3, 1.2};
+  spot.direction = {0, 0.2, -1};
+  spot.color = Eigen::Vector3f::Constant(1.0f);
+  spot.shadow = true;
+  world.lights.push_back(spot);
+  world.ambient = Eigen::Vector3f::Constant(0.1f);
+  // from above and in front, the horizon in view (background pixels)
+  Pose X_WC(Eigen::Vector3d(0.2, 0.1, 0.9),
+            Eigen::Quaterniond(Eigen::AngleAxisd(0.45, Eigen::Vector3d::UnitY())));
+  CameraParams cam = Camera(160, 120, X_WC, 1.1);
+
+  Picture deferred, forward;
+  Backend().Render(world, cam, &deferred);
+  Backend().Render(world, cam, &forward, kColor | kPosition);
+  size_t n = 160 * 120;
+  EXPECT_EQ(forward.outputs, unsigned{kColor | kPosition});
+  ASSERT_EQ(forward.color.size(), 4 * n);
+  ASSERT_EQ(forward.position.size(), 4 * n);
+  EXPECT_TRUE(forward.albedo.empty());
+  EXPECT_TRUE(forward.normal.empty());
+  EXPECT_TRUE(forward.segmentation.empty());
+  size_t close = 0, surface = 0, background = 0, lit = 0;
+  double max_position_error = 0;
+  for (size_t i = 0; i < n; ++i) {
+    float diff = 0;
+    for (int k = 0; k < 4; ++k)
+      diff = std::max(diff, std::abs(forward.color[4 * i + k] - deferred.color[4 * i + k]));
+    close += diff <= 2.0f / 255;
+    for (int k = 0; k < 4; ++k) {
+      max_position_error =
+          std::max(max_position_error, static_cast<double>(std::abs(forward.position[4 * i + k] -
+                                                                    deferred.position[4 * i + k])));
+    }
+    bool seen = deferred.position[4 * i + 3] > 0;
+    surface += seen;
+    background += !seen;
+    lit += seen && deferred.color[4 * i] > 0.2f;
+  }
+  // the scene fills most of the picture, with sky above the horizon and lit surfaces
+  EXPECT_GT(surface, n / 2);
+  EXPECT_GT(background, n / 20);
+  EXPECT_GT(lit, n / 10);
+  EXPECT_GE(close, static_cast<size_t>(0.995 * n)) << n - close << " pixels differ by > 2/255";
+  EXPECT_LT(max_position_error, 1e-4);
+  // the sun's shadow is there: the first box's top centre shadows the ground at
+  // (1.3, 0.3) + 0.3 (-0.2, 0.6)
+  size_t shade = Pixel(deferred, Project(cam, {1.24, 0.48, 0.0}));
+  size_t sunny = Pixel(deferred, Project(cam, {1.0, 0.0, 0.0}));
+  EXPECT_LT(forward.color[4 * shade + 1], 0.6f * forward.color[4 * sunny + 1]);
+
+  // any other output takes the deferred path, which renders only what was asked for
+  Picture some;
+  Backend().Render(world, cam, &some, kColor | kNormal);
+  EXPECT_EQ(some.color, deferred.color);
+  EXPECT_EQ(some.normal, deferred.normal);
+  EXPECT_TRUE(some.position.empty());
+  EXPECT_TRUE(some.albedo.empty());
+  // and all outputs again after a forward picture
+  Picture again;
+  Backend().Render(world, cam, &again);
+  EXPECT_EQ(again.color, deferred.color);
+  EXPECT_EQ(again.segmentation, deferred.segmentation);
+  std::remove(path.c_str());
+}
+
+TEST(RasterTest, CustomShadersKeepTheDeferredPathForColorAndPosition) {
+  // a custom lighting pass that paints every surface green: Color + Position still runs it
+  RasterOptions options;
+  options.lighting_fragment_shader = R"(#version 450 core
+uniform sampler2D u_position;
+layout(location = 0) out vec4 o_color;
+void main() {
+  vec4 p = texelFetch(u_position, ivec2(gl_FragCoord.xy), 0);
+  o_color = p.w > 0.0 ? vec4(0.0, 1.0, 0.0, 1.0) : vec4(0.0);
+}
+)";
+  std::unique_ptr<RenderBackend> custom = MakeRasterBackend(options);
+  RenderWorld world;
+  world.instances.push_back(Instance(Box({0.2f, 0.2f, 0.2f}), {1, 0, 0}, {1, 0, 0, 1}, 1, 1));
+  CameraParams cam = Camera(32, 32);
+  Picture pic;
+  custom->Render(world, cam, &pic, kColor | kPosition);
+  size_t centre = 16 * 32 + 16;
+  EXPECT_EQ(Rgba(pic.color, centre), Eigen::Vector4f(0, 1, 0, 1));
+  EXPECT_NEAR(pic.position[4 * centre + 3], 0.8, 1e-4);
+}
+
 TEST(RasterTest, ManyInstancesAndBackends) {
   // a grid of 400 boxes with their own ids, rendered by two backends in turn
   RenderWorld world;

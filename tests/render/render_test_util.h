@@ -87,8 +87,11 @@ class PlaneBackend : public RenderBackend {
   explicit PlaneBackend(double depth = 2.0, float color = 0.5f) : depth_(depth), color_(color) {}
   std::string Name() const override { return "test-plane"; }
   std::string Device() const override { return "test"; }
-  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out) override {
+  // fills every output whatever `outputs` asks for (Camera::TakePicture drops the others)
+  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
+              unsigned outputs = kAllOutputs) override {
     ++renders;
+    last_outputs = outputs;
     int w = camera.width, h = camera.height;
     size_t n = static_cast<size_t>(w) * h;
     out->width = w;
@@ -119,6 +122,7 @@ class PlaneBackend : public RenderBackend {
     }
   }
   int renders = 0;
+  unsigned last_outputs = 0;  ///< `outputs` of the last Render
 
  private:
   double depth_;

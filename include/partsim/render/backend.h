@@ -62,13 +62,29 @@ struct CameraParams {
   Eigen::Matrix4d projection = Eigen::Matrix4d::Identity();  ///< OpenGL camera -> clip
 };
 
-/// The outputs of one picture, row-major, row 0 at the top of the image.
+/// Outputs of a picture, as bits of a mask (RenderBackend::Render, Camera::TakePicture).
+enum PictureOutput : unsigned {
+  kColor = 1,
+  kAlbedo = 2,
+  kNormal = 4,
+  kPosition = 8,
+  kSegmentation = 16,
+  kAllOutputs = 31,
+};
+
+/// "Color, Position": the SAPIEN names of the outputs in `outputs` (PictureOutput bits), in the
+/// order Color, Albedo, Normal, Position, Segmentation; "none" for an empty mask.
+std::string PictureOutputNames(unsigned outputs);
+
+/// The outputs of one picture, row-major, row 0 at the top of the image. Outputs not in
+/// `outputs` were not rendered and are empty (size 0).
 struct Picture {
   int width = 0;
   int height = 0;
-  std::vector<float> color;     ///< h x w x 4, lit RGBA, linear in [0, 1]
-  std::vector<float> albedo;    ///< h x w x 4, surface colour without lighting
-  std::vector<float> normal;    ///< h x w x 4, unit normal in the OpenGL camera frame, w = 0
+  unsigned outputs = kAllOutputs;  ///< PictureOutput bits of the outputs that hold data
+  std::vector<float> color;        ///< h x w x 4, lit RGBA, linear in [0, 1]
+  std::vector<float> albedo;       ///< h x w x 4, surface colour without lighting
+  std::vector<float> normal;       ///< h x w x 4, unit normal in the OpenGL camera frame, w = 0
   std::vector<float> position;  ///< h x w x 4, xyz in the OpenGL camera frame (m), w = depth (m);
                                 ///< all 0 where no surface is seen
   std::vector<uint32_t> segmentation;  ///< h x w x 2: visual id, entity id; 0 = background
@@ -82,8 +98,12 @@ class RenderBackend {
   virtual std::string Name() const = 0;
   /// A line for logs: which device renders (e.g. the GL_RENDERER string).
   virtual std::string Device() const = 0;
-  /// Fills every output of `out` (sized width x height). Arguments were validated by the caller.
-  virtual void Render(const RenderWorld& world, const CameraParams& camera, Picture* out) = 0;
+  /// Fills the outputs of `out` named by `outputs` (PictureOutput bits, sized width x height),
+  /// leaves the others empty (size 0) and sets out->outputs. Asking for less lets a backend do
+  /// less: the rasterizer renders Color and Position alone in one forward pass. Arguments were
+  /// validated by the caller.
+  virtual void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
+                      unsigned outputs = kAllOutputs) = 0;
 };
 
 /// Fills nothing but the background (for tests that need no pixels).
@@ -99,8 +119,11 @@ struct RasterOptions {
   int shadow_map_size = 2048;
 };
 
-/// OpenGL 4.5 core through headless EGL; on an NVIDIA GPU when there is one, else Mesa's CPU
-/// rasterizer. Throws partsim::Error when no EGL display can be created or a shader fails.
+/// OpenGL 4.5 core through headless EGL. Pictures that ask for no more than Color and Position
+/// (with the built-in shaders) are shaded in one forward pass, the same lighting as the deferred
+/// G-buffer + lighting passes that every other set of outputs takes; on an NVIDIA GPU when there is
+/// one, else Mesa's CPU rasterizer. Throws partsim::Error when no EGL display can be created or a
+/// shader fails.
 std::unique_ptr<RenderBackend> MakeRasterBackend(const RasterOptions& options = RasterOptions());
 
 /// Path tracer options.
@@ -111,7 +134,8 @@ struct PathTracerOptions {
   int threads = 0;             ///< 0: all cores
 };
 
-/// Physically based path tracer on Intel Embree 3.
+/// Physically based path tracer on Intel Embree 3. It traces every output whatever the mask of
+/// Render (they come from the same paths) and then drops those not asked for.
 std::unique_ptr<RenderBackend> MakePathTracerBackend(
     const PathTracerOptions& options = PathTracerOptions());
 

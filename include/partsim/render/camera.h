@@ -17,6 +17,10 @@ namespace partsim {
 /// "Position" (h x w x 4 float), "Segmentation" (h x w x 2 uint32).
 bool IsFloatPictureName(const std::string& name);
 
+/// The PictureOutput bit of a picture name ("Color" -> kColor, ...); throws partsim::Error naming
+/// `name` when it names no picture.
+unsigned PictureOutputFromName(const std::string& name);
+
 /// Handle to a camera of a scene. A camera sits in the world, or is mounted on an actor or a link
 /// and moves with it. Its pose uses x forward, y left, z up.
 class Camera {
@@ -55,13 +59,17 @@ class Camera {
   Pose GetLocalPose() const;
 
   /// Renders the scene as of the last Scene::UpdateRender() with the scene's backend.
-  void TakePicture();
+  /// `outputs` (PictureOutput bits, at least one) names the outputs to render; the others stay
+  /// empty and asking for them (GetFloatPicture, GetDepth, ...) throws. Color and Position alone
+  /// take the rasterizer's faster forward pass.
+  void TakePicture(unsigned outputs = kAllOutputs);
   /// All outputs of the last picture; throws if none was taken.
   const Picture& GetPictureData() const;
   /// The last picture, shared: it stays valid (and unchanged) after later TakePicture calls,
   /// which then render into a new Picture. Python's numpy views hold this. Throws if none.
   std::shared_ptr<const Picture> GetSharedPicture() const;
   /// One float output by name ("Color", "Albedo", "Normal", "Position"): h x w x 4 values.
+  /// Throws when the last picture did not render it.
   const std::vector<float>& GetFloatPicture(const std::string& name) const;
   /// "Segmentation": h x w x 2 (visual id, entity id).
   const std::vector<uint32_t>& GetUintPicture(const std::string& name) const;
