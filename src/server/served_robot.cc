@@ -512,7 +512,7 @@ const Camera& ServedRobot::TakePicture(size_t i) {
   if (m.pictured_at.at(i) == step) return cameras_[i].camera;
   if (m.rendered_at != step) scene_->UpdateRender();  // this step's poses, once for all cameras
   m.rendered_at = step;
-  cameras_[i].camera.TakePicture();
+  cameras_[i].camera.TakePicture(kColor | kPosition);  // what the topics carry: the fast path
   m.pictured_at[i] = step;
   return cameras_[i].camera;
 }

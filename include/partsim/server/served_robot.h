@@ -161,7 +161,8 @@ class ServedRobot {
   JointStateReading ReadJointStates() const;
   std::vector<FrameReading> ReadFrames() const;
   std::vector<CameraSensor>& GetCameras() { return cameras_; }
-  /// Camera `i` pictured at the current step: renders it unless it already was this step.
+  /// Camera `i` pictured at the current step (Color and Position: images and point clouds):
+  /// renders it unless it already was this step.
   const Camera& TakePicture(size_t i);
   /// The IMU (null when the robot has no links) and its frame.
   const Imu* GetImu() const { return imu_.get(); }
