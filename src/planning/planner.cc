@@ -143,7 +143,9 @@ double Seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void CheckOptions(const PlannerOptions& opt) {
+}  // namespace
+
+void CheckPlannerOptions(const PlannerOptions& opt) {
   if (!(opt.time_limit > 0) || !std::isfinite(opt.time_limit))
     throw Error("PlannerOptions: time_limit must be finite and > 0");
   if (!(opt.resolution > 0) || !std::isfinite(opt.resolution))
@@ -155,6 +157,8 @@ void CheckOptions(const PlannerOptions& opt) {
     throw Error("PlannerOptions: unknown algorithm '" + opt.algorithm +
                 "' (RRTConnect, RRT, RRTstar, PRM or KPIECE1)");
 }
+
+namespace {
 
 ob::PlannerPtr MakePlanner(const std::string& name, const ob::SpaceInformationPtr& si) {
   if (name == "RRT") return std::make_shared<og::RRT>(si);
@@ -271,7 +275,7 @@ bool MotionPlanner::IsStateValid(const Eigen::VectorXd& q, double clearance, std
 PlanResult MotionPlanner::PlanToJoints(const Eigen::VectorXd& goal, const PlannerOptions& options) {
   auto t0 = std::chrono::steady_clock::now();
   impl_->CheckVector(goal, "goal");
-  CheckOptions(options);
+  CheckPlannerOptions(options);
   if (!options.use_last_snapshot || !impl_->world) impl_->Snapshot();
   return impl_->Plan(goal, options, t0);
 }
@@ -366,7 +370,7 @@ PlanResult MotionPlanner::PlanToPose(const std::string& link, const Pose& tcp_of
                                      const Pose& target, const PlannerOptions& options) {
   auto t0 = std::chrono::steady_clock::now();
   Impl& p = *impl_;
-  CheckOptions(options);
+  CheckPlannerOptions(options);
   if (!target.p.allFinite() || !target.q.coeffs().allFinite())
     throw Error("MotionPlanner::PlanToPose: target is not finite");
   if (!options.use_last_snapshot || !p.world) p.Snapshot();

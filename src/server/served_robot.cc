@@ -39,7 +39,6 @@ Pose OpticalPose(const Pose& camera) {
 }  // namespace
 
 struct ServedRobot::Impl {
-  ServedRobot* self;
   SimServer* sim;
   Scene* scene;
   ControlLoop* loop;
@@ -153,7 +152,8 @@ struct ServedRobot::Impl {
       f.actual_velocity = trajectory->GetQvel();
       goal->feedback(f);
     }
-    auto worst = [&](const Eigen::VectorXd& tol, bool* bad) {
+    // the joint furthest beyond its tolerance (0: unbounded), or -1 if none is beyond
+    auto worst = [&](const Eigen::VectorXd& tol) {
       int w = -1;
       double excess = 0;
       for (Eigen::Index i = 0; i < err.size(); ++i) {
@@ -163,17 +163,15 @@ struct ServedRobot::Impl {
           w = static_cast<int>(i);
         }
       }
-      *bad = w >= 0;
       return w;
     };
     if (st.state == ControllerState::kFailed && t <= goal->end - goal->start) {
       Finish(TrajectoryOutcome::kPathToleranceViolated, st.message);
       return Hold();
     }
-    bool bad = false;
     if (t <= goal->end - goal->start) {
-      int w = worst(goal->path_tolerance, &bad);
-      if (bad) {
+      const int w = worst(goal->path_tolerance);
+      if (w >= 0) {
         std::string msg = "joint '" + joint_names[w] + "' is " + std::to_string(err[w]) +
                           " from the trajectory at t = " + std::to_string(t) +
                           " s (path tolerance " + std::to_string(goal->path_tolerance[w]) + ")";
@@ -182,8 +180,8 @@ struct ServedRobot::Impl {
       }
       return;
     }
-    int w = worst(goal->goal_tolerance, &bad);
-    if (!bad) return Finish(TrajectoryOutcome::kSucceeded, "");
+    const int w = worst(goal->goal_tolerance);
+    if (w < 0) return Finish(TrajectoryOutcome::kSucceeded, "");
     if (t > goal->end - goal->start + goal->goal_time_tolerance) {
       std::string msg = "joint '" + joint_names[w] + "' is " + std::to_string(err[w]) +
                         " from its goal " + std::to_string(goal->goal_time_tolerance) +
@@ -266,7 +264,6 @@ ServedRobot::ServedRobot(SimServer* sim, Scene* scene, ControlLoop* loop, const 
     if (!(r >= 0) || !std::isfinite(r))
       throw Error("ServedRobot: rates must be finite and >= 0 (0: every step)");
   Impl& m = *impl_;
-  m.self = this;
   m.sim = sim;
   m.scene = scene;
   m.loop = loop;
@@ -428,14 +425,11 @@ void ServedRobot::Plan(const PlanRequest& request, PlanCallback on_result, DoneC
     throw Error("plan: pose_goal must be finite with a unit quaternion");
   PlannerOptions opt = request.options;
   opt.use_last_snapshot = true;
-  // check the options now, so that a bad request fails on the caller's thread
-  static const char* known[] = {"RRTConnect", "RRT", "RRTstar", "PRM", "KPIECE1"};
-  if (!(opt.time_limit > 0) || !std::isfinite(opt.time_limit) || !(opt.resolution > 0) ||
-      !std::isfinite(opt.resolution) || !(opt.clearance >= 0) || !std::isfinite(opt.clearance) ||
-      std::find(std::begin(known), std::end(known), opt.algorithm) == std::end(known))
-    throw Error(
-        "plan: options need time_limit > 0, resolution > 0, clearance >= 0 and an algorithm of "
-        "RRTConnect, RRT, RRTstar, PRM or KPIECE1");
+  try {  // now, so that a bad request fails on the caller's thread
+    CheckPlannerOptions(opt);
+  } catch (const Error& e) {
+    throw Error(std::string("plan: ") + e.what());
+  }
   {
     std::lock_guard<std::mutex> lock(m->jobs_mutex);
     if (m->stopping) throw Error("plan: the server is shutting down");

@@ -31,6 +31,10 @@ struct PlannerOptions {
   int ik_attempts = 8;  ///< PlanToPose: IK solutions tried (from the start, then random)
 };
 
+/// Throws partsim::Error naming the first bad field: time_limit and resolution must be finite
+/// and > 0, clearance finite and >= 0, algorithm one of those listed above.
+void CheckPlannerOptions(const PlannerOptions& options);
+
 /// What a planning request produced.
 struct PlanResult {
   bool success = false;
