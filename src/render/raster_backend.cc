@@ -59,7 +59,9 @@ void main() {
 }
 )";
 
-const char* kGbufferFragment = R"(#version 450 core
+// the surface a fragment sees, as the G-buffer pass stores it and the forward pass shades it:
+// the inputs of both built-in fragment shaders ("#version 450 core" goes before it)
+const char* kSurface = R"(
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
@@ -68,6 +70,19 @@ uniform float u_roughness;
 uniform float u_metallic;
 uniform bool u_has_texture;
 uniform sampler2D u_diffuse;  // sRGB texture, sampled as linear
+vec4 SurfaceAlbedo() {
+  vec4 albedo = u_base_color;
+  if (u_has_texture) albedo *= texture(u_diffuse, v_uv);
+  return albedo;
+}
+vec3 SurfaceNormal() {
+  vec3 n = normalize(v_normal);
+  return gl_FrontFacing ? n : -n;  // two-sided: thin surfaces seen from behind
+}
+)";
+
+// the built-in G-buffer pass: kSurface, then this
+const char* kGbufferMain = R"(
 uniform uvec2 u_ids;          // visual id, entity id
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out vec4 o_normal;
@@ -75,12 +90,8 @@ layout(location = 2) out vec4 o_position;
 layout(location = 3) out uvec4 o_segmentation;
 layout(location = 4) out vec4 o_material;
 void main() {
-  vec4 albedo = u_base_color;
-  if (u_has_texture) albedo *= texture(u_diffuse, v_uv);
-  vec3 n = normalize(v_normal);
-  if (!gl_FrontFacing) n = -n;  // two-sided: thin surfaces seen from behind
-  o_albedo = albedo;
-  o_normal = vec4(n, 0.0);
+  o_albedo = SurfaceAlbedo();
+  o_normal = vec4(SurfaceNormal(), 0.0);
   o_position = vec4(v_position, -v_position.z);
   o_segmentation = uvec4(u_ids, 0u, 0u);
   o_material = vec4(u_roughness, u_metallic, 0.0, 1.0);
@@ -218,26 +229,14 @@ void main() {
 }
 )";
 
-// the forward pass's fragment shader (after kGbufferVertex): kShading, then this. The material
-// inputs are those kGbufferFragment writes, roughness and metallic rounded to 8 bits as its
-// RGBA8 target stores them, so that both paths shade the same numbers.
+// the forward pass's fragment shader (after kGbufferVertex): kShading, kSurface, then this.
+// The material inputs are those the G-buffer pass writes, roughness and metallic rounded to 8
+// bits as its RGBA8 target stores them, so that both paths shade the same numbers.
 const char* kForwardMain = R"(
-in vec3 v_position;
-in vec3 v_normal;
-in vec2 v_uv;
-uniform vec4 u_base_color;   // linear RGBA
-uniform float u_roughness;
-uniform float u_metallic;
-uniform bool u_has_texture;
-uniform sampler2D u_diffuse;  // sRGB texture, sampled as linear
 layout(location = 0) out vec4 o_color;
 float Unorm8(float x) { return round(clamp(x, 0.0, 1.0) * 255.0) / 255.0; }
 void main() {
-  vec4 surface_albedo = u_base_color;
-  if (u_has_texture) surface_albedo *= texture(u_diffuse, v_uv);
-  vec3 normal = normalize(v_normal);
-  if (!gl_FrontFacing) normal = -normal;  // two-sided: thin surfaces seen from behind
-  o_color = vec4(Shade(surface_albedo.rgb, normalize(normal), v_position, Unorm8(u_roughness),
+  o_color = vec4(Shade(SurfaceAlbedo().rgb, SurfaceNormal(), v_position, Unorm8(u_roughness),
                        Unorm8(u_metallic)),
                  1.0);
 }
@@ -431,7 +430,8 @@ class RasterBackend final : public RenderBackend {
     gbuffer_program_ = internal::BuildProgram(
         "gbuffer", custom_vs ? options_.gbuffer_vertex_shader : kGbufferVertex,
         custom_vs ? "custom RasterOptions::gbuffer_vertex_shader" : "built-in",
-        custom_fs ? options_.gbuffer_fragment_shader : kGbufferFragment,
+        custom_fs ? options_.gbuffer_fragment_shader
+                  : std::string("#version 450 core\n") + kSurface + kGbufferMain,
         custom_fs ? "custom RasterOptions::gbuffer_fragment_shader" : "built-in");
     // the built-in lighting pass is compiled for each set of lights; this one has none
     LightingProgram(custom_ls ? "" : "#define LIGHTS\n");
@@ -496,7 +496,8 @@ class RasterBackend final : public RenderBackend {
     Forward out;
     out.program = internal::BuildProgram(
         "forward", kGbufferVertex, "built-in",
-        std::string("#version 450 core\n") + defines + kShading + kForwardMain, "built-in");
+        std::string("#version 450 core\n") + defines + kShading + kSurface + kForwardMain,
+        "built-in");
     out.gbuffer = GbufferUniforms(out.program);
     out.lighting = LightingUniforms(out.program);
     return forward_.emplace(defines, out).first->second;
