@@ -24,10 +24,14 @@
 #include <cstdio>
 #include <limits>
 #include <mutex>
+#include <system_error>
+#include <thread>
 #include <unordered_map>
 
+#include "core/worker_pool.h"
 #include "partsim/core/error.h"
 #include "partsim/render/backend.h"
+#include "render/depth_to_position.h"
 #include "render/gl_util.h"
 #include "render/picture_internal.h"
 
@@ -1028,99 +1032,68 @@ class RasterBackend final : public RenderBackend {
     glReadnPixels(0, 0, width_, height_, format, type, static_cast<GLsizei>(bytes), dst);
   }
 
-  // the outputs of the forward path: colour, and Position rebuilt from the depth buffer
+  // the outputs of the forward path: colour, and Position rebuilt from the depth buffer. The
+  // depth buffer is read back first and converted on worker threads while this thread reads the
+  // colour back (on a GPU the conversion would otherwise be most of the frame's time at 512 x 512:
+  // bench/README.md).
   void ReadBackForward(const CameraParams& camera, unsigned outputs, Picture* out) {
     size_t n = static_cast<size_t>(width_) * height_;
     out->width = width_;
     out->height = height_;
     internal::KeepOutputs(outputs, out);
+    if (outputs & kColor) out->color.resize(n * 4);
+    if (outputs & kPosition) {
+      out->position.resize(n * 4);
+      window_depth_.resize(n);
+    }
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    const Eigen::Matrix4d P = FlippedProjection(camera);
+    const int parts = (outputs & kPosition) ? ConversionParts(n) : 0;
+    auto convert = [&](int part) {
+      internal::PositionFromDepth(
+          P, width_, height_, window_depth_.data(), out->position.data(),
+          static_cast<int>(static_cast<int64_t>(height_) * part / parts),
+          static_cast<int>(static_cast<int64_t>(height_) * (part + 1) / parts));
+    };
+    bool started = false;
+    if (outputs & kPosition) {
+      Read(forward_fbo_, GL_COLOR_ATTACHMENT0, GL_DEPTH_COMPONENT, GL_FLOAT, window_depth_.data(),
+           window_depth_.size() * sizeof(float));
+      if (parts > 1) {
+        try {
+          conversion_workers_.Start(parts, convert);
+          started = true;
+        } catch (const std::system_error&) {
+          // no thread to be had: this thread converts after the colour
+        }
+      }
+    }
     if (outputs & kColor) {
-      out->color.resize(n * 4);
       Read(forward_fbo_, GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, out->color.data(),
            out->color.size() * sizeof(float));
     }
-    if (outputs & kPosition) {
-      window_depth_.resize(n);
-      Read(forward_fbo_, GL_COLOR_ATTACHMENT0, GL_DEPTH_COMPONENT, GL_FLOAT, window_depth_.data(),
-           window_depth_.size() * sizeof(float));
-      out->position.resize(n * 4);
-      PositionFromDepth(FlippedProjection(camera), window_depth_, out->position.data());
+    if (started) {
+      conversion_workers_.Wait();
+    } else if (outputs & kPosition) {
+      for (int part = 0; part < parts; ++part) convert(part);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     GLenum err = glGetError();
     if (err == GL_OUT_OF_MEMORY) throw Error("rasterizer: out of GPU memory");
   }
 
-  // Position (xyz in the OpenGL camera frame, w = depth along the view axis; zeros where the
-  // depth buffer holds its clear value 1) of every pixel from its depth buffer value and the
-  // (flipped) projection P: the point whose projection is the pixel's centre at that depth,
-  // solved in double. Its error is the depth buffer's resolution, about z^2 / near * 6e-8 m
-  // (5e-6 m at 2 m with near = 0.05 m).
-  void PositionFromDepth(const Eigen::Matrix4d& P, const std::vector<float>& depth,
-                         float* position) const {
-    const int w = width_, h = height_;
-    auto ndc = [](int i, int size) { return (i + 0.5) * 2.0 / size - 1.0; };
-    auto write = [](float* out, double x, double y, double z) {
-      out[0] = static_cast<float>(x);
-      out[1] = static_cast<float>(y);
-      out[2] = static_cast<float>(z);
-      out[3] = static_cast<float>(-z);
-    };
-    bool perspective = P(3, 0) == 0 && P(3, 1) == 0 && P(2, 0) == 0 && P(2, 1) == 0;
-    if (perspective) {
-      // rows 0 and 1 of P (x, y, z, 1) equal the NDC times row 3 of P (x, y, z, 1), and row 2
-      // gives z alone: A [x y]^T = z * b1 + b0, with A constant and each b's row depending on
-      // the column (row 0) or the image row (row 1) alone
-      Eigen::Matrix2d A;
-      A << P(0, 0), P(0, 1), P(1, 0), P(1, 1);
-      Eigen::Matrix2d A_inv = A.inverse();
-      std::vector<double> c1(w), c0(w), r1(h), r0(h);
-      for (int u = 0; u < w; ++u) {
-        c1[u] = ndc(u, w) * P(3, 2) - P(0, 2);
-        c0[u] = ndc(u, w) * P(3, 3) - P(0, 3);
-      }
-      for (int v = 0; v < h; ++v) {
-        r1[v] = ndc(v, h) * P(3, 2) - P(1, 2);
-        r0[v] = ndc(v, h) * P(3, 3) - P(1, 3);
-      }
-      for (int v = 0; v < h; ++v) {
-        for (int u = 0; u < w; ++u) {
-          size_t i = static_cast<size_t>(v) * w + u;
-          float* out = position + 4 * i;
-          if (!(depth[i] < 1.0f)) {
-            out[0] = out[1] = out[2] = out[3] = 0.0f;
-            continue;
-          }
-          double z_ndc = 2.0 * depth[i] - 1.0;
-          double z = (z_ndc * P(3, 3) - P(2, 3)) / (P(2, 2) - z_ndc * P(3, 2));
-          Eigen::Vector2d xy = A_inv * Eigen::Vector2d(z * c1[u] + c0[u], z * r1[v] + r0[v]);
-          write(out, xy.x(), xy.y(), z);
-        }
-      }
-      return;
-    }
-    // any other P: a 3 x 3 solve per pixel
-    for (int v = 0; v < h; ++v) {
-      for (int u = 0; u < w; ++u) {
-        size_t i = static_cast<size_t>(v) * w + u;
-        float* out = position + 4 * i;
-        if (!(depth[i] < 1.0f)) {
-          out[0] = out[1] = out[2] = out[3] = 0.0f;
-          continue;
-        }
-        Eigen::Vector3d p_ndc(ndc(u, w), ndc(v, h), 2.0 * depth[i] - 1.0);
-        Eigen::Matrix3d A;
-        Eigen::Vector3d b;
-        for (int r = 0; r < 3; ++r) {
-          Eigen::Vector4d row = P.row(r).transpose() - p_ndc(r) * P.row(3).transpose();
-          A.row(r) = row.head<3>().transpose();
-          b(r) = -row(3);
-        }
-        Eigen::Vector3d p = A.partialPivLu().solve(b);
-        write(out, p.x(), p.y(), p.z());
-      }
-    }
+  // the parts the depth of n pixels is converted in: one below 64 x 64 (converted on this
+  // thread), else one per 16k pixels, at most twice the workers
+  int ConversionParts(size_t n) const {
+    if (n < 64 * 64) return 1;
+    return std::clamp(static_cast<int>(n / 16384), 2, 2 * conversion_workers_.size());
+  }
+
+  // threads converting the depth buffer to Position while this one reads the colour back: at most
+  // 4, one fewer than the cores
+  static int ConversionWorkers() {
+    int cores = static_cast<int>(std::thread::hardware_concurrency());
+    return std::clamp(cores - 1, 1, 4);
   }
 
   // the outputs of the deferred path asked for, from the G-buffer and colour targets
@@ -1187,6 +1160,7 @@ class RasterBackend final : public RenderBackend {
   std::array<GLuint, kNumTargets> targets_{};
   GLuint depth_ = 0, gbuffer_fbo_ = 0, color_fbo_ = 0, forward_fbo_ = 0;
   std::vector<float> window_depth_;  // forward path: the depth buffer read back
+  internal::WorkerPool conversion_workers_{ConversionWorkers()};
   GLuint empty_vao_ = 0, white_texture_ = 0;
   GLuint shadow_fbo_ = 0, shadow_maps_ = 0;
   std::array<Eigen::Matrix4f, kMaxShadows> shadow_matrix_;
