@@ -11,9 +11,10 @@
 namespace partsim::internal {
 
 /// Runs the parts of one job at a time on `threads` worker threads, started on the first job and
-/// joined by the destructor (which first waits for a job still running). Start() hands the parts out and returns at once, so that the caller
-/// can do other work; Wait() runs on the calling thread whatever parts no worker has begun, then
-/// blocks until every part is done. Not for use from several threads at once.
+/// joined by the destructor (which first waits for a job still running). Start() hands the parts
+/// out and returns at once, so that the caller can do other work; Wait() runs on the calling thread
+/// whatever parts no worker has begun, then blocks until every part is done. Not for use from
+/// several threads at once.
 class WorkerPool {
  public:
   explicit WorkerPool(int threads) : size_(threads < 1 ? 1 : threads) {}
