@@ -106,6 +106,33 @@ TEST(DepthToPositionTest, PerspectiveMatchesAnExactSolveWithinTheDepthResolution
   }
 }
 
+TEST(DepthToPositionTest, EveryKernelGivesTheSameFloats) {
+  // the scalar, SSE2 and AVX2 loops (those this processor has) on a row length that leaves a
+  // tail for each
+  const int w = 45, h = 9;
+  Eigen::Matrix4d P = Perspective(0.05, 10.0);
+  std::vector<float> d(w * h);
+  for (int i = 0; i < w * h; ++i) d[i] = (i % 11 == 3) ? 1.0f : 0.95f + 0.0049f * (i % 10);
+  std::vector<float> scalar(4 * w * h, -1.0f);
+  PositionFromDepth(P, w, h, d.data(), scalar.data(), 0, -1, PositionKernel::kScalar);
+  for (PositionKernel k : {PositionKernel::kSse2, PositionKernel::kAvx2, PositionKernel::kBest}) {
+    if (!HasPositionKernel(k)) continue;
+    std::vector<float> out(4 * w * h, -1.0f);
+    PositionFromDepth(P, w, h, d.data(), out.data(), 0, -1, k);
+#if defined(__x86_64__)
+    EXPECT_EQ(out, scalar) << "kernel " << static_cast<int>(k);
+#else
+    for (size_t i = 0; i < out.size(); ++i)
+      ASSERT_NEAR(out[i], scalar[i], 1e-6 * std::abs(scalar[i]));
+#endif
+  }
+  // rows can be filled in pieces
+  std::vector<float> pieces(4 * w * h, -1.0f);
+  PositionFromDepth(P, w, h, d.data(), pieces.data(), 0, 4, PositionKernel::kScalar);
+  PositionFromDepth(P, w, h, d.data(), pieces.data(), 4, h, PositionKernel::kScalar);
+  EXPECT_EQ(pieces, scalar);
+}
+
 TEST(DepthToPositionTest, OrthographicProjection) {
   // z's denominator is constant (P(3, 2) = 0): the other branch of the split arithmetic
   Eigen::Matrix4d P = Eigen::Matrix4d::Identity();

@@ -699,6 +699,23 @@ TEST(RasterTest, ForwardPathMatchesDeferredPath) {
   Backend().Render(world, cam, &again);
   EXPECT_EQ(again.color, deferred.color);
   EXPECT_EQ(again.segmentation, deferred.segmentation);
+
+  // a picture large enough that worker threads convert its depth (from 256 x 256 pixels), with
+  // and without the colour read back beside them: the same Position as the deferred path
+  CameraParams big = Camera(400, 300, X_WC, 1.1);
+  Picture big_deferred;
+  Backend().Render(world, big, &big_deferred, kPosition | kSegmentation);
+  for (unsigned outputs : {unsigned{kColor | kPosition}, unsigned{kPosition}}) {
+    Picture big_forward;
+    big_forward.position.assign(4 * 400 * 300, -5.0f);  // every value must be written
+    Backend().Render(world, big, &big_forward, outputs);
+    ASSERT_EQ(big_forward.position.size(), big_deferred.position.size());
+    float worst = 0;
+    for (size_t i = 0; i < big_forward.position.size(); ++i) {
+      worst = std::max(worst, std::abs(big_forward.position[i] - big_deferred.position[i]));
+    }
+    EXPECT_LT(worst, 1e-4f) << PictureOutputNames(outputs);
+  }
   std::remove(path.c_str());
 }
 
