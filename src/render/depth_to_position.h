@@ -20,8 +20,8 @@ namespace partsim::internal {
 /// share an image; `depth` and `position` still point at the whole image.
 ///
 /// `kernel` picks the inner loop (for tests: they do the same float operations in the same order,
-/// so on x86-64 they give the same bits): by default the widest this processor has.
-enum class PositionKernel { kBest, kScalar, kSse2, kAvx2 };
+/// so on x86-64 they give the same bits): by default SSE2 where the build has it.
+enum class PositionKernel { kBest, kScalar, kSse2 };
 void PositionFromDepth(const Eigen::Matrix4d& P, int width, int height, const float* depth,
                        float* position, int row_begin = 0, int row_end = -1,
                        PositionKernel kernel = PositionKernel::kBest);

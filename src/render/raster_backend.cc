@@ -1082,11 +1082,11 @@ class RasterBackend final : public RenderBackend {
     if (err == GL_OUT_OF_MEMORY) throw Error("rasterizer: out of GPU memory");
   }
 
-  // the parts the depth of n pixels is converted in: one below 256 x 256 (converted on this
-  // thread: waking a worker took longer than the conversion on a GPU machine's VM at 128 x 128),
-  // else one per 16k pixels, at most twice the workers
+  // the parts the depth of n pixels is converted in: one below 64 x 64 (converted on this
+  // thread), else one per 16k pixels, from 2 to twice the workers. (Converting 128 x 128 on this
+  // thread instead made the frame slower on a GPU machine: bench/README.md.)
   int ConversionParts(size_t n) const {
-    if (n < 256 * 256) return 1;
+    if (n < 64 * 64) return 1;
     return std::clamp(static_cast<int>(n / 16384), 2, 2 * conversion_workers_.size());
   }
 

@@ -700,8 +700,8 @@ TEST(RasterTest, ForwardPathMatchesDeferredPath) {
   EXPECT_EQ(again.color, deferred.color);
   EXPECT_EQ(again.segmentation, deferred.segmentation);
 
-  // a picture large enough that worker threads convert its depth (from 256 x 256 pixels), with
-  // and without the colour read back beside them: the same Position as the deferred path
+  // a larger picture, whose depth more worker threads convert in more parts, with and without
+  // the colour read back beside them: the same Position as the deferred path
   CameraParams big = Camera(400, 300, X_WC, 1.1);
   Picture big_deferred;
   Backend().Render(world, big, &big_deferred, kPosition | kSegmentation);
