@@ -7,13 +7,18 @@
 // triangles each (50k triangles) on a ground plane. Sizes 128x128 and 512x512.
 //
 // Runs per scene and size:
-//   bare         the bare program: colour (RGBA float) + depth (float) read back
+//   bare         the bare program: one Lambert term, colour (RGBA float) + depth (float) read back
+//   bare PBR     the bare program shading like partsim (Oren-Nayar + GGX for the scene's
+//                directional and point light, ambient), same targets and read-back; the program
+//                checks that its colours match partsim's (mean difference < 0.01)
 //   partsim c+d  partsim asked for Color and Position only (RenderBackend::Render's outputs
 //                mask): its forward path, one pass shading colour and writing depth, Position
-//                rebuilt from depth on the CPU (like for like with the bare program)
+//                rebuilt from depth on the CPU (like for like with the bare programs)
 //   partsim all  partsim asked for every output (colour, albedo, normal, position,
 //                segmentation), as Camera::TakePicture does by default: G-buffer + lighting
-// Runs interleave within each repetition; the summary gives medians over repetitions.
+// The ratio to "bare PBR" is partsim's overhead for the same work; the ratio to "bare" also
+// counts the cost of its shading model. Runs interleave within each repetition; the summary
+// gives medians over repetitions.
 //
 // Usage: partsim_render_bench [--reps N] [--seconds S] [--shadows] [--cpu-time]
 // (--cpu-time: frames per second of process CPU time, all of llvmpipe's threads together)
@@ -200,14 +205,81 @@ void main() {
 }
 )";
 
+// the bare program shading like partsim: the same BRDF (Oren-Nayar diffuse, GGX specular with
+// Smith-Schlick G and Schlick Fresnel), the bench's two lights (one directional, one point) and
+// ambient, written here as a stand-alone program would be: no G-buffer inputs, no shadows
+const char* kBarePbrVertex = R"(#version 450 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+uniform mat4 u_mvp;
+uniform mat4 u_model_view;
+uniform mat3 u_normal_matrix;
+out vec3 v_position;
+out vec3 v_normal;
+void main() {
+  v_position = (u_model_view * vec4(a_position, 1.0)).xyz;
+  v_normal = u_normal_matrix * a_normal;
+  gl_Position = u_mvp * vec4(a_position, 1.0);
+}
+)";
+
+const char* kBarePbrFragment = R"(#version 450 core
+in vec3 v_position;
+in vec3 v_normal;
+uniform vec4 u_color;
+uniform float u_roughness;
+uniform float u_metallic;
+uniform vec3 u_sun_direction;  // camera frame, where the light travels
+uniform vec3 u_sun_color;
+uniform vec3 u_lamp_position;  // camera frame
+uniform vec3 u_lamp_color;
+uniform vec3 u_ambient;
+layout(location = 0) out vec4 o_color;
+const float PI = 3.14159265358979;
+vec3 Brdf(vec3 n, vec3 v, vec3 l, vec3 albedo, float r, float m) {
+  float nl = dot(n, l);
+  if (nl <= 0.0) return vec3(0.0);
+  float nv = max(dot(n, v), 1e-4);
+  vec3 h = normalize(l + v);
+  float nh = max(dot(n, h), 0.0), vh = max(dot(v, h), 0.0);
+  vec3 f0 = mix(vec3(0.04), albedo, m);
+  vec3 f = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
+  float a2 = r * r * r * r, k = 0.5 * r * r;
+  float q = nh * nh * (a2 - 1.0) + 1.0;
+  float g = nl / (nl * (1.0 - k) + k) * nv / (nv * (1.0 - k) + k);
+  vec3 spec = f * (a2 / (PI * q * q) * g / (4.0 * nl * nv));
+  float s2 = r * r, t = dot(l, v) - nl * nv;
+  float on = 1.0 - 0.5 * s2 / (s2 + 0.33) + (t > 0.0 ? 0.45 * s2 / (s2 + 0.09) * t / max(nl, nv) : 0.0);
+  return ((1.0 - f) * (1.0 - m) * albedo / PI * on + spec) * nl;
+}
+void main() {
+  vec3 n = normalize(v_normal);
+  if (!gl_FrontFacing) n = -n;
+  vec3 v = normalize(-v_position);
+  float r = clamp(u_roughness, 0.05, 1.0), m = clamp(u_metallic, 0.0, 1.0);
+  vec3 albedo = u_color.rgb;
+  vec3 c = albedo * u_ambient * (1.0 - m) + mix(vec3(0.04), albedo, m) * u_ambient * m;
+  c += Brdf(n, v, -u_sun_direction, albedo, r, m) * u_sun_color;
+  vec3 d = u_lamp_position - v_position;
+  float dist2 = max(dot(d, d), 1e-12);
+  c += Brdf(n, v, d * inversesqrt(dist2), albedo, r, m) * u_lamp_color / dist2;
+  o_color = vec4(clamp(c, 0.0, 1.0), 1.0);
+}
+)";
+
 class BareRenderer {
  public:
-  explicit BareRenderer(const RenderWorld& world) {
-    program_ =
-        partsim::internal::BuildProgram("bare", kBareVertex, "bench", kBareFragment, "bench");
+  // pbr: shade like partsim (kBarePbr*) rather than with one Lambert term
+  BareRenderer(const RenderWorld& world, bool pbr) : pbr_(pbr) {
+    program_ = partsim::internal::BuildProgram("bare", pbr ? kBarePbrVertex : kBareVertex, "bench",
+                                               pbr ? kBarePbrFragment : kBareFragment, "bench");
     mvp_ = glGetUniformLocation(program_, "u_mvp");
     normal_matrix_ = glGetUniformLocation(program_, "u_normal_matrix");
     color_ = glGetUniformLocation(program_, "u_color");
+    for (const char* name : {"u_model_view", "u_roughness", "u_metallic", "u_sun_direction",
+                             "u_sun_color", "u_lamp_position", "u_lamp_color", "u_ambient"}) {
+      pbr_locations_.push_back(glGetUniformLocation(program_, name));
+    }
     for (const RenderInstance& inst : world.instances) {
       const MeshData* key = inst.mesh.get();
       if (std::find_if(meshes_.begin(), meshes_.end(),
@@ -243,6 +315,7 @@ class BareRenderer {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glUseProgram(program_);
+    if (pbr_) SetLights(world, cam);
     Eigen::Matrix4d view_proj = cam.projection * cam.view;
     for (const RenderInstance& inst : world.instances) {
       const Mesh* mesh = nullptr;
@@ -255,6 +328,12 @@ class BareRenderer {
       glUniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
       glUniformMatrix3fv(normal_matrix_, 1, GL_FALSE, nm.data());
       glUniform4fv(color_, 1, inst.material.base_color.data());
+      if (pbr_) {
+        Eigen::Matrix4f mv = (cam.view * inst.X_WV).cast<float>();
+        glUniformMatrix4fv(pbr_locations_[0], 1, GL_FALSE, mv.data());
+        glUniform1f(pbr_locations_[1], inst.material.roughness);
+        glUniform1f(pbr_locations_[2], inst.material.metallic);
+      }
       glBindVertexArray(mesh->vao);
       glDrawElements(GL_TRIANGLES, mesh->count, GL_UNSIGNED_INT, nullptr);
     }
@@ -268,6 +347,23 @@ class BareRenderer {
   }
 
  private:
+  // the scene's directional and point light (AddLights) and ambient, in the camera frame
+  void SetLights(const RenderWorld& world, const CameraParams& cam) {
+    Eigen::Matrix3d R = cam.view.topLeftCorner<3, 3>();
+    for (const partsim::LightDesc& light : world.lights) {
+      if (light.type == partsim::LightType::kDirectional) {
+        Eigen::Vector3f d = (R * light.direction.normalized()).cast<float>();
+        glUniform3fv(pbr_locations_[3], 1, d.data());
+        glUniform3fv(pbr_locations_[4], 1, light.color.data());
+      } else {
+        Eigen::Vector3f p = (cam.view * light.position.homogeneous()).head<3>().cast<float>();
+        glUniform3fv(pbr_locations_[5], 1, p.data());
+        glUniform3fv(pbr_locations_[6], 1, light.color.data());
+      }
+    }
+    glUniform3fv(pbr_locations_[7], 1, world.ambient.data());
+  }
+
   struct Mesh {
     const MeshData* key = nullptr;
     GLuint vao = 0, vbo = 0, ebo = 0;
@@ -333,8 +429,10 @@ class BareRenderer {
   }
 
   partsim::internal::EglContext context_;  // constructed (and current) before the GL calls
+  bool pbr_ = false;
   GLuint program_ = 0;
   GLint mvp_ = -1, normal_matrix_ = -1, color_ = -1;
+  std::vector<GLint> pbr_locations_;
   std::vector<Mesh> meshes_;
   GLuint fbo_ = 0, color_tex_ = 0, depth_tex_ = 0;
   int width_ = 0, height_ = 0;
@@ -412,16 +510,17 @@ int main(int argc, char** argv) {
   std::printf("device: %s; shadows %s; %d repetitions of >= %.2f s (%s) per run\n",
               partsim_backend->Device().c_str(), shadows ? "on" : "off", reps, seconds,
               g_cpu_time ? "process CPU time" : "wall clock");
-  std::printf("%-16s %6s %7s | %10s %12s %12s | %9s %9s\n", "scene", "size", "tris", "bare fps",
-              "partsim c+d", "partsim all", "c+d/bare", "all/bare");
+  std::printf("%-16s %5s %6s | %9s %9s %9s %9s | %8s %8s %8s %8s\n", "scene", "size", "tris",
+              "bare", "bare PBR", "c+d", "all", "c+d/bare", "c+d/PBR", "all/bare", "all/PBR");
 
   int status = 0;
+  std::vector<double> diffs;
   for (Case& c : cases) {
-    BareRenderer bare(c.world);
+    BareRenderer bare(c.world, false), bare_pbr(c.world, true);
     for (int size : {128, 512}) {
       CameraParams cam = CameraFor(size, c.eye, c.target);
       partsim::Picture pic;
-      std::vector<float> color, depth;
+      std::vector<float> color, depth, pbr_color, pbr_depth;
 
       // the same triangles: both see a surface at the same number of pixels
       // (both partsim paths)
@@ -439,36 +538,66 @@ int main(int argc, char** argv) {
           status = 1;
         }
       }
+      // and the PBR program shades like partsim: its colours (rows flipped: the bare programs
+      // draw row 0 at the bottom) against partsim's forward path, where both see a surface
+      bare_pbr.Render(c.world, cam, &pbr_color, &pbr_depth);
+      double diff = 0;
+      size_t seen = 0;
+      for (int v = 0; v < size; ++v) {
+        for (int u = 0; u < size; ++u) {
+          size_t i = static_cast<size_t>(v) * size + u;
+          size_t j = static_cast<size_t>(size - 1 - v) * size + u;
+          if (!(pbr_depth[j] < 1.0f) || !(pic.position[4 * i + 3] > 0)) continue;
+          for (int k = 0; k < 3; ++k) diff += std::abs(pbr_color[4 * j + k] - pic.color[4 * i + k]);
+          ++seen;
+        }
+      }
+      diff /= 3.0 * std::max<size_t>(seen, 1);
+      diffs.push_back(diff);
+      if (!(diff < 0.01)) {
+        std::fprintf(stderr,
+                     "%s %d: the PBR bare program's colours differ from partsim's by %.4f\n",
+                     c.name, size, diff);
+        status = 1;
+      }
 
-      std::vector<double> fb, fcd, fall, rcd, rall;
+      // four runs, rotating which goes first
+      std::vector<double> fps[4], ratio[4];
       for (int r = 0; r < reps; ++r) {
-        // rotate which run goes first
-        double b = 0, cd = 0, all = 0;
-        for (int k = 0; k < 3; ++k) {
-          switch ((r + k) % 3) {
+        double f[4] = {0, 0, 0, 0};
+        for (int k = 0; k < 4; ++k) {
+          switch ((r + k) % 4) {
             case 0:
-              b = Fps([&] { bare.Render(c.world, cam, &color, &depth); }, seconds);
+              f[0] = Fps([&] { bare.Render(c.world, cam, &color, &depth); }, seconds);
               break;
             case 1:
-              cd = Fps([&] { partsim_backend->Render(c.world, cam, &pic, kColorDepth); }, seconds);
+              f[1] = Fps([&] { bare_pbr.Render(c.world, cam, &pbr_color, &pbr_depth); }, seconds);
               break;
             case 2:
-              all = Fps([&] { partsim_backend->Render(c.world, cam, &pic, partsim::kAllOutputs); },
-                        seconds);
+              f[2] =
+                  Fps([&] { partsim_backend->Render(c.world, cam, &pic, kColorDepth); }, seconds);
+              break;
+            case 3:
+              f[3] = Fps([&] { partsim_backend->Render(c.world, cam, &pic, partsim::kAllOutputs); },
+                         seconds);
               break;
           }
         }
-        fb.push_back(b);
-        fcd.push_back(cd);
-        fall.push_back(all);
-        rcd.push_back(cd / b);
-        rall.push_back(all / b);
+        for (int k = 0; k < 4; ++k) fps[k].push_back(f[k]);
+        ratio[0].push_back(f[2] / f[0]);
+        ratio[1].push_back(f[2] / f[1]);
+        ratio[2].push_back(f[3] / f[0]);
+        ratio[3].push_back(f[3] / f[1]);
       }
-      std::printf("%-16s %6d %7zu | %10.1f %12.1f %12.1f | %9.3f %9.3f\n", c.name, size,
-                  TriangleCount(c.world), Median(fb), Median(fcd), Median(fall), Median(rcd),
-                  Median(rall));
+      std::printf("%-16s %5d %6zu | %9.1f %9.1f %9.1f %9.1f | %8.3f %8.3f %8.3f %8.3f\n", c.name,
+                  size, TriangleCount(c.world), Median(fps[0]), Median(fps[1]), Median(fps[2]),
+                  Median(fps[3]), Median(ratio[0]), Median(ratio[1]), Median(ratio[2]),
+                  Median(ratio[3]));
       std::fflush(stdout);
     }
   }
+  std::printf("mean colour difference, bare PBR against partsim c+d, by row:");
+  for (double d : diffs) std::printf(" %.4f", d);
+  std::printf("\n");
   return status;
 }
