@@ -154,29 +154,6 @@ void RowsSse2(const Separable& s, int row_begin, int row_end) {
 
 }  // namespace
 
-PositionKernel BestPositionKernel() {
-#if defined(__SSE2__)
-  return PositionKernel::kSse2;
-#else
-  return PositionKernel::kScalar;
-#endif
-}
-
-bool HasPositionKernel(PositionKernel kernel) {
-  switch (kernel) {
-    case PositionKernel::kBest:
-    case PositionKernel::kScalar:
-      return true;
-    case PositionKernel::kSse2:
-#if defined(__SSE2__)
-      return true;
-#else
-      return false;
-#endif
-  }
-  return false;
-}
-
 void PositionFromDepth(const Eigen::Matrix4d& P, int w, int h, const float* depth, float* position,
                        int row_begin, int row_end, PositionKernel kernel) {
   if (row_end < 0 || row_end > h) row_end = h;
@@ -219,17 +196,13 @@ void PositionFromDepth(const Eigen::Matrix4d& P, int w, int h, const float* dept
     s.cy0[u] = static_cast<float>(s.A_inv(1, 0) * c0);
   }
 
-  if (kernel == PositionKernel::kBest) kernel = BestPositionKernel();
-  if (!HasPositionKernel(kernel)) kernel = PositionKernel::kScalar;
-  switch (kernel) {
 #if defined(__SSE2__)
-    case PositionKernel::kSse2:
-      RowsSse2(s, row_begin, row_end);
-      return;
-#endif
-    default:
-      for (int v = row_begin; v < row_end; ++v) PixelsScalar(s, v, 0);
+  if (kernel == PositionKernel::kVector) {
+    RowsSse2(s, row_begin, row_end);
+    return;
   }
+#endif
+  for (int v = row_begin; v < row_end; ++v) PixelsScalar(s, v, 0);
 }
 
 }  // namespace partsim::internal

@@ -19,15 +19,12 @@ namespace partsim::internal {
 /// Only rows [row_begin, row_end) are written (row_end < 0: to the last row), so that threads can
 /// share an image; `depth` and `position` still point at the whole image.
 ///
-/// `kernel` picks the inner loop (for tests: they do the same float operations in the same order,
-/// so on x86-64 they give the same bits): by default SSE2 where the build has it.
-enum class PositionKernel { kBest, kScalar, kSse2 };
+/// `kernel` picks the inner loop, for tests: kVector (SSE2 where the build has it, else the
+/// scalar loop) or kScalar. They do the same float operations in the same order, so on x86-64
+/// they give the same bits.
+enum class PositionKernel { kVector, kScalar };
 void PositionFromDepth(const Eigen::Matrix4d& P, int width, int height, const float* depth,
                        float* position, int row_begin = 0, int row_end = -1,
-                       PositionKernel kernel = PositionKernel::kBest);
-
-/// The kernel kBest stands for on this processor, and whether `kernel` can run on it.
-PositionKernel BestPositionKernel();
-bool HasPositionKernel(PositionKernel kernel);
+                       PositionKernel kernel = PositionKernel::kVector);
 
 }  // namespace partsim::internal

@@ -415,7 +415,7 @@ class RasterBackend final : public RenderBackend {
     } else {
       RenderGbuffer(world, camera);
       if (outputs & kColor) RenderLighting(world, lights, num_shadows);
-      ReadBack(camera.width, camera.height, outputs, out);
+      ReadBack(outputs, out);
     }
   }
 
@@ -1098,10 +1098,10 @@ class RasterBackend final : public RenderBackend {
   }
 
   // the outputs of the deferred path asked for, from the G-buffer and colour targets
-  void ReadBack(int width, int height, unsigned outputs, Picture* out) {
-    size_t n = static_cast<size_t>(width) * height;
-    out->width = width;
-    out->height = height;
+  void ReadBack(unsigned outputs, Picture* out) {
+    size_t n = static_cast<size_t>(width_) * height_;
+    out->width = width_;
+    out->height = height_;
     internal::KeepOutputs(outputs, out);
     if (outputs & kColor) out->color.resize(n * 4);
     if (outputs & kAlbedo) out->albedo.resize(n * 4);
@@ -1109,26 +1109,24 @@ class RasterBackend final : public RenderBackend {
     if (outputs & kPosition) out->position.resize(n * 4);
     if (outputs & kSegmentation) out->segmentation.resize(n * 2);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    auto read = [&](GLuint fbo, GLenum attachment, GLenum format, GLenum type, void* dst,
-                    size_t bytes) { Read(fbo, attachment, format, type, dst, bytes); };
     if (outputs & kColor) {
-      read(color_fbo_, GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, out->color.data(),
+      Read(color_fbo_, GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, out->color.data(),
            out->color.size() * sizeof(float));
     }
     if (outputs & kAlbedo) {
-      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetAlbedo, GL_RGBA, GL_FLOAT,
+      Read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetAlbedo, GL_RGBA, GL_FLOAT,
            out->albedo.data(), out->albedo.size() * sizeof(float));
     }
     if (outputs & kNormal) {
-      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetNormal, GL_RGBA, GL_FLOAT,
+      Read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetNormal, GL_RGBA, GL_FLOAT,
            out->normal.data(), out->normal.size() * sizeof(float));
     }
     if (outputs & kPosition) {
-      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetPosition, GL_RGBA, GL_FLOAT,
+      Read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetPosition, GL_RGBA, GL_FLOAT,
            out->position.data(), out->position.size() * sizeof(float));
     }
     if (outputs & kSegmentation) {
-      read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER, GL_UNSIGNED_INT,
+      Read(gbuffer_fbo_, GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER, GL_UNSIGNED_INT,
            out->segmentation.data(), out->segmentation.size() * sizeof(uint32_t));
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
