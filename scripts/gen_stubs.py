@@ -52,6 +52,7 @@ def clean_type(t):
     t = t.strip()
     t = _strip_brackets_after(t, "numpy.ndarray")
     t = t.replace(MODULE + ".", "")
+    t = re.sub(r"\b(int|float|bool|str)\[\d+\]", r"\1", t)  # std::array: List[int[4]]
     for name in ("List", "Dict", "Optional", "Tuple", "Union", "Callable", "Iterator", "Any"):
         t = re.sub(r"(?<![\w.])%s\b" % name, "typing." + name, t)
     if "::" in t or "<" in t:

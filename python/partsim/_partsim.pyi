@@ -22,6 +22,9 @@ class Actor:
     def get_angular_velocity(self) -> numpy.ndarray:
         """World-frame angular velocity (3,), rad/s."""
         ...
+    def get_collision_shapes(self) -> list:
+        """One Shape per collision shape, in the order of get_desc().collisions."""
+        ...
     def get_desc(self) -> ActorDesc:
         """A copy of the actor's description."""
         ...
@@ -95,6 +98,12 @@ class ActorBuilder:
     def get_desc(self) -> ActorDesc:
         """A copy of the description built so far."""
         ...
+    @typing.overload
+    def set_collision_groups(self, groups: typing.List[int]) -> ActorBuilder:
+        """SAPIEN's collision groups [g0, g1, g2, g3] (uint32) for every collision shape of the body, added before or after. Returns self."""
+        ...
+    @typing.overload
+    def set_collision_groups(self, group0: int, group1: int, group2: int, group3: int) -> ActorBuilder: ...
     def set_initial_pose(self, pose: Pose) -> ActorBuilder:
         """X_WA at creation. Returns self."""
         ...
@@ -173,6 +182,9 @@ class Articulation:
         ...
     def compute_world_cartesian_jacobian(self) -> numpy.ndarray:
         """Stacked link Jacobians (6 nlinks, dof)."""
+        ...
+    def disable_collision(self, link_a: Link, link_b: Link) -> None:
+        """The two links of this articulation never collide with each other from now on (links joined by a joint never do); the scene's state is kept."""
         ...
     @property
     def dof(self) -> int:
@@ -263,6 +275,12 @@ class ArticulationDesc:
     def couplings(self) -> typing.List[JointCoupling]: ...
     @couplings.setter
     def couplings(self, value: typing.List[JointCoupling]) -> None: ...
+    @property
+    def disabled_collisions(self) -> typing.List[typing.Tuple[str, str]]:
+        """Pairs of link names that never collide with each other."""
+        ...
+    @disabled_collisions.setter
+    def disabled_collisions(self, value: typing.List[typing.Tuple[str, str]]) -> None: ...
     @property
     def fix_root(self) -> bool: ...
     @fix_root.setter
@@ -368,6 +386,12 @@ class BodyDesc:
     @name.setter
     def name(self, value: str) -> None: ...
     @property
+    def partnet_name(self) -> str:
+        """Name of the part in the PartNet hierarchy (mobility_v2.json's "name", e.g. "cabinet_door"), "" if none."""
+        ...
+    @partnet_name.setter
+    def partnet_name(self, value: str) -> None: ...
+    @property
     def semantic_label(self) -> str:
         """Part label (e.g. "drawer"), "" if none."""
         ...
@@ -462,6 +486,12 @@ class Camera:
 class CollisionShape:
     """A collision shape of an actor or link."""
     def __init__(self) -> None: ...
+    @property
+    def collision_groups(self) -> typing.List[int]:
+        """SAPIEN's [g0, g1, g2, g3]: shapes A and B collide when (A.g0 & B.g1 or A.g1 & B.g0) and not (A.g2 & B.g2 and A.g3 == B.g3)."""
+        ...
+    @collision_groups.setter
+    def collision_groups(self, value: typing.List[int]) -> None: ...
     @property
     def density(self) -> float:
         """kg/m^3, > 0."""
@@ -1023,7 +1053,7 @@ class Joint:
         """A copy of the joint's description."""
         ...
     def get_dof(self) -> int:
-        """0 or 1 (a coupled joint has 0)."""
+        """0 for a fixed joint, else 1 (coupled joints included)."""
         ...
     def get_dof_index(self) -> int:
         """Index in qpos, -1 if the joint has no dof."""
@@ -1414,6 +1444,9 @@ class Link:
     def get_cmass_pose(self) -> Pose:
         """X_WC: centre of mass frame (principal axes) in the world."""
         ...
+    def get_collision_shapes(self) -> list:
+        """One Shape per collision shape, in the order of get_desc().collisions."""
+        ...
     def get_desc(self) -> LinkDesc:
         """A copy of the link's description."""
         ...
@@ -1430,8 +1463,14 @@ class Link:
     def get_parent_index(self) -> int:
         """Parent link index; -1 for the root."""
         ...
+    def get_partnet_name(self) -> str:
+        """The PartNet part name (mobility_v2.json's "name"), "" if none."""
+        ...
     def get_pose(self) -> Pose:
         """X_WL: the link frame in the world."""
+        ...
+    def get_semantic_label(self) -> str:
+        """The part label (semantics.txt's vocabulary for PartNet-Mobility objects: "drawer", "rotation_door", ...), "" if none."""
         ...
     def get_velocity(self) -> numpy.ndarray:
         """World-frame velocity (3,) at the origin, m/s."""
@@ -1473,6 +1512,12 @@ class LinkBuilder:
         """Adds every sub-mesh of a mesh file as visuals, multiplied by `scale`. Returns self."""
         ...
     def get_index(self) -> int: ...
+    @typing.overload
+    def set_collision_groups(self, groups: typing.List[int]) -> LinkBuilder:
+        """SAPIEN's collision groups [g0, g1, g2, g3] (uint32) for every collision shape of the body, added before or after. Returns self."""
+        ...
+    @typing.overload
+    def set_collision_groups(self, group0: int, group1: int, group2: int, group3: int) -> LinkBuilder: ...
     def set_joint_armature(self, armature: float) -> LinkBuilder: ...
     def set_joint_name(self, name: str) -> LinkBuilder: ...
     @typing.overload
@@ -1503,6 +1548,31 @@ class LinkDesc(BodyDesc):
         ...
     @parent.setter
     def parent(self, value: int) -> None: ...
+
+
+class LoadReport:
+    """The warnings of one load (UrdfLoader.last_report(), PartNetMobilityLoader.last_report())."""
+    def __bool__(self) -> bool: ...
+    def __len__(self) -> int: ...
+    def __str__(self) -> str: ...
+    @property
+    def warnings(self) -> typing.List[LoadWarning]:
+        """list of LoadWarning, in file order."""
+        ...
+
+
+class LoadWarning:
+    """A defect a loader repaired or ignored."""
+    def __repr__(self) -> str: ...
+    def __str__(self) -> str: ...
+    @property
+    def file(self) -> str:
+        """The file at fault."""
+        ...
+    @property
+    def message(self) -> str:
+        """What was wrong and what the loader did, naming the element."""
+        ...
 
 
 class LoadedMesh:
@@ -1614,7 +1684,7 @@ class PartNetLink:
     def id(self) -> int: ...
     @property
     def joint(self) -> str:
-        """hinge, slider, free, heavy or static."""
+        """mobility_v2.json motion: hinge, slider, free, heavy or static."""
         ...
     @property
     def limit_a(self) -> float: ...
@@ -1627,18 +1697,31 @@ class PartNetLink:
     @property
     def parent(self) -> int: ...
     @property
+    def partnet_name(self) -> str:
+        """mobility_v2.json name, the PartNet vocabulary ('cabinet_door', ...)."""
+        ...
+    @property
     def parts(self) -> typing.List[PartNetPart]: ...
     @property
     def rotates(self) -> bool: ...
     @property
     def rotation_limit(self) -> float: ...
     @property
-    def semantic_label(self) -> str: ...
+    def semantic_joint(self) -> str:
+        """semantics.txt joint kind: hinge, slider, slider+, free, heavy, static."""
+        ...
+    @property
+    def semantic_label(self) -> str:
+        """semantics.txt label ('drawer', 'rotation_door', ...)."""
+        ...
 
 
 class PartNetMobilityLoader:
     """Reads PartNet-Mobility folders. Get one from Scene.create_partnet_mobility_loader(); one made with PartNetMobilityLoader() can only parse. `urdf` holds the URDF options."""
     def __init__(self) -> None: ...
+    def last_report(self) -> LoadReport:
+        """The warnings of the last parse or load (a LoadReport)."""
+        ...
     def load(self, folder: str) -> Articulation:
         """Parses a folder and adds its articulation to the scene."""
         ...
@@ -1646,13 +1729,23 @@ class PartNetMobilityLoader:
         """Reads and cross-checks a folder; raises PartsimError naming the file and entry."""
         ...
     @property
+    def strict(self) -> bool:
+        """Cross-file disagreements and missing files become errors (dataset QA)."""
+        ...
+    @strict.setter
+    def strict(self, value: bool) -> None: ...
+    @property
     def urdf(self) -> UrdfLoader: ...
     @urdf.setter
     def urdf(self, value: UrdfLoader) -> None: ...
 
 
 class PartNetMobilityObject:
-    """A parsed PartNet-Mobility folder: its articulation (z-up, root 'base') and its annotations."""
+    """A parsed PartNet-Mobility folder: its articulation (mobility.urdf as it is: z-up, root 'base') and its annotations (frame X_BF, y-up)."""
+    @property
+    def X_BF(self) -> Pose:
+        """The annotation files' frame F (y-up) in the root link 'base'."""
+        ...
     @property
     def articulation(self) -> ArticulationDesc: ...
     @property
@@ -1671,10 +1764,17 @@ class PartNetMobilityObject:
         ...
     @property
     def links(self) -> typing.List[PartNetLink]: ...
+    def links_with_label(self, label: str) -> typing.List[int]:
+        """link ids whose semantics label is `label` (e.g. 'drawer')."""
+        ...
     @property
     def model_id(self) -> str: ...
     def part_visuals(self, id: int, part_name: str) -> typing.List[int]:
         """Indices of the visuals of part `part_name` on link_<id> (e.g. its handle)."""
+        ...
+    @property
+    def report(self) -> LoadReport:
+        """What the reader worked around."""
         ...
 
 
@@ -1683,7 +1783,13 @@ class PartNetPart:
     @property
     def id(self) -> int: ...
     @property
-    def name(self) -> str: ...
+    def name(self) -> str:
+        """PartNet part name, e.g. 'handle'."""
+        ...
+    @property
+    def visuals(self) -> typing.List[int]:
+        """Indices of the part's visuals in its link's visuals."""
+        ...
 
 
 class PartsimError(ValueError):
@@ -2170,6 +2276,26 @@ class SceneWarning:
         ...
 
 
+class Shape:
+    """Handle to one collision shape of an actor or a link (SAPIEN's CollisionShape); its description is get_desc()."""
+    def __repr__(self) -> str: ...
+    def get_collision_groups(self) -> typing.List[int]:
+        """SAPIEN's collision groups [g0, g1, g2, g3]."""
+        ...
+    def get_desc(self) -> CollisionShape:
+        """A copy of the shape's description."""
+        ...
+    def get_index(self) -> int:
+        """Index in the body's collisions."""
+        ...
+    @typing.overload
+    def set_collision_groups(self, groups: typing.List[int]) -> None:
+        """SAPIEN's collision groups [g0, g1, g2, g3] (uint32): shapes A and B collide when (A.g0 & B.g1 or A.g1 & B.g0) and not (A.g2 & B.g2 and A.g3 == B.g3). The scene's state is kept."""
+        ...
+    @typing.overload
+    def set_collision_groups(self, group0: int, group1: int, group2: int, group3: int) -> None: ...
+
+
 class ShapeType:
     """Geometric primitive or mesh.
 
@@ -2281,6 +2407,12 @@ class TaskOptions:
     @max_seconds.setter
     def max_seconds(self, value: float) -> None: ...
     @property
+    def object_folder(self) -> str:
+        """A PartNet-Mobility folder (real or generated) instead of the generator's object; '' uses object_index and dataset_seed."""
+        ...
+    @object_folder.setter
+    def object_folder(self, value: str) -> None: ...
+    @property
     def object_index(self) -> int:
         """Index of the generated StorageFurniture object."""
         ...
@@ -2369,6 +2501,9 @@ class UrdfLoader:
     def fix_root_link(self) -> bool: ...
     @fix_root_link.setter
     def fix_root_link(self, value: bool) -> None: ...
+    def last_report(self) -> LoadReport:
+        """The warnings of the last parse or load (a LoadReport)."""
+        ...
     @property
     def link_overrides(self) -> typing.Dict[str, UrdfLinkOverride]:
         """dict: link name -> UrdfLinkOverride."""
@@ -2409,6 +2544,18 @@ class UrdfLoader:
         ...
     @scale.setter
     def scale(self, value: float) -> None: ...
+    @property
+    def srdf_file(self) -> str:
+        """SRDF whose <disable_collisions> pairs apply; "" looks for <urdf stem>.srdf beside the URDF file."""
+        ...
+    @srdf_file.setter
+    def srdf_file(self, value: str) -> None: ...
+    @property
+    def strict(self) -> bool:
+        """Defects the loader would repair with a warning are errors instead."""
+        ...
+    @strict.setter
+    def strict(self, value: bool) -> None: ...
 
 
 class VisualShape:
@@ -2472,6 +2619,14 @@ def find_task_objects(type: TaskType, count: int, dataset_seed: int = ...) -> ty
     """The first `count` StorageFurniture indices with a drawer (door) that has a handle."""
     ...
 
+def find_task_targets(object: PartNetMobilityObject, type: TaskType) -> typing.List[int]:
+    """link ids N (of link_N) of a PartNetMobilityObject that the task can target: labelled task_target_label(type), with a handle and a finite joint range."""
+    ...
+
+def get_log_level() -> str:
+    """The current log level: 'warning', 'error' or 'off'."""
+    ...
+
 def get_point_cloud(camera: Camera, frame: str = ...) -> dict:
     """Points of the camera's last picture that see a surface, in the 'camera' (OpenGL: x right, y up, z backward) or 'world' frame: dict of positions float32 (N, 3) m, colors uint8 (N, 4) sRGB, visual_ids and entity_ids uint32 (N,); colors (0, 4) and ids (0,) when the picture did not take Color or Segmentation."""
     ...
@@ -2508,8 +2663,16 @@ def parse_task_type(name: str) -> TaskType:
     """'drawer' or 'door' to a TaskType."""
     ...
 
+def place_on_ground(articulation: Articulation, altitude: float = ...) -> None:
+    """Moves the articulation's root so that its lowest point touches z = altitude."""
+    ...
+
 def pose_error(current: Pose, target: Pose) -> numpy.ndarray:
     """(p_target - p; axis-angle of R_target R^T), a (6,) array in m and rad."""
+    ...
+
+def set_log_level(level: str) -> None:
+    """What partsim writes to standard error: 'warning' (default: loaders' repairs and numerical trouble), 'error' or 'off' (warnings are still kept in load reports)."""
     ...
 
 def solve_open_door(task: ArticulationTask, options: SolverOptions = ...) -> SolverResult:
@@ -2526,6 +2689,14 @@ def solve_task(task: ArticulationTask, options: SolverOptions = ...) -> SolverRe
 
 def split_connected_components(mesh: MeshData) -> typing.List[MeshData]:
     """Connected components of a mesh (positions welded within 1e-7 m)."""
+    ...
+
+def standing_root_pose(articulation: Articulation, altitude: float = ...) -> Pose:
+    """Root pose that makes the articulation stand on z = altitude at its current joint positions (orientation and x, y kept)."""
+    ...
+
+def task_target_label(type: TaskType) -> str:
+    """The semantics.txt label of the task's targets: 'drawer' or 'rotation_door'."""
     ...
 
 def time_parameterize(path: typing.List[numpy.ndarray], velocity_limits: numpy.ndarray, acceleration_limits: numpy.ndarray) -> JointTrajectory:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import numbers
+import os
 from typing import Any
 
 import numpy as np
@@ -172,7 +173,12 @@ class _ClosedByContext:
 
 class OpenCabinetEnv(_ClosedByContext):
     """Drawer pulling (``task="drawer"``) or door opening (``task="door"``) on generated cabinets
-    with the flying gripper.
+    or PartNet-Mobility folders with the flying gripper.
+
+    ``objects``: generated StorageFurniture indices (ints) and/or PartNet-Mobility folders (str or
+    path-like; real or generated objects whose semantics.txt labels a ``drawer`` or a
+    ``rotation_door`` with a handle), one or a list; None takes the first generated object with a
+    target.
 
     Action: 7 values in [-1, 1]: the gripper's TCP twist in the world frame, scaled by 0.5 m/s
     (linear) and 1.5 rad/s (angular), then the gripper command (-1 close, 1 open). Actions outside
@@ -221,16 +227,25 @@ class OpenCabinetEnv(_ClosedByContext):
         self.max_episode_steps = int(max_episode_steps)
         if objects is None:
             objects = _ps.find_task_objects(self.task_type, 1, dataset_seed)
-        elif isinstance(objects, numbers.Integral):
+        elif isinstance(objects, (numbers.Integral, str, os.PathLike)):
             objects = [objects]
-        self.objects = [int(o) for o in objects]
+        self.objects = [
+            os.fspath(o) if isinstance(o, (str, os.PathLike)) else int(o) for o in objects
+        ]
         if not self.objects:
-            raise ValueError("objects must name at least one StorageFurniture index")
+            raise ValueError(
+                "objects must name at least one StorageFurniture index or PartNet-Mobility folder"
+            )
         self._options = []
-        for index in self.objects:
+        for obj in self.objects:
             o = _ps.TaskOptions()
             o.type = self.task_type
-            o.object_index = index
+            if isinstance(obj, str):
+                if not os.path.isfile(os.path.join(obj, "mobility.urdf")):
+                    raise ValueError(f"objects: {obj!r} is not a PartNet-Mobility folder")
+                o.object_folder = obj
+            else:
+                o.object_index = obj
             o.dataset_seed = dataset_seed
             o.control_rate = control_rate
             o.max_seconds = max_episode_steps / control_rate + 1.0
@@ -375,7 +390,11 @@ class OpenCabinetEnv(_ClosedByContext):
         return {
             "success": bool(t.is_success()),
             "progress": float(t.get_progress()),
-            "object": int(t.options.object_index),
+            "object": (
+                os.path.basename(os.path.normpath(t.options.object_folder))
+                if t.options.object_folder
+                else int(t.options.object_index)
+            ),
             "target": t.target_link.get_name(),
             "touching": bool(t.gripper_touches_target()),
             "elapsed": float(t.get_elapsed()),

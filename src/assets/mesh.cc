@@ -5,14 +5,21 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <assimp/Importer.hpp>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <numeric>
+#include <set>
 #include <tuple>
+#include <unordered_map>
 
+#include "partsim/assets/convex_decomposition.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -126,7 +133,189 @@ void CollectNode(const aiScene* scene, const aiNode* node, const Eigen::Matrix4d
   }
 }
 
+// "%.3g" of a length or count, for messages.
+std::string Short(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.3g", v);
+  return buf;
+}
+
+// Whether a triangle surface is (nearly) closed and consistently wound, so that its enclosed
+// volume means something: after welding equal positions no directed edge appears twice, and at
+// most 2% of them lack their reverse (exported meshes often have a few cracks).
+bool ClosedAndConsistent(const MeshData& mesh) {
+  std::map<std::tuple<float, float, float>, int> ids;
+  std::vector<int> id(mesh.vertices.size());
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3f& v = mesh.vertices[i];
+    id[i] = ids.emplace(std::make_tuple(v.x(), v.y(), v.z()), static_cast<int>(ids.size()))
+                .first->second;
+  }
+  const int nv = static_cast<int>(mesh.vertices.size());
+  std::unordered_map<uint64_t, int> directed;
+  auto key = [](int a, int b) {
+    return (static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b);
+  };
+  for (const Eigen::Vector3i& f : mesh.faces) {
+    if (f.minCoeff() < 0 || f.maxCoeff() >= nv) return false;
+    const int a = id[f[0]], b = id[f[1]], c = id[f[2]];
+    if (a == b || b == c || a == c) continue;  // a degenerate triangle bounds nothing
+    for (auto [u, w] : {std::make_pair(a, b), std::make_pair(b, c), std::make_pair(c, a)}) {
+      if (++directed[key(u, w)] > 1) return false;
+    }
+  }
+  if (directed.empty()) return false;
+  size_t open = 0;
+  for (const auto& entry : directed) {
+    const int u = static_cast<int>(entry.first >> 32);
+    const int w = static_cast<int>(entry.first & 0xFFFFFFFFu);
+    open += !directed.count(key(w, u));
+  }
+  return open <= directed.size() / 50;
+}
+
 }  // namespace
+
+ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh) {
+  // sizes in metres: below kTiny a piece is dropped; hulls under kMinVolume, or thinner than
+  // kFlat of their size, are what MuJoCo's qhull and volume checks refuse (with margin)
+  constexpr double kTiny = 1e-4, kMinVolume = 1e-13, kFlat = 1e-6;
+  ConvexPieceCheck out;
+  out.piece = mesh;
+  out.volume_ratio = std::numeric_limits<double>::quiet_NaN();
+
+  // distinct finite points
+  std::vector<Eigen::Vector3d> points;
+  {
+    std::set<std::tuple<float, float, float>> seen;
+    for (const Eigen::Vector3f& v : mesh->vertices) {
+      if (v.allFinite() && seen.insert(std::make_tuple(v.x(), v.y(), v.z())).second)
+        points.push_back(v.cast<double>());
+    }
+  }
+  if (points.empty()) {
+    out.piece = nullptr;
+    out.repair = "has no vertices: dropped";
+    return out;
+  }
+
+  // principal directions, and the extents along them, largest first
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : points) cov += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const Eigen::Matrix3d axes = eig.eigenvectors();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const Eigen::Vector3d& p : points) {
+    const Eigen::Vector3d x = axes.transpose() * (p - mean);
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  const Eigen::Vector3d extent = hi - lo;
+  std::array<int, 3> order = {0, 1, 2};
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return extent[a] > extent[b]; });
+  const double size = extent[order[0]], middle = extent[order[1]], thin = extent[order[2]];
+  const std::string counted = std::to_string(points.size()) + " distinct point" +
+                              (points.size() == 1 ? "" : "s") + ", " + Short(size) + " m across";
+  if (size < kTiny) {
+    out.piece = nullptr;
+    out.repair = "is under 0.1 mm across (" + counted + "): dropped";
+    return out;
+  }
+
+  std::shared_ptr<MeshData> hull;
+  try {
+    hull = ConvexHull(points);
+  } catch (const Error&) {
+    // flat, line-like or fewer than 4 points: repaired below
+  }
+  const double hull_volume = hull ? std::abs(MeshVolume(*hull)) : 0.0;
+  if (!hull || hull_volume < kMinVolume || thin < kFlat * size) {
+    // a thin hull: the points pushed out along the thin direction, and along the middle one
+    // too when the piece is a line. Not thinner than needed: MuJoCo 2.2.2's plane-mesh contact
+    // can hold a hull 1 mm thick that a fall pushed through the plane (depending on the order
+    // of its vertices); from 4 mm on it pushes every such hull back out
+    const double t = std::clamp(0.03 * size, 2e-5, 5e-3);
+    const bool line = middle < kFlat * size || middle < t;
+    std::vector<Eigen::Vector3d> offsets = {Eigen::Vector3d::Zero()};
+    for (int k : {order[2], order[1]}) {
+      if (k == order[1] && !line) continue;
+      std::vector<Eigen::Vector3d> next;
+      for (const Eigen::Vector3d& o : offsets) {
+        next.push_back(o + 0.5 * t * axes.col(k));
+        next.push_back(o - 0.5 * t * axes.col(k));
+      }
+      offsets = next;
+    }
+    std::vector<Eigen::Vector3d> pushed;
+    pushed.reserve(points.size() * offsets.size());
+    for (const Eigen::Vector3d& p : points)
+      for (const Eigen::Vector3d& o : offsets) pushed.push_back(p + o);
+    std::string what = points.size() < 4 ? "has fewer than 4 distinct points"
+                       : line            ? "lies on a line"
+                       : !hull           ? "is flat"
+                                         : "is nearly flat";
+    what += " (" + counted + ", " + Short(thin) + " m thick)";
+    try {
+      std::shared_ptr<MeshData> thick = ConvexHull(pushed);
+      thick->source = mesh->source;
+      thick->name = mesh->name;
+      out.piece = thick;
+      out.thickness = t;
+      out.repair = what + ": given a convex hull " + Short(t) + " m thick";
+    } catch (const Error&) {
+      out.piece = nullptr;
+      out.repair = what + ": dropped";
+    }
+    return out;
+  }
+
+  // convexity. A closed surface: the volume it encloses against its hull's. An open one: how
+  // much of its area lies deeper inside the hull than 5% of its size (at triangle centroids, a
+  // sample of at most 20000 triangles); vertices alone would not do, as every vertex of an
+  // extruded shape lies on one of its hull's end faces
+  std::vector<Eigen::Vector3d> normals;
+  std::vector<double> offsets;
+  for (const Eigen::Vector3i& f : hull->faces) {
+    const Eigen::Vector3d a = hull->vertices[f[0]].cast<double>();
+    Eigen::Vector3d n =
+        (hull->vertices[f[1]].cast<double>() - a).cross(hull->vertices[f[2]].cast<double>() - a);
+    if (n.norm() < 1e-300) continue;
+    n.normalize();
+    normals.push_back(n);
+    offsets.push_back(n.dot(a));
+  }
+  const double deep = 0.05 * extent.norm();
+  const int nv = static_cast<int>(mesh->vertices.size());
+  const size_t stride = std::max<size_t>(1, mesh->faces.size() / 20000);
+  double area = 0.0, deep_area = 0.0;
+  for (size_t t = 0; t < mesh->faces.size(); t += stride) {
+    const Eigen::Vector3i& f = mesh->faces[t];
+    if (f.minCoeff() < 0 || f.maxCoeff() >= nv) continue;
+    const Eigen::Vector3d a = mesh->vertices[f[0]].cast<double>();
+    const Eigen::Vector3d b = mesh->vertices[f[1]].cast<double>();
+    const Eigen::Vector3d c = mesh->vertices[f[2]].cast<double>();
+    const double triangle = 0.5 * (b - a).cross(c - a).norm();
+    if (!std::isfinite(triangle)) continue;
+    const Eigen::Vector3d centroid = (a + b + c) / 3.0;
+    double depth = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < normals.size(); ++k)
+      depth = std::min(depth, offsets[k] - normals[k].dot(centroid));
+    area += triangle;
+    if (depth > deep) deep_area += triangle;
+  }
+  out.deep_area_fraction = area > 0 ? deep_area / area : 0.0;
+  if (ClosedAndConsistent(*mesh)) {
+    out.volume_ratio = std::abs(MeshVolume(*mesh)) / hull_volume;
+    out.non_convex = out.volume_ratio < 0.8;
+  } else {
+    out.non_convex = out.deep_area_fraction > 0.1;
+  }
+  return out;
+}
 
 std::vector<LoadedMesh> LoadMeshFile(const std::string& path, const Eigen::Vector3d& scale) {
   std::error_code ec;

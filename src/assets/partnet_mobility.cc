@@ -104,13 +104,14 @@ PartNetLink ReadLinkEntry(const json& e, size_t index, const fs::path& file) {
     Fail(file, "entry " + std::to_string(index) + " (link_" + std::to_string(l.id) +
                    "): unknown joint type '" + l.joint +
                    "' (expected hinge, slider, free, heavy or static)");
-  l.semantic_label = g.String(e, "name");
+  l.partnet_name = g.String(e, "name");
+  l.semantic_label = l.partnet_name;  // until semantics.txt gives the label
   if (e.contains("parts")) {
     const json& parts = e.at("parts");
     if (!parts.is_array()) Fail(file, "link_" + std::to_string(l.id) + ": 'parts' must be a list");
     for (const json& p : parts) {
       if (p.is_null()) continue;  // the dataset leaves holes in some part lists
-      l.parts.push_back({g.Int(p, "id"), g.String(p, "name")});
+      l.parts.push_back({g.Int(p, "id"), g.String(p, "name"), {}});
     }
   }
   if (l.joint == "hinge" || l.joint == "slider") {
@@ -137,12 +138,12 @@ PartNetLink ReadLinkEntry(const json& e, size_t index, const fs::path& file) {
   return l;
 }
 
-// Forward kinematics at q = 0 of a description, in the file's frame: X_FL per link.
+// Forward kinematics at q = 0 of a description with its root at the origin: X_BL per link.
 std::vector<Pose> RestPoses(const ArticulationDesc& desc) {
   std::vector<Pose> X(desc.links.size());
   for (size_t i = 0; i < desc.links.size(); ++i) {
     const LinkDesc& l = desc.links[i];
-    X[i] = l.parent < 0 ? desc.root_pose
+    X[i] = l.parent < 0 ? Pose()
                         : X[l.parent] * l.joint.pose_in_parent * l.joint.pose_in_child.Inverse();
   }
   return X;
@@ -154,45 +155,107 @@ int FindLink(const ArticulationDesc& desc, const std::string& name) {
   return -1;
 }
 
-// Checks one link's URDF joint(s) against its mobility_v2.json entry. `scale` is the loader's:
-// the URDF was read scaled, mobility_v2.json's lengths are not.
+// Records what the reader works around: a warning in the object's report, or an error when the
+// loader is strict.
+class Notes {
+ public:
+  Notes(bool strict, LoadReport* report) : strict_(strict), report_(report) {}
+  void Warn(const fs::path& file, const std::string& what) const {
+    if (strict_) Fail(file, what + " (strict loading)");
+    report_->Warn("PartNet-Mobility " + file.string(), what);
+  }
+
+ private:
+  bool strict_;
+  LoadReport* report_;
+};
+
+// Indices of the visuals of `link` named "<anything>-<part id>".
+std::vector<int> VisualsOfPart(const LinkDesc& link, int part_id) {
+  const std::string suffix = "-" + std::to_string(part_id);
+  std::vector<int> out;
+  for (size_t v = 0; v < link.visuals.size(); ++v) {
+    const std::string& n = link.visuals[v].name;
+    if (n.size() >= suffix.size() &&
+        n.compare(n.size() - suffix.size(), suffix.size(), suffix) == 0)
+      out.push_back(static_cast<int>(v));
+  }
+  return out;
+}
+
+std::string Describe(const PartNetLink& e) {
+  return "link_" + std::to_string(e.id) + " ('" + e.partnet_name + "')";
+}
+
+// The annotation frame F in the root: the orientation of the object's body link, the child of
+// the root joined by a fixed joint (real files turn the y-up meshes z-up there), else of the
+// root's first child; identity when the root has none.
+Pose AnnotationFrame(const ArticulationDesc& desc) {
+  int first = -1, fixed = -1;
+  for (size_t i = 0; i < desc.links.size(); ++i) {
+    const LinkDesc& l = desc.links[i];
+    if (l.parent < 0 || desc.links[l.parent].parent >= 0) continue;
+    if (first < 0) first = static_cast<int>(i);
+    if (fixed < 0 && l.joint.type == JointType::kFixed) fixed = static_cast<int>(i);
+  }
+  int pick = fixed >= 0 ? fixed : first;
+  if (pick < 0) return Pose();
+  const JointDesc& j = desc.links[pick].joint;
+  Pose X_BC = j.pose_in_parent * j.pose_in_child.Inverse();
+  return Pose(Eigen::Vector3d::Zero(), X_BC.q);
+}
+
+// Checks one link's URDF joint(s) against its mobility_v2.json entry, in the root frame B.
+// mobility.urdf is the physical truth: a disagreement is a note. `scale` is the loader's: the
+// URDF was read scaled, mobility_v2.json's lengths are not.
 void CheckLink(const PartNetLink& e, const ArticulationDesc& desc, const std::vector<Pose>& X,
-               const fs::path& folder, double scale) {
+               const Pose& X_BF, const fs::path& folder, double scale, const Notes& notes) {
   const fs::path urdf = folder / "mobility.urdf";
-  std::string link_name = "link_" + std::to_string(e.id);
-  std::string where = "link_" + std::to_string(e.id) + " ('" + e.semantic_label + "')";
-  int li = FindLink(desc, link_name);
-  if (li < 0) Fail(urdf, "has no link '" + link_name + "', which mobility_v2.json describes");
+  const fs::path json_file = folder / "mobility_v2.json";
+  const std::string link_name = "link_" + std::to_string(e.id);
+  const std::string where = Describe(e);
+  const int li = FindLink(desc, link_name);
   // a rotating slider hangs from a helper link: the slide is the helper's joint
   int motion = li;
   if (e.rotates) {
     motion = desc.links[li].parent;
-    if (motion < 0 || desc.links[motion].name != link_name + "_helper")
-      Fail(urdf, where + " is a rotating slider but its parent is not '" + link_name + "_helper'");
+    if (motion < 0 || desc.links[motion].name != link_name + "_helper") {
+      notes.Warn(urdf, where + " is a rotating slider in mobility_v2.json but its parent is not '" +
+                           link_name + "_helper'; its motion is read from mobility.urdf alone");
+      return;
+    }
   }
   const LinkDesc& m = desc.links[motion];
   // parent
-  std::string parent_name = e.parent < 0 ? "base" : "link_" + std::to_string(e.parent);
-  if (m.parent < 0 || desc.links[m.parent].name != parent_name)
-    Fail(urdf, where + ": parent is '" +
-                   (m.parent < 0 ? std::string("(none)") : desc.links[m.parent].name) +
-                   "', mobility_v2.json says '" + parent_name + "'");
+  const std::string parent_name = e.parent < 0 ? "base" : "link_" + std::to_string(e.parent);
+  const std::string urdf_parent = m.parent < 0 ? "(none)" : desc.links[m.parent].name;
+  if (urdf_parent != parent_name &&
+      !(e.parent < 0 && m.parent >= 0 && desc.links[m.parent].parent < 0)) {
+    notes.Warn(json_file, where + ": parent is '" + parent_name + "', mobility.urdf says '" +
+                              urdf_parent + "'");
+  }
   // type
-  JointType expect = PartNetMobilityObject::MotionJointType(e);
-  if (m.joint.type != expect)
-    Fail(urdf, where + ": joint '" + m.joint.name + "' is " + JointTypeName(m.joint.type) +
-                   ", mobility_v2.json says " + e.joint + (e.no_limit ? " without limit" : "") +
-                   " (" + JointTypeName(expect) + ")");
-  if (!e.has_axis) return;
-  // axis: the joint frame's x axis in the file frame
-  Pose X_FJ = X[m.parent] * m.joint.pose_in_parent;
-  Eigen::Vector3d d = X_FJ.q * Eigen::Vector3d::UnitX();
-  double dot = d.dot(e.axis_direction);
-  if ((d.cross(e.axis_direction)).norm() > kAxisTolerance)
-    Fail(urdf, where + ": joint axis differs from mobility_v2.json's direction");
-  if (e.joint == "hinge" &&
-      (e.axis_origin * scale - X_FJ.p).cross(d).norm() > kAxisTolerance * scale)
-    Fail(urdf, where + ": mobility_v2.json's axis origin is not on the joint's axis");
+  const JointType expect = PartNetMobilityObject::MotionJointType(e);
+  if (m.joint.type != expect) {
+    notes.Warn(json_file, where + ": motion '" + e.joint + (e.no_limit ? " without limit" : "") +
+                              "' (" + JointTypeName(expect) + "), mobility.urdf's joint '" +
+                              m.joint.name + "' is " + JointTypeName(m.joint.type));
+    return;
+  }
+  if (!e.has_axis || m.parent < 0) return;
+  // axis: the joint frame's x axis, and the file's axis turned into B
+  const Pose X_BJ = X[m.parent] * m.joint.pose_in_parent;
+  const Eigen::Vector3d d = X_BJ.q * Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d file_d = X_BF.q * e.axis_direction;
+  const Eigen::Vector3d file_o = X_BF.q * (e.axis_origin * scale);
+  const double dot = d.dot(file_d);
+  if (d.cross(file_d).norm() > kAxisTolerance) {
+    notes.Warn(json_file, where + ": axis direction differs from mobility.urdf's joint '" +
+                              m.joint.name + "'");
+  } else if (e.joint == "hinge" && (file_o - X_BJ.p).cross(d).norm() > kAxisTolerance * scale) {
+    notes.Warn(json_file, where + ": axis origin is not on the axis of mobility.urdf's joint '" +
+                              m.joint.name + "'");
+  }
   // limits, flipped when the file's axis points the other way
   if (!e.no_limit) {
     double lo = std::min(e.limit_a, e.limit_b), hi = std::max(e.limit_a, e.limit_b);
@@ -204,42 +267,85 @@ void CheckLink(const PartNetLink& e, const ArticulationDesc& desc, const std::ve
     if (std::abs(m.joint.lower - lo) > kLimitTolerance ||
         std::abs(m.joint.upper - hi) > kLimitTolerance) {
       std::ostringstream s;
-      s << where << ": limits [" << m.joint.lower << ", " << m.joint.upper
-        << "] differ from mobility_v2.json's [" << lo << ", " << hi << "]"
-        << (e.joint == "hinge" ? " (radians)" : " (metres)");
-      Fail(urdf, s.str());
+      s << where << ": limits [" << lo << ", " << hi << "]"
+        << (e.joint == "hinge" ? " (radians)" : " (metres)") << " differ from mobility.urdf's ["
+        << m.joint.lower << ", " << m.joint.upper << "]";
+      notes.Warn(json_file, s.str());
     }
   }
   if (e.rotates) {
     const JointDesc& r = desc.links[li].joint;
-    JointType rot = e.no_rotation_limit ? JointType::kContinuous : JointType::kRevolute;
-    if (r.type != rot)
-      Fail(urdf, where + ": rotation joint '" + r.name + "' is " + JointTypeName(r.type) +
-                     ", expected " + JointTypeName(rot));
-    if (!e.no_rotation_limit && (std::abs(r.lower) > kLimitTolerance ||
-                                 std::abs(r.upper - Radians(e.rotation_limit)) > kLimitTolerance))
-      Fail(urdf, where + ": rotation limits differ from mobility_v2.json's rotationLimit");
+    const JointType rot = e.no_rotation_limit ? JointType::kContinuous : JointType::kRevolute;
+    if (r.type != rot) {
+      notes.Warn(json_file,
+                 where + ": the turn is " + JointTypeName(rot) +
+                     (e.no_rotation_limit
+                          ? std::string()
+                          : " over [0, " + std::to_string(e.rotation_limit) + "] degrees") +
+                     ", mobility.urdf's joint '" + r.name + "' is " + JointTypeName(r.type));
+    } else if (!e.no_rotation_limit &&
+               (std::abs(r.lower) > kLimitTolerance ||
+                std::abs(r.upper - Radians(e.rotation_limit)) > kLimitTolerance)) {
+      notes.Warn(json_file,
+                 where + ": rotation limits differ from mobility.urdf's joint '" + r.name + "'");
+    }
   }
 }
 
-std::vector<std::pair<std::string, std::pair<std::string, std::string>>> ReadSemantics(
-    const fs::path& file) {
+// One line of semantics.txt.
+struct SemanticsLine {
+  std::string link, joint, label;
+  int line = 0;
+};
+
+std::vector<SemanticsLine> ReadSemantics(const fs::path& file) {
   std::ifstream in(file);
   if (!in) Fail(file, "cannot be read");
-  std::vector<std::pair<std::string, std::pair<std::string, std::string>>> out;
+  std::vector<SemanticsLine> out;
   std::string line;
   int n = 0;
   while (std::getline(in, line)) {
     ++n;
     std::istringstream s(line);
-    std::string link, joint, label, extra;
-    if (!(s >> link)) continue;  // blank line
-    if (!(s >> joint >> label) || (s >> extra))
+    SemanticsLine e;
+    e.line = n;
+    std::string extra;
+    if (!(s >> e.link)) continue;  // blank line
+    if (!(s >> e.joint >> e.label) || (s >> extra))
       Fail(file, "line " + std::to_string(n) + ": expected '<link> <joint type> <label>', got '" +
                      line + "'");
-    out.push_back({link, {joint, label}});
+    out.push_back(e);
   }
   return out;
+}
+
+// The semantics.txt joint kind that a mobility_v2.json motion is written as.
+std::string SemanticsKind(const PartNetLink& l) {
+  return l.joint == "slider" && l.rotates ? "slider+" : l.joint;
+}
+
+// Bounds at rest of the visual meshes (collision shapes' when there are none), in frame F.
+void ComputeBounds(PartNetMobilityObject* obj) {
+  const ArticulationDesc& art = obj->articulation;
+  std::vector<Pose> X = RestPoses(art);
+  const Pose X_FB = obj->X_BF.Inverse();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(kInf), hi = -lo;
+  for (size_t i = 0; i < art.links.size(); ++i) {
+    const Pose X_FL = X_FB * X[i];
+    for (const VisualShape& v : art.links[i].visuals) {
+      if (!v.mesh) continue;
+      const Pose X_FV = X_FL * v.pose;
+      for (const Eigen::Vector3f& p : v.mesh->vertices) {
+        Eigen::Vector3d q = X_FV.Transform(p.cast<double>());
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+      }
+    }
+  }
+  if (lo.allFinite() && hi.allFinite()) {
+    obj->bbox_min = lo;
+    obj->bbox_max = hi;
+  }
 }
 
 }  // namespace
@@ -267,91 +373,157 @@ std::vector<int> PartNetMobilityObject::PartVisuals(int id, const std::string& p
   std::vector<int> out;
   for (const PartNetPart& p : Link(id).parts) {
     if (p.name != part_name) continue;
-    std::string suffix = "-" + std::to_string(p.id);
-    for (size_t v = 0; v < link.visuals.size(); ++v) {
-      const std::string& n = link.visuals[v].name;
-      if (n.size() >= suffix.size() &&
-          n.compare(n.size() - suffix.size(), suffix.size(), suffix) == 0)
-        out.push_back(static_cast<int>(v));
-    }
+    for (int v : VisualsOfPart(link, p.id)) out.push_back(v);
   }
   return out;
 }
 
+std::vector<int> PartNetMobilityObject::LinksWithLabel(const std::string& label) const {
+  std::vector<int> out;
+  for (const PartNetLink& l : links)
+    if (l.semantic_label == label) out.push_back(l.id);
+  return out;
+}
+
 PartNetMobilityObject PartNetMobilityLoader::Parse(const std::string& folder_in) const {
+  last_report_ = LoadReport();
   fs::path folder(folder_in);
-  if (!fs::is_directory(folder)) Fail(folder, "is not a folder");
-  fs::path urdf_file = Require(folder, "mobility.urdf");
-  fs::path json_file = Require(folder, "mobility_v2.json");
-  fs::path sem_file = Require(folder, "semantics.txt");
-  fs::path meta_file = Require(folder, "meta.json");
-  fs::path bbox_file = Require(folder, "bounding_box.json");
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) Fail(folder, "is not a folder");
+  const fs::path urdf_file = Require(folder, "mobility.urdf");
+  const fs::path json_file = folder / "mobility_v2.json";
+  const fs::path sem_file = folder / "semantics.txt";
+  const fs::path meta_file = folder / "meta.json";
+  const fs::path bbox_file = folder / "bounding_box.json";
 
   PartNetMobilityObject obj;
   obj.folder = folder.string();
-  // meta.json and bounding_box.json
-  json meta = ReadJson(meta_file);
-  obj.category = Fields(meta_file, "meta").String(meta, "model_cat");
-  obj.model_id = meta.contains("model_id") && meta["model_id"].is_string()
-                     ? meta["model_id"].get<std::string>()
-                     : folder.filename().string();
-  json bbox = ReadJson(bbox_file);
-  obj.bbox_min = Fields(bbox_file, "bounding box").Vec3(bbox, "min");
-  obj.bbox_max = Fields(bbox_file, "bounding box").Vec3(bbox, "max");
+  Notes notes(strict, &obj.report);
+  auto present = [&](const fs::path& p) {
+    if (fs::is_regular_file(p, ec)) return true;
+    notes.Warn(p, "file is missing");
+    return false;
+  };
+
+  // meta.json: category and model id
+  obj.model_id = folder.filename().string();
+  if (present(meta_file)) {
+    json meta = ReadJson(meta_file);
+    if (!meta.is_object()) Fail(meta_file, "must hold a JSON object");
+    if (meta.contains("model_cat") && meta["model_cat"].is_string())
+      obj.category = meta["model_cat"].get<std::string>();
+    else
+      notes.Warn(meta_file, "has no string 'model_cat': the category is unknown");
+    if (meta.contains("model_id") && meta["model_id"].is_string())
+      obj.model_id = meta["model_id"].get<std::string>();
+  }
 
   // mobility_v2.json
-  json entries = ReadJson(json_file);
-  if (!entries.is_array()) Fail(json_file, "must hold a list of links");
-  for (size_t i = 0; i < entries.size(); ++i)
-    obj.links.push_back(ReadLinkEntry(entries[i], i, json_file));
-  std::sort(obj.links.begin(), obj.links.end(),
-            [](const PartNetLink& a, const PartNetLink& b) { return a.id < b.id; });
-  for (size_t i = 1; i < obj.links.size(); ++i)
-    if (obj.links[i].id == obj.links[i - 1].id)
-      Fail(json_file, "link_" + std::to_string(obj.links[i].id) + " appears twice");
-  for (const PartNetLink& l : obj.links)
-    if (l.parent >= 0 && std::none_of(obj.links.begin(), obj.links.end(),
-                                      [&](const PartNetLink& o) { return o.id == l.parent; }))
-      Fail(json_file, "link_" + std::to_string(l.id) + " has parent " + std::to_string(l.parent) +
-                          ", which is not in the file");
+  if (present(json_file)) {
+    json entries = ReadJson(json_file);
+    if (!entries.is_array()) Fail(json_file, "must hold a list of links");
+    for (size_t i = 0; i < entries.size(); ++i)
+      obj.links.push_back(ReadLinkEntry(entries[i], i, json_file));
+    std::sort(obj.links.begin(), obj.links.end(),
+              [](const PartNetLink& a, const PartNetLink& b) { return a.id < b.id; });
+    for (size_t i = 1; i < obj.links.size(); ++i)
+      if (obj.links[i].id == obj.links[i - 1].id)
+        Fail(json_file, "link_" + std::to_string(obj.links[i].id) + " appears twice");
+    for (const PartNetLink& l : obj.links)
+      if (l.parent >= 0 && std::none_of(obj.links.begin(), obj.links.end(),
+                                        [&](const PartNetLink& o) { return o.id == l.parent; }))
+        notes.Warn(json_file, Describe(l) + " has parent " + std::to_string(l.parent) +
+                                  ", which is not in the file");
+  }
 
-  // semantics.txt agrees with the JSON
-  auto semantics = ReadSemantics(sem_file);
-  for (const PartNetLink& l : obj.links) {
-    std::string name = "link_" + std::to_string(l.id);
+  // semantics.txt: the movable-part labels; its joint kinds must agree with the JSON's motions
+  // (its labels are another vocabulary than the JSON's names, and may differ from them)
+  std::vector<SemanticsLine> semantics;
+  if (present(sem_file)) semantics = ReadSemantics(sem_file);
+  static const char* kKinds[] = {"hinge", "slider", "slider+", "free", "heavy", "static"};
+  for (const SemanticsLine& s : semantics) {
+    if (std::find(std::begin(kKinds), std::end(kKinds), s.joint) == std::end(kKinds))
+      notes.Warn(sem_file, "line " + std::to_string(s.line) + ": unknown joint kind '" + s.joint +
+                               "' (expected hinge, slider, slider+, free, heavy or static)");
+  }
+  for (PartNetLink& l : obj.links) {
+    const std::string name = "link_" + std::to_string(l.id);
     auto it = std::find_if(semantics.begin(), semantics.end(),
-                           [&](const auto& s) { return s.first == name; });
-    if (it == semantics.end()) Fail(sem_file, "has no line for " + name);
-    if (it->second.first != l.joint || it->second.second != l.semantic_label)
-      Fail(sem_file, name + " is '" + it->second.first + " " + it->second.second +
-                         "', mobility_v2.json says '" + l.joint + " " + l.semantic_label + "'");
+                           [&](const SemanticsLine& s) { return s.link == name; });
+    if (it == semantics.end()) {
+      if (fs::is_regular_file(sem_file, ec))
+        notes.Warn(sem_file, "has no line for " + name + "; its label is mobility_v2.json's '" +
+                                 l.partnet_name + "'");
+      continue;
+    }
+    l.semantic_label = it->label;
+    l.semantic_joint = it->joint;
+    if (it->joint != SemanticsKind(l))
+      notes.Warn(sem_file, "line " + std::to_string(it->line) + ": " + name + " is '" + it->joint +
+                               "', mobility_v2.json says '" + SemanticsKind(l) + "'");
   }
 
-  // mobility.urdf, cross-checked in the file's frame
+  // mobility.urdf, the physical truth, as it is (already z-up)
   UrdfLoader u = urdf;
-  u.fix_root_link = urdf.fix_root_link;
+  u.strict = urdf.strict || strict;
   obj.articulation = u.ParseFile(urdf_file.string());
-  std::vector<Pose> X = RestPoses(obj.articulation);
-  for (const PartNetLink& l : obj.links) CheckLink(l, obj.articulation, X, folder, u.scale);
-  for (const PartNetLink& l : obj.links)
-    for (const PartNetPart& p : l.parts)
-      if (obj.PartVisuals(l.id, p.name).empty())
-        Fail(urdf_file, "link_" + std::to_string(l.id) + " has no visual named '*-" +
-                            std::to_string(p.id) + "' for part '" + p.name + "' (" +
-                            std::to_string(p.id) + ") of mobility_v2.json");
-
-  // labels, names, and the file's y-up frame turned z-up at the root
+  obj.report.Append(u.LastReport());
   ArticulationDesc& art = obj.articulation;
-  art.name = obj.category + "_" + obj.model_id;
-  for (const PartNetLink& l : obj.links) {
-    int i = FindLink(art, "link_" + std::to_string(l.id));
-    art.links[i].semantic_label = l.semantic_label;
-    if (l.rotates) art.links[art.links[i].parent].semantic_label = l.semantic_label;
+  obj.X_BF = AnnotationFrame(art);
+
+  // entries naming links that mobility.urdf lacks are dropped; the rest are cross-checked
+  std::vector<PartNetLink> kept;
+  for (PartNetLink& l : obj.links) {
+    if (FindLink(art, "link_" + std::to_string(l.id)) < 0) {
+      notes.Warn(json_file, Describe(l) + " names a link that mobility.urdf lacks; dropped");
+      continue;
+    }
+    kept.push_back(std::move(l));
   }
-  const Eigen::Quaterniond y_up_to_z_up(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()));
-  for (LinkDesc& l : art.links)
-    if (l.parent >= 0 && art.links[l.parent].parent < 0)
-      l.joint.pose_in_parent = Pose(Eigen::Vector3d::Zero(), y_up_to_z_up) * l.joint.pose_in_parent;
+  obj.links = std::move(kept);
+  std::vector<Pose> X = RestPoses(art);
+  for (const PartNetLink& l : obj.links) CheckLink(l, art, X, obj.X_BF, folder, u.scale, notes);
+  for (PartNetLink& l : obj.links) {
+    for (PartNetPart& p : l.parts) {
+      p.visuals = VisualsOfPart(art.links[obj.LinkIndex(l.id)], p.id);
+      if (p.visuals.empty())
+        notes.Warn(urdf_file, "link_" + std::to_string(l.id) + " has no visual named '*-" +
+                                  std::to_string(p.id) + "' for part '" + p.name + "' (" +
+                                  std::to_string(p.id) + ") of mobility_v2.json");
+    }
+  }
+
+  // labels and names on the links (a rotating slider's helper link carries its link's labels)
+  art.name = (obj.category.empty() ? "object" : obj.category) + "_" + obj.model_id;
+  for (const PartNetLink& l : obj.links) {
+    const int i = obj.LinkIndex(l.id);
+    for (int k : {i, l.rotates ? art.links[i].parent : -1}) {
+      if (k < 0) continue;
+      art.links[k].semantic_label = l.semantic_label;
+      art.links[k].partnet_name = l.partnet_name;
+    }
+  }
+  for (const SemanticsLine& s : semantics) {
+    const int i = FindLink(art, s.link);
+    if (i < 0) {
+      notes.Warn(sem_file, "line " + std::to_string(s.line) + " names '" + s.link +
+                               "', which mobility.urdf lacks");
+    } else if (std::none_of(obj.links.begin(), obj.links.end(), [&](const PartNetLink& l) {
+                 return "link_" + std::to_string(l.id) == s.link;
+               })) {
+      art.links[i].semantic_label = s.label;  // a link the JSON does not describe
+    }
+  }
+
+  // bounds: bounding_box.json when present, else from the meshes
+  if (present(bbox_file)) {
+    json bbox = ReadJson(bbox_file);
+    obj.bbox_min = Fields(bbox_file, "bounding box").Vec3(bbox, "min") * u.scale;
+    obj.bbox_max = Fields(bbox_file, "bounding box").Vec3(bbox, "max") * u.scale;
+  } else {
+    ComputeBounds(&obj);
+  }
+  last_report_ = obj.report;
   return obj;
 }
 
@@ -366,7 +538,7 @@ std::vector<PartNetBatchEntry> ParsePartNetMobilityBatch(const std::string& root
   if (!fs::is_directory(root))
     throw Error("PartNet-Mobility batch: '" + root + "' is not a folder");
   for (const auto& e : fs::recursive_directory_iterator(root))
-    if (e.is_regular_file() && e.path().filename() == "mobility_v2.json")
+    if (e.is_regular_file() && e.path().filename() == "mobility.urdf")
       folders.push_back(e.path().parent_path().string());
   std::sort(folders.begin(), folders.end());
   std::vector<PartNetBatchEntry> out;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "partsim/assets/mesh.h"
+#include "partsim/assets/srdf.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -47,14 +48,23 @@ Eigen::Quaterniond XToZ() {
 // Parses URDF text for one source; every error message starts with "URDF <source>: ".
 class Parser {
  public:
-  Parser(const UrdfLoader& loader, const std::string& base_dir, const std::string& source)
-      : loader_(loader), base_dir_(base_dir.empty() ? "." : base_dir), source_(source) {}
+  Parser(const UrdfLoader& loader, const std::string& base_dir, const std::string& source,
+         LoadReport* report)
+      : loader_(loader),
+        base_dir_(base_dir.empty() ? "." : base_dir),
+        source_(source),
+        report_(report) {}
 
   ArticulationDesc Run(const std::string& text);
 
  private:
   [[noreturn]] void Fail(const std::string& what) const {
     throw Error("URDF " + source_ + ": " + what);
+  }
+  // a defect partsim works around: a warning in the report, an error when the loader is strict
+  void Warn(const std::string& what) const {
+    if (loader_.strict) Fail(what + " (strict loading)");
+    report_->Warn(source_, what);
   }
 
   // numbers
@@ -80,19 +90,33 @@ class Parser {
                                                                       Shape* shape) const;
   std::optional<Inertial> ReadInertial(const XMLElement* e, const std::string& link) const;
   JointDesc ReadJoint(const RawJoint& raw, ArticulationDesc* desc);
-  std::string ResolvePath(const std::string& uri, const std::string& where) const;
-  std::vector<std::shared_ptr<MeshData>> CollisionMeshes(const std::string& path,
-                                                         const Eigen::Vector3d& scale);
+  // a file named by the URDF, resolved; nullopt (and the file noted for the one error that
+  // lists them all) when it is missing
+  std::optional<std::string> ResolvePath(const std::string& uri, const std::string& where) const;
+  // ResolvePath for a mesh file, which must also not be empty (noted like a missing one)
+  std::optional<std::string> ResolveMeshFile(const std::string& uri,
+                                             const std::string& where) const;
+  // notes a missing or unreadable file; Run fails listing every one of them
+  void NoteBadFile(const std::string& where, const std::string& uri,
+                   const std::string& problem) const;
+  std::vector<std::shared_ptr<const MeshData>> CollisionMeshes(const std::string& path,
+                                                               const Eigen::Vector3d& scale,
+                                                               const std::string& where,
+                                                               const std::string& uri);
   const std::vector<LoadedMesh>& VisualMeshes(const std::string& path,
                                               const Eigen::Vector3d& scale);
 
   const UrdfLoader& loader_;
   fs::path base_dir_;
   std::string source_;
+  LoadReport* report_;
   std::map<std::string, RenderMaterial> materials_;
   // meshes read during this parse, by path and scale
-  std::map<std::pair<std::string, std::string>, std::vector<std::shared_ptr<MeshData>>>
+  std::map<std::pair<std::string, std::string>, std::vector<std::shared_ptr<const MeshData>>>
       collision_cache_;
+  // files that are missing or cannot be read: "where: 'uri' problem", in file order
+  mutable std::vector<std::string> bad_files_;
+  mutable std::set<std::string> bad_uris_;
   std::map<std::pair<std::string, std::string>, std::vector<LoadedMesh>> visual_cache_;
 };
 
@@ -178,12 +202,32 @@ std::optional<RenderMaterial> Parser::ReadMaterial(const XMLElement* material,
     }
   }
   if (texture != nullptr && texture->Attribute("filename") != nullptr) {
-    out.diffuse_texture = ResolvePath(texture->Attribute("filename"), where + " <texture>");
+    // a missing texture is listed with the missing meshes
+    out.diffuse_texture =
+        ResolvePath(texture->Attribute("filename"), where + " <texture>").value_or("");
   }
   return out;
 }
 
-std::string Parser::ResolvePath(const std::string& uri, const std::string& where) const {
+void Parser::NoteBadFile(const std::string& where, const std::string& uri,
+                         const std::string& problem) const {
+  bad_files_.push_back(where + ": '" + uri + "' " + problem);
+  bad_uris_.insert(uri);
+}
+
+std::optional<std::string> Parser::ResolveMeshFile(const std::string& uri,
+                                                   const std::string& where) const {
+  std::optional<std::string> path = ResolvePath(uri, where);
+  std::error_code ec;
+  if (path && fs::file_size(*path, ec) == 0 && !ec) {
+    NoteBadFile(where, uri, "is empty");
+    return std::nullopt;
+  }
+  return path;
+}
+
+std::optional<std::string> Parser::ResolvePath(const std::string& uri,
+                                               const std::string& where) const {
   std::vector<fs::path> tried;
   std::error_code ec;
   auto found = [&](const fs::path& p) {
@@ -217,25 +261,79 @@ std::string Parser::ResolvePath(const std::string& uri, const std::string& where
     if (p.is_relative()) p = base_dir_ / p;
     if (found(p)) return p.lexically_normal().string();
   }
-  std::string msg = where + ": file '" + uri + "' not found (tried";
+  std::string msg = "not found (tried";
   for (const fs::path& p : tried) msg += " '" + p.string() + "'";
-  Fail(msg + ")");
+  NoteBadFile(where, uri, msg + ")");
+  return std::nullopt;
 }
 
-std::vector<std::shared_ptr<MeshData>> Parser::CollisionMeshes(const std::string& path,
-                                                               const Eigen::Vector3d& scale) {
+std::vector<std::shared_ptr<const MeshData>> Parser::CollisionMeshes(const std::string& path,
+                                                                     const Eigen::Vector3d& scale,
+                                                                     const std::string& where,
+                                                                     const std::string& uri) {
   std::ostringstream key;
   key.precision(17);
   key << scale.transpose();
-  auto& cached = collision_cache_[{path, key.str()}];
-  if (cached.empty()) {
-    if (loader_.load_multiple_collisions_from_file) {
-      cached = LoadConvexPieces(path, scale);
+  auto found = collision_cache_.find({path, key.str()});
+  if (found != collision_cache_.end()) return found->second;
+
+  std::vector<std::shared_ptr<MeshData>> loaded;
+  if (loader_.load_multiple_collisions_from_file) {
+    loaded = LoadConvexPieces(path, scale);
+  } else {
+    loaded = {LoadMergedMesh(path, scale)};
+  }
+
+  // MuJoCo collides each piece as its convex hull and refuses pieces without volume: flat,
+  // line-like and tiny pieces are thickened or dropped; the file's first user hears of it, once
+  std::vector<std::shared_ptr<const MeshData>> pieces;
+  std::vector<std::string> repairs;
+  int non_convex = 0;
+  const bool several = loaded.size() > 1;
+  for (size_t k = 0; k < loaded.size(); ++k) {
+    ConvexPieceCheck check = CheckConvexPiece(loaded[k]);
+    if (!check.repair.empty()) {
+      repairs.push_back((several ? "piece " + std::to_string(k) + " " : std::string()) +
+                        check.repair);
+    }
+    if (check.piece) pieces.push_back(check.piece);
+    non_convex += check.non_convex;
+  }
+  const std::string file = "mesh '" + uri + "'";
+  if (!repairs.empty()) {
+    std::string list;
+    for (size_t k = 0; k < repairs.size() && k < 4; ++k) list += (k ? "; " : "") + repairs[k];
+    if (repairs.size() > 4) list += "; and " + std::to_string(repairs.size() - 4) + " more";
+    Warn(where + " " + file + ": " +
+         (several ? std::to_string(repairs.size()) + " of " + std::to_string(loaded.size()) +
+                        " collision pieces are degenerate: "
+                  : "collision piece ") +
+         list);
+  }
+  // a non-convex mesh is no defect of the file, only a limit of hull collision: a warning even
+  // when loading strictly
+  if (non_convex > 0) {
+    const std::string decompose = "`partsim assets decompose " + path + " --out DIR`";
+    if (several) {
+      report_->Warn(
+          source_,
+          where + " " + file + ": " + std::to_string(non_convex) + " of " +
+              std::to_string(loaded.size()) +
+              " connected pieces are not convex, and each collides as its convex hull; split the "
+              "mesh into convex pieces with " +
+              decompose);
     } else {
-      cached = {LoadMergedMesh(path, scale)};
+      report_->Warn(
+          source_,
+          where + " " + file +
+              " is not convex, and collides as one convex hull; set "
+              "load_multiple_collisions_from_file to make each connected part its own piece, or "
+              "split it into convex pieces with " +
+              decompose);
     }
   }
-  return cached;
+  collision_cache_[{path, key.str()}] = pieces;
+  return pieces;
 }
 
 const std::vector<LoadedMesh>& Parser::VisualMeshes(const std::string& path,
@@ -334,12 +432,14 @@ void Parser::ReadCollision(const XMLElement* c, const std::string& link, LinkDes
     out->collisions.push_back(shape);
     return;
   }
-  std::string path = ResolvePath(mesh->first, where + " <mesh>");
-  std::vector<std::shared_ptr<MeshData>> pieces;
+  std::optional<std::string> path = ResolveMeshFile(mesh->first, where + " <mesh>");
+  if (!path) return;
+  std::vector<std::shared_ptr<const MeshData>> pieces;
   try {
-    pieces = CollisionMeshes(path, mesh->second);
+    pieces = CollisionMeshes(*path, mesh->second, where, mesh->first);
   } catch (const Error& e) {
-    Fail(where + ": " + e.what());
+    NoteBadFile(where + " <mesh>", mesh->first, std::string("cannot be read: ") + e.what());
+    return;
   }
   for (const auto& piece : pieces) {
     CollisionShape s = shape;
@@ -371,12 +471,14 @@ void Parser::ReadVisual(const XMLElement* v, const std::string& link, LinkDesc* 
     out->visuals.push_back(shape);
     return;
   }
-  std::string path = ResolvePath(mesh->first, where + " <mesh>");
+  std::optional<std::string> path = ResolveMeshFile(mesh->first, where + " <mesh>");
+  if (!path) return;
   const std::vector<LoadedMesh>* parts = nullptr;
   try {
-    parts = &VisualMeshes(path, mesh->second);
+    parts = &VisualMeshes(*path, mesh->second);
   } catch (const Error& e) {
-    Fail(where + ": " + e.what());
+    NoteBadFile(where + " <mesh>", mesh->first, std::string("cannot be read: ") + e.what());
+    return;
   }
   // one visual per sub-mesh, with the file's material unless the URDF gives one
   for (const LoadedMesh& part : *parts) {
@@ -422,6 +524,26 @@ std::optional<Inertial> Parser::ReadInertial(const XMLElement* e, const std::str
   }
   const double floor = std::max(1e-9 * mass, 1e-6 * largest);
   moments = moments.cwiseMax(floor);
+
+  // MuJoCo refuses principal moments that break the triangle inequality A + B >= C (exported
+  // files often do): balanced as its compiler's balanceinertia does, all three set to their mean.
+  // A breach within rounding (a thin disc's A + B = C) only moves C onto A + B. Moments ascend.
+  const double breach = moments[2] - (moments[0] + moments[1]);
+  if (breach > 1e-9 * moments[2]) {
+    const Eigen::Vector3d before = moments;
+    moments.setConstant(moments.sum() / 3.0);
+    auto list = [](const Eigen::Vector3d& v) {
+      std::ostringstream out;
+      out.precision(6);
+      out << "(" << v[0] << ", " << v[1] << ", " << v[2] << ")";
+      return out.str();
+    };
+    Warn(where + ": principal moments of inertia " + list(before) +
+         " kg m^2 break the triangle inequality A + B >= C; set to their mean " + list(moments) +
+         " as MuJoCo's balanceinertia does");
+  } else if (breach > 0) {
+    moments[2] = moments[0] + moments[1];
+  }
   if (axes.determinant() < 0) axes.col(2) = -axes.col(2);
 
   Inertial out;
@@ -487,7 +609,12 @@ JointDesc Parser::ReadJoint(const RawJoint& raw, ArticulationDesc* desc) {
     Fail(where + " (" + raw.type + ") has no <limit>");
   }
   if (limit != nullptr && j.type != JointType::kFixed) {
-    if (j.type != JointType::kContinuous) {
+    if (j.type != JointType::kContinuous && limit->Attribute("lower") == nullptr &&
+        limit->Attribute("upper") == nullptr) {
+      // a <limit> for effort and velocity alone (ANYmal's): URDF's defaults, 0 and 0, would
+      // lock the joint, which is not what such files mean
+      Warn(where + " <limit> gives neither lower nor upper: the joint is left unlimited");
+    } else if (j.type != JointType::kContinuous) {
       const double s = j.type == JointType::kPrismatic ? loader_.scale : 1.0;
       j.lower = Number(limit, "lower", 0.0, where) * s;
       j.upper = Number(limit, "upper", 0.0, where) * s;
@@ -528,9 +655,14 @@ JointDesc Parser::ReadJoint(const RawJoint& raw, ArticulationDesc* desc) {
     if (j.armature < 0) Fail(at + " armature is negative");
   }
 
-  // mimic: a coupling; prismatic lengths scale with the robot
-  if (const XMLElement* m = e->FirstChildElement("mimic")) {
-    if (j.type == JointType::kFixed) Fail(where + " is fixed and cannot <mimic>");
+  // mimic: a coupling; prismatic lengths scale with the robot. A fixed joint has nothing to
+  // couple, so its <mimic> is ignored
+  const XMLElement* m = e->FirstChildElement("mimic");
+  if (m != nullptr && j.type == JointType::kFixed) {
+    Warn(where + " is fixed: its <mimic> is ignored");
+    m = nullptr;
+  }
+  if (m != nullptr) {
     const char* src = m->Attribute("joint");
     if (src == nullptr) Fail(where + " <mimic> has no 'joint'");
     JointCoupling c;
@@ -704,6 +836,15 @@ ArticulationDesc Parser::Run(const std::string& text) {
     desc.links.push_back(std::move(link));
   }
 
+  // every file that is missing or unreadable, in one error
+  if (!bad_files_.empty()) {
+    std::string list;
+    for (const std::string& b : bad_files_) list += "\n  " + b;
+    Fail(std::to_string(bad_uris_.size()) + " file" + (bad_uris_.size() > 1 ? "s" : "") +
+         " named by the URDF " + (bad_uris_.size() > 1 ? "are" : "is") +
+         " missing or unreadable:" + list);
+  }
+
   // couplings name existing, moving joints other than themselves; a prismatic source turns
   // lengths into the scaled unit
   std::map<std::string, JointType> moving;
@@ -729,9 +870,39 @@ ArticulationDesc Parser::Run(const std::string& text) {
 
 }  // namespace
 
+namespace {
+
+// Adds the <disable_collisions> pairs of an SRDF to a parsed URDF. What the loader skips (a pair
+// naming a link the URDF lacks, an entry without links) is a warning, an error when strict.
+void ApplySrdf(const std::string& path, const std::string& urdf_source, bool strict,
+               ArticulationDesc* desc, LoadReport* report) {
+  LoadReport srdf_report;
+  SrdfDesc srdf = ReadSrdfFile(path, &srdf_report);
+  auto warn = [&](const std::string& what) {
+    if (strict) throw Error("SRDF " + path + ": " + what + " (strict loading)");
+    report->Warn(path, what);
+  };
+  for (const LoadWarning& w : srdf_report.warnings) warn(w.message);
+  std::set<std::string> links;
+  for (const LinkDesc& l : desc->links) links.insert(l.name);
+  for (const SrdfDisabledCollision& p : srdf.disabled_collisions) {
+    std::string missing = !links.count(p.link1) ? p.link1 : !links.count(p.link2) ? p.link2 : "";
+    if (links.count(p.link1) && links.count(p.link2))
+      desc->disabled_collisions.emplace_back(p.link1, p.link2);
+    else
+      warn("<disable_collisions> at line " + std::to_string(p.line) + " names link '" + missing +
+           "', which URDF " + urdf_source + " lacks; pair ignored");
+  }
+}
+
+}  // namespace
+
 ArticulationDesc UrdfLoader::Parse(const std::string& text, const std::string& base_dir,
                                    const std::string& source) const {
-  return Parser(*this, base_dir, source).Run(text);
+  last_report_ = LoadReport();
+  ArticulationDesc desc = Parser(*this, base_dir, source, &last_report_).Run(text);
+  if (!srdf_file.empty()) ApplySrdf(srdf_file, source, strict, &desc, &last_report_);
+  return desc;
 }
 
 ArticulationDesc UrdfLoader::ParseFile(const std::string& path) const {
@@ -742,7 +913,12 @@ ArticulationDesc UrdfLoader::ParseFile(const std::string& path) const {
   std::ostringstream text;
   text << in.rdbuf();
   fs::path dir = fs::absolute(fs::path(path), ec).parent_path();
-  return Parse(text.str(), dir.string(), name);
+  ArticulationDesc desc = Parse(text.str(), dir.string(), name);
+  // without an SRDF named, the one beside the file (same stem) applies
+  fs::path beside = fs::path(path).replace_extension(".srdf");
+  if (srdf_file.empty() && fs::is_regular_file(beside, ec))
+    ApplySrdf(beside.string(), name, strict, &desc, &last_report_);
+  return desc;
 }
 
 Articulation UrdfLoader::Load(const std::string& path) {

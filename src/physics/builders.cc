@@ -1,8 +1,11 @@
 // ActorBuilder, LinkBuilder and ArticulationBuilder: assemble descriptions piece by piece.
 #include <cmath>
+#include <mutex>
+#include <set>
 
 #include "partsim/assets/mesh.h"
 #include "partsim/assets/urdf.h"
+#include "partsim/core/log.h"
 #include "partsim/physics/scene.h"
 
 namespace partsim {
@@ -43,6 +46,30 @@ void AddConvexMesh(BodyDesc& b, std::shared_ptr<const MeshData> mesh, const Pose
   CollisionShape s = Primitive(ShapeType::kConvexMesh, pose, material, density);
   s.mesh = std::move(mesh);
   b.collisions.push_back(s);
+}
+
+// A piece MuJoCo can collide with (CheckConvexPiece): a flat or line-like piece gets a thin hull,
+// a tiny one is dropped (nullptr), each with a warning naming the mesh. A non-convex mesh loaded
+// as one piece (`whole_file`) is warned about once per file and process.
+std::shared_ptr<const MeshData> CollidablePiece(std::shared_ptr<const MeshData> mesh,
+                                                bool whole_file) {
+  ConvexPieceCheck check = CheckConvexPiece(mesh);
+  const std::string name =
+      mesh->source.empty() ? "a collision mesh" : "mesh '" + mesh->source + "'";
+  if (!check.repair.empty()) LogWarning(name + ": collision piece " + check.repair);
+  if (check.non_convex && whole_file) {
+    static std::mutex mutex;
+    static std::set<std::string> warned;
+    std::lock_guard<std::mutex> lock(mutex);
+    if (warned.insert(mesh->source).second) {
+      LogWarning(name +
+                 " is not convex, and collides as one convex hull; use "
+                 "add_multiple_convex_collisions_from_file to make each connected part its own "
+                 "piece, or split it into convex pieces with `partsim assets decompose " +
+                 mesh->source + " --out DIR`");
+    }
+  }
+  return check.piece;
 }
 
 void CheckScale(const Eigen::Vector3d& scale, const std::string& filename) {
@@ -120,7 +147,8 @@ D& BodyBuilder<D>::AddConvexCollisionFromFile(const std::string& filename, const
                                               const std::optional<PhysicalMaterial>& material,
                                               double density) {
   CheckScale(scale, filename);
-  AddConvexMesh(body(), LoadMergedMesh(filename, scale), pose, material, density);
+  if (auto piece = CollidablePiece(LoadMergedMesh(filename, scale), true))
+    AddConvexMesh(body(), piece, pose, material, density);
   return self();
 }
 template <typename D>
@@ -128,8 +156,9 @@ D& BodyBuilder<D>::AddMultipleConvexCollisionsFromFile(
     const std::string& filename, const Pose& pose, const Eigen::Vector3d& scale,
     const std::optional<PhysicalMaterial>& material, double density) {
   CheckScale(scale, filename);
-  for (auto& piece : LoadConvexPieces(filename, scale))
-    AddConvexMesh(body(), piece, pose, material, density);
+  for (auto& loaded : LoadConvexPieces(filename, scale))
+    if (auto piece = CollidablePiece(loaded, false))
+      AddConvexMesh(body(), piece, pose, material, density);
   return self();
 }
 template <typename D>
@@ -137,7 +166,9 @@ D& BodyBuilder<D>::AddConvexCollisionFromMesh(std::shared_ptr<const MeshData> me
                                               const Pose& pose,
                                               const std::optional<PhysicalMaterial>& material,
                                               double density) {
-  AddConvexMesh(body(), std::move(mesh), pose, material, density);
+  if (!mesh) throw Error("add_convex_collision_from_mesh: the mesh is null");
+  if (auto piece = CollidablePiece(std::move(mesh), false))
+    AddConvexMesh(body(), piece, pose, material, density);
   return self();
 }
 template <typename D>
@@ -186,6 +217,16 @@ D& BodyBuilder<D>::SetMassAndInertia(double mass, const Pose& cmass_local_pose,
   body().inertial = MakeInertial(mass, cmass_local_pose, inertia);
   return self();
 }
+template <typename D>
+D& BodyBuilder<D>::SetCollisionGroups(const std::array<uint32_t, 4>& groups) {
+  collision_groups_ = groups;
+  return self();
+}
+template <typename D>
+void BodyBuilder<D>::ApplyCollisionGroups(BodyDesc& body) const {
+  if (!collision_groups_) return;
+  for (CollisionShape& s : body.collisions) s.collision_groups = *collision_groups_;
+}
 
 template class BodyBuilder<ActorBuilder>;
 template class BodyBuilder<LinkBuilder>;
@@ -200,11 +241,13 @@ ActorBuilder& ActorBuilder::SetInitialPose(const Pose& pose) {
 
 Actor ActorBuilder::Build(bool kinematic) {
   desc_.type = kinematic ? ActorType::kKinematic : ActorType::kDynamic;
+  ApplyCollisionGroups(desc_);
   return scene_->AddActor(desc_);
 }
 
 Actor ActorBuilder::BuildStatic() {
   desc_.type = ActorType::kStatic;
+  ApplyCollisionGroups(desc_);
   return scene_->AddActor(desc_);
 }
 
@@ -283,15 +326,22 @@ ArticulationDesc Named(ArticulationDesc desc) {
 
 }  // namespace
 
-Articulation ArticulationBuilder::Build(bool fix_root_link) {
+ArticulationDesc ArticulationBuilder::Finished() const {
   ArticulationDesc desc = Named(desc_);
+  for (size_t i = 0; i < link_builders_.size(); ++i)
+    link_builders_[i]->ApplyCollisionGroups(desc.links[i]);
+  return desc;
+}
+
+Articulation ArticulationBuilder::Build(bool fix_root_link) {
+  ArticulationDesc desc = Finished();
   desc.fix_root = fix_root_link;
   desc.kinematic = false;
   return scene_->AddArticulation(desc);
 }
 
 Articulation ArticulationBuilder::BuildKinematic() {
-  ArticulationDesc desc = Named(desc_);
+  ArticulationDesc desc = Finished();
   desc.fix_root = true;
   desc.kinematic = true;
   return scene_->AddArticulation(desc);

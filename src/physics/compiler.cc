@@ -1,9 +1,15 @@
 // Compiles partsim's scene description into MJCF text for MuJoCo, and after MuJoCo has loaded it,
 // resolves the ids that partsim's handles use.
+#include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <map>
+#include <regex>
+#include <set>
 #include <sstream>
+#include <utility>
 
 #include "core/number_text.h"
 #include "physics/scene_internal.h"
@@ -30,6 +36,9 @@ class MjcfWriter {
  public:
   explicit MjcfWriter(const SceneImpl& scene) : scene_(scene) {}
 
+  /// After Write(): the first geom that uses each mesh asset.
+  const std::map<std::string, std::string>& MeshUsers() const { return mesh_users_; }
+
   std::string Write() {
     const SceneConfig& c = scene_.config;
     const char* integrator = c.integrator == Integrator::kEuler ? "Euler"
@@ -38,6 +47,7 @@ class MjcfWriter {
     // bodies first: they collect mesh assets and equality constraints
     for (const auto& a : scene_.actors) WriteActor(a.id, a.desc);
     for (const auto& a : scene_.articulations) WriteArticulation(a.id, a.desc);
+    WriteIgnoreGroupExcludes();
 
     std::ostringstream out;
     out << "<mujoco model=\"partsim\">\n"
@@ -52,6 +62,12 @@ class MjcfWriter {
     out << "  <size nconmax=\"" << nconmax << "\" njmax=\"" << njmax << "\"/>\n";
     if (!assets_.str().empty()) out << "  <asset>\n" << assets_.str() << "  </asset>\n";
     out << "  <worldbody>\n" << bodies_.str() << "  </worldbody>\n";
+    if (!excludes_.empty()) {
+      out << "  <contact>\n";
+      for (const auto& [a, b] : excludes_)
+        out << "    <exclude body1=\"" << a << "\" body2=\"" << b << "\"/>\n";
+      out << "  </contact>\n";
+    }
     if (!equality_.str().empty()) out << "  <equality>\n" << equality_.str() << "  </equality>\n";
     if (!actuators_.str().empty()) out << "  <actuator>\n" << actuators_.str() << "  </actuator>\n";
     out << "</mujoco>\n";
@@ -108,20 +124,101 @@ class MjcfWriter {
       Indent(depth);
       bodies_ << "<geom name=\"" << prefix << "_g" << i << "\" type=\"" << type << "\"";
       if (!size.empty()) bodies_ << " size=\"" << size << "\"";
-      if (s.type == ShapeType::kConvexMesh) bodies_ << " mesh=\"" << MeshAsset(*s.mesh) << "\"";
+      if (s.type == ShapeType::kConvexMesh)
+        bodies_ << " mesh=\"" << MeshAsset(*s.mesh, prefix + "_g" + std::to_string(i)) << "\"";
       bodies_ << PoseAttrs(pose) << " density=\"" << Num(s.density) << "\" friction=\""
               << Num(mat.static_friction) << " 0.005 0.0001\" solref=\"0.02 "
-              << Num(RestitutionToDampingRatio(mat.restitution)) << "\"/>\n";
+              << Num(RestitutionToDampingRatio(mat.restitution)) << "\"";
+      // SAPIEN's g0 / g1 follow MuJoCo's contype / conaffinity rule; MuJoCo stores them as
+      // signed 32-bit integers (MuJoCo's default is 1)
+      const std::array<uint32_t, 4>& g = s.collision_groups;
+      if (g[0] != 1u) bodies_ << " contype=\"" << static_cast<int32_t>(g[0]) << "\"";
+      if (g[1] != 1u) bodies_ << " conaffinity=\"" << static_cast<int32_t>(g[1]) << "\"";
+      bodies_ << "/>\n";
       ++num_collision_geoms_;
+    }
+    NoteIgnoreGroups(prefix, shapes);
+  }
+
+  // A body can only be ignored as a whole by another when each of its shapes has g2 != 0 and
+  // they share one g3; such bodies are kept, by g3, for WriteIgnoreGroupExcludes.
+  void NoteIgnoreGroups(const std::string& body, const std::vector<CollisionShape>& shapes) {
+    if (shapes.empty()) return;
+    uint32_t g3 = shapes[0].collision_groups[3];
+    for (const CollisionShape& s : shapes)
+      if (s.collision_groups[2] == 0 || s.collision_groups[3] != g3) return;
+    ignore_candidates_[g3].push_back({body, &shapes});
+  }
+
+  // SAPIEN's g2 / g3: shapes A and B never collide when A.g2 & B.g2 != 0 and A.g3 == B.g3.
+  // MuJoCo excludes contacts per body pair only, so two bodies are excluded when every pair of
+  // their shapes is ignored. Limitation: where only some shape pairs of two bodies are ignored,
+  // all of them keep colliding. Only the candidates noted above are compared, pairwise within
+  // each g3, so scenes that leave g2 at 0 cost nothing.
+  void WriteIgnoreGroupExcludes() {
+    for (const auto& [g3, bodies] : ignore_candidates_) {
+      for (size_t i = 0; i < bodies.size(); ++i) {
+        for (size_t j = i + 1; j < bodies.size(); ++j) {
+          bool all_ignored = true;
+          for (const CollisionShape& a : *bodies[i].second)
+            for (const CollisionShape& b : *bodies[j].second)
+              all_ignored = all_ignored && (a.collision_groups[2] & b.collision_groups[2]) != 0;
+          if (all_ignored) Exclude(bodies[i].first, bodies[j].first);
+        }
+      }
     }
   }
 
+  // Contacts between two bodies are never generated.
+  void Exclude(const std::string& a, const std::string& b) {
+    if (a != b) excludes_.insert(a < b ? std::make_pair(a, b) : std::make_pair(b, a));
+  }
+
+  // Links joined by a joint never collide. MuJoCo filters a body against its parent's weld group
+  // (the bodies fixed to it) only when neither is welded to the world, so the links of a fixed
+  // root would still touch their children. Excluded here, for every moving joint: each link
+  // rigidly attached (through fixed joints) to its parent against each link rigidly attached to
+  // its child; and every pair joined by a fixed joint. Then the pairs the description disables.
+  void WriteCollisionExcludes(int id, const ArticulationDesc& art) {
+    size_t n = art.links.size();
+    // rigid group of a link: the topmost link reached through fixed joints (parents come first)
+    std::vector<int> group(n);
+    std::vector<std::vector<int>> members(n);  // links with shapes, by group
+    for (size_t i = 0; i < n; ++i) {
+      const LinkDesc& l = art.links[i];
+      bool fixed = l.parent >= 0 && l.joint.type == JointType::kFixed;
+      group[i] = fixed ? group[l.parent] : static_cast<int>(i);
+      if (!l.collisions.empty()) members[group[i]].push_back(static_cast<int>(i));
+    }
+    auto body = [&](int link) { return LinkBodyName(id, link); };
+    for (size_t i = 0; i < n; ++i) {
+      const LinkDesc& l = art.links[i];
+      if (l.parent < 0) continue;
+      if (l.joint.type == JointType::kFixed) {
+        if (!l.collisions.empty() && !art.links[l.parent].collisions.empty())
+          Exclude(body(l.parent), body(static_cast<int>(i)));
+        continue;
+      }
+      // a rigid group without shapes (the helper link of a compound joint, such as the slide
+      // under a rotating slider) is seen through: the group above it counts as the parent
+      int p = group[l.parent];
+      while (members[p].empty() && art.links[p].parent >= 0) p = group[art.links[p].parent];
+      for (int a : members[p])
+        for (int b : members[i]) Exclude(body(a), body(b));
+    }
+    std::map<std::string, int> index;
+    for (size_t i = 0; i < n; ++i) index[art.links[i].name] = static_cast<int>(i);
+    for (const auto& [a, b] : art.disabled_collisions)
+      Exclude(body(index.at(a)), body(index.at(b)));  // Validate() has checked the names
+  }
+
   // Registers a mesh asset (once per MeshData) and returns its name.
-  std::string MeshAsset(const MeshData& mesh) {
+  std::string MeshAsset(const MeshData& mesh, const std::string& geom) {
     auto it = mesh_names_.find(&mesh);
     if (it != mesh_names_.end()) return it->second;
     std::string name = "mesh" + std::to_string(mesh_names_.size());
     mesh_names_[&mesh] = name;
+    mesh_users_[name] = geom;
     assets_ << "    <mesh name=\"" << name << "\" vertex=\"";
     char buf[64];
     for (const auto& v : mesh.vertices) {
@@ -149,6 +246,7 @@ class MjcfWriter {
   }
 
   void WriteArticulation(int id, const ArticulationDesc& art) {
+    WriteCollisionExcludes(id, art);
     if (art.kinematic) {
       // every link is a mocap body placed by forward kinematics
       for (size_t i = 0; i < art.links.size(); ++i) {
@@ -260,6 +358,11 @@ class MjcfWriter {
   const SceneImpl& scene_;
   std::ostringstream bodies_, assets_, equality_, actuators_;
   std::map<const MeshData*, std::string> mesh_names_;
+  std::map<std::string, std::string> mesh_users_;  ///< mesh asset -> first geom that uses it
+  std::set<std::pair<std::string, std::string>> excludes_;  ///< body pairs, first < second
+  /// bodies that may be ignored as a whole (NoteIgnoreGroups) by g3: body name and its shapes
+  std::map<uint32_t, std::vector<std::pair<std::string, const std::vector<CollisionShape>*>>>
+      ignore_candidates_;
   int num_collision_geoms_ = 0;
   int num_limits_ = 0;
   int num_equalities_ = 0;
@@ -294,6 +397,101 @@ double RestitutionToDampingRatio(double e) {
 }
 
 std::string GenerateMjcf(const SceneImpl& scene) { return MjcfWriter(scene).Write(); }
+
+std::string DescribeMjNames(const SceneImpl& scene, const std::string& text) {
+  MjcfWriter writer(scene);
+  writer.Write();
+  const std::map<std::string, std::string>& mesh_users = writer.MeshUsers();
+  auto quoted = [](const std::string& kind, const std::string& name, int id) {
+    return name.empty() ? kind + " " + std::to_string(id) : kind + " '" + name + "'";
+  };
+  // the user's names of a generated MuJoCo name, or "" when it names nothing partsim made
+  std::function<std::string(const std::string&)> describe =
+      [&](const std::string& name) -> std::string {
+    std::smatch m;
+    static const std::regex kArt("r(\\d+)_([ljsd])(\\d+)(?:_g(\\d+))?");
+    static const std::regex kActor("a(\\d+)(?:_g(\\d+)|(_free))?");
+    static const std::regex kMesh("mesh(\\d+)");
+    if (std::regex_match(name, m, kArt)) {
+      const int id = std::stoi(m[1]), index = std::stoi(m[3]);
+      for (const auto& a : scene.articulations) {
+        if (a.id != id || index >= static_cast<int>(a.desc.links.size())) continue;
+        const LinkDesc& link = a.desc.links[index];
+        const std::string art = " of " + quoted("articulation", a.desc.name, id);
+        const std::string joint = quoted("joint", link.joint.name, index);
+        const char kind = m[2].str()[0];
+        if (kind == 'l' && m[4].matched) {
+          const size_t k = std::stoul(m[4]);
+          std::string out =
+              "collision shape " + m[4].str() + " of " + quoted("link", link.name, index) + art;
+          if (k < link.collisions.size() && link.collisions[k].mesh &&
+              !link.collisions[k].mesh->source.empty())
+            out += " (mesh '" + link.collisions[k].mesh->source + "')";
+          return out;
+        }
+        if (kind == 'l') return quoted("link", link.name, index) + art;
+        if (kind == 'j' && link.parent < 0) return "the free root joint" + art;
+        if (kind == 'j') return joint + art;
+        if (kind == 's') return "the slide of screw " + joint + art;
+        return "the drive of " + joint + art;
+      }
+    } else if (std::regex_match(name, m, kActor)) {
+      const int id = std::stoi(m[1]);
+      for (const auto& a : scene.actors) {
+        if (a.id != id) continue;
+        const std::string actor = quoted("actor", a.desc.name, id);
+        if (m[3].matched) return "the free joint of " + actor;
+        if (!m[2].matched) return actor;
+        const size_t k = std::stoul(m[2]);
+        std::string out = "collision shape " + m[2].str() + " of " + actor;
+        if (k < a.desc.collisions.size() && a.desc.collisions[k].mesh &&
+            !a.desc.collisions[k].mesh->source.empty())
+          out += " (mesh '" + a.desc.collisions[k].mesh->source + "')";
+        return out;
+      }
+    } else if (std::regex_match(name, m, kMesh)) {
+      auto it = mesh_users.find(name);
+      if (it != mesh_users.end()) {
+        std::string user = describe(it->second);
+        if (!user.empty()) return "the convex mesh of " + user;
+      }
+    }
+    return "";
+  };
+
+  // each generated name (with the kind of element MuJoCo may put before it) becomes the user's
+  static const std::regex kName(
+      "(?:\\b(?:body|joint|geom|mesh|actuator) )?'?\\b(r\\d+_[ljsd]\\d+(?:_g\\d+)?|a\\d+(?:_g\\d+|_"
+      "free)?|mesh\\d+)\\b'?");
+  // MuJoCo's "Object name = X" line repeats a name the message may already hold
+  std::string message = text;
+  static const std::regex kObjectLine(
+      "\\s*\\n\\s*(?:Object|Element) name\\s*=?\\s*'?([A-Za-z0-9_]+)'?[^\\n]*");
+  std::smatch object;
+  if (std::regex_search(message, object, kObjectLine) &&
+      message.substr(0, object.position(0)).find(object[1].str()) != std::string::npos)
+    message.erase(object.position(0), object.length(0));
+  std::string out;
+  auto begin = std::sregex_iterator(message.begin(), message.end(), kName);
+  size_t last = 0;
+  for (auto it = begin; it != std::sregex_iterator(); ++it) {
+    const std::smatch& m = *it;
+    std::string user = describe(m[1]);
+    out += message.substr(last, m.position(0) - last);
+    out += user.empty() ? m.str(0) : user;
+    last = m.position(0) + m.length(0);
+  }
+  out += message.substr(last);
+  // MuJoCo's positions point into the generated MJCF, which the user never wrote
+  static const std::regex kWhere(",? ?\\(?id = -?\\d+(?:, line = -?\\d+, column = -?\\d+)?\\)?");
+  out = std::regex_replace(out, kWhere, "");
+  static const std::regex kObject("\\s*\\n\\s*(?:Object|Element) name\\s*=?\\s*");
+  out = std::regex_replace(out, kObject, " in ");
+  static const std::regex kError("^Error: ");
+  out = std::regex_replace(out, kError, "");
+  while (!out.empty() && std::isspace(static_cast<unsigned char>(out.back()))) out.pop_back();
+  return out;
+}
 
 void BuildTables(SceneImpl& s) {
   const mjModel* m = s.m;
@@ -352,9 +550,8 @@ void BuildTables(SceneImpl& s) {
         c.root_dofadr = m->jnt_dofadr[j];
       }
     }
-    // dofs: one per non-fixed, non-coupled joint, in link order
-    std::map<int, const JointCoupling*> coupled;  // link index -> coupling
-    for (const JointCoupling& cp : desc.couplings) coupled[link_of_joint[cp.joint]] = &cp;
+    // dofs: one per non-fixed joint, in link order; a coupled joint (URDF mimic) is a dof of
+    // its own with its own drive, held to its source by an equality constraint
     for (size_t i = 0; i < n; ++i) {
       const LinkDesc& link = desc.links[i];
       if (link.parent < 0 || link.joint.type == JointType::kFixed) continue;
@@ -369,19 +566,17 @@ void BuildTables(SceneImpl& s) {
           cj.screw_slide_dofadr = m->jnt_dofadr[sj];
         }
       }
-      if (coupled.count(static_cast<int>(i))) continue;
       cj.dof_index = static_cast<int>(c.dof_links.size());
       c.dof_links.push_back(static_cast<int>(i));
       if (!desc.kinematic)
         cj.actuator = Id(m, mjOBJ_ACTUATOR, ActuatorMjName(a.id, static_cast<int>(i)));
     }
-    for (const auto& [li, cp] : coupled) {
+    for (const JointCoupling& cp : desc.couplings) {
       CompiledCoupling cc;
-      cc.qposadr = c.joints[li].qposadr;
-      cc.dofadr = c.joints[li].dofadr;
-      cc.source_dof = c.joints[link_of_joint[cp->source]].dof_index;
-      cc.multiplier = cp->multiplier;
-      cc.offset = cp->offset;
+      cc.dof = c.joints[link_of_joint[cp.joint]].dof_index;
+      cc.source_dof = c.joints[link_of_joint[cp.source]].dof_index;
+      cc.multiplier = cp.multiplier;
+      cc.offset = cp.offset;
       c.couplings.push_back(cc);
     }
     // G: partsim dof velocities -> MuJoCo dof velocities of this articulation
@@ -392,14 +587,6 @@ void BuildTables(SceneImpl& s) {
         rows.push_back({cj.dofadr, {cj.dof_index, 1.0}});
         if (cj.screw_slide_dofadr >= 0)
           rows.push_back({cj.screw_slide_dofadr, {cj.dof_index, desc.links[li].joint.pitch}});
-      }
-      for (const CompiledCoupling& cc : c.couplings) {
-        rows.push_back({cc.dofadr, {cc.source_dof, cc.multiplier}});
-        // a coupled screw joint's slide follows too
-        for (size_t i = 0; i < n; ++i)
-          if (c.joints[i].dofadr == cc.dofadr && c.joints[i].screw_slide_dofadr >= 0)
-            rows.push_back({c.joints[i].screw_slide_dofadr,
-                            {cc.source_dof, cc.multiplier * desc.links[i].joint.pitch}});
       }
       std::sort(rows.begin(), rows.end());
       c.G = Eigen::MatrixXd::Zero(rows.size(), c.dof_links.size());

@@ -209,6 +209,13 @@ void Validate(const ArticulationDesc& art, const std::string& where) {
   for (const JointCoupling& c : art.couplings)
     Require(!coupled.count(c.source), where,
             "joint '" + c.joint + "' follows '" + c.source + "', which itself follows another");
+  // pairs that never collide name existing links
+  for (const auto& [a, b] : art.disabled_collisions) {
+    for (const std::string& name : {a, b})
+      Require(!name.empty() && link_names.count(name), where,
+              what + ": disabled collision pair ('" + a + "', '" + b + "') names link '" + name +
+                  "', which does not exist");
+  }
 }
 
 }  // namespace partsim

@@ -1,4 +1,5 @@
 // Actor, Link, Joint and Articulation handles: views into the scene's description and data.
+#include <algorithm>
 #include <cmath>
 
 #include "partsim/physics/scene.h"
@@ -165,6 +166,13 @@ void Actor::AddForceTorque(const Eigen::Vector3d& force, const Eigen::Vector3d& 
   s.xfrc_dirty = true;
 }
 
+std::vector<Shape> Actor::GetCollisionShapes() const {
+  std::vector<Shape> out;
+  int n = static_cast<int>(GetDesc().collisions.size());
+  for (int i = 0; i < n; ++i) out.emplace_back(scene_, id_, -1, -1, i);
+  return out;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Link
 
@@ -231,6 +239,57 @@ void Link::AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& 
   AddBodyForce(s, LinkBody(s, articulation_id_, index_), force, point);
 }
 
+std::vector<Shape> Link::GetCollisionShapes() const {
+  std::vector<Shape> out;
+  int n = static_cast<int>(GetDesc().collisions.size());
+  for (int i = 0; i < n; ++i) out.emplace_back(scene_, -1, articulation_id_, index_, i);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shape
+
+Actor Shape::GetActor() const { return articulation_id_ < 0 ? Actor(scene_, actor_id_) : Actor(); }
+Link Shape::GetLink() const {
+  return articulation_id_ < 0 ? Link() : Link(scene_, articulation_id_, link_index_);
+}
+
+CollisionShape& Shape::Desc() const {
+  SceneImpl& s = S(scene_);
+  BodyDesc& body = articulation_id_ < 0
+                       ? static_cast<BodyDesc&>(s.GetActor(actor_id_).desc)
+                       : const_cast<LinkDesc&>(LinkAt(s, articulation_id_, link_index_));
+  if (index_ < 0 || index_ >= static_cast<int>(body.collisions.size()))
+    throw IndexError("collision shape index " + std::to_string(index_) + " out of range [0, " +
+                     std::to_string(body.collisions.size()) + ") of '" + body.name + "'");
+  return body.collisions[index_];
+}
+
+const CollisionShape& Shape::GetDesc() const { return Desc(); }
+std::array<uint32_t, 4> Shape::GetCollisionGroups() const { return Desc().collision_groups; }
+
+void Shape::SetCollisionGroups(const std::array<uint32_t, 4>& groups) {
+  CollisionShape& shape = Desc();
+  std::array<uint32_t, 4> old = shape.collision_groups;
+  shape.collision_groups = groups;
+  SceneImpl& s = S(scene_);
+  // g2 / g3 decide which body pairs are excluded at compile time: recompile, keeping the state
+  if (old[2] != groups[2] || old[3] != groups[3]) {
+    s.dirty = true;
+    s.EnsureCompiled();
+    return;
+  }
+  // g0 / g1 are the geom's contype / conaffinity: patch the compiled model
+  s.EnsureCompiled();
+  std::string body = articulation_id_ < 0 ? internal::ActorBodyName(actor_id_)
+                                          : internal::LinkBodyName(articulation_id_, link_index_);
+  int geom = mj_name2id(s.m, mjOBJ_GEOM, (body + "_g" + std::to_string(index_)).c_str());
+  if (geom < 0) throw Error("collision shape " + std::to_string(index_) + " was not compiled");
+  s.m->geom_contype[geom] = static_cast<int>(groups[0]);
+  s.m->geom_conaffinity[geom] = static_cast<int>(groups[1]);
+  s.Invalidate();
+}
+
 // ---------------------------------------------------------------------------------------------
 // Joint
 
@@ -258,8 +317,7 @@ JointRef DofJoint(Scene* scene, int art, int index, const char* what) {
   JointRef j = GetJointRef(scene, art, index);
   if (j.compiled->dof_index < 0)
     throw Error(std::string(what) + ": joint '" + j.desc->name + "' has no degree of freedom (" +
-                JointTypeName(j.desc->type) +
-                (j.desc->type == JointType::kFixed ? "" : ", coupled") + ")");
+                JointTypeName(j.desc->type) + ")");
   return j;
 }
 
@@ -466,6 +524,14 @@ Eigen::VectorXd MjDofs(const ArtRef& r, const double* src) {
   return out;
 }
 
+// Joint-space values with every coupled joint (URDF mimic) set from its source: positions
+// (q = multiplier * q_source + offset) or velocities (qd = multiplier * qd_source).
+Eigen::VectorXd WithCouplings(const ArtRef& r, Eigen::VectorXd x, bool positions) {
+  for (const auto& cp : r.c.couplings)
+    x[cp.dof] = cp.multiplier * x[cp.source_dof] + (positions ? cp.offset : 0.0);
+  return x;
+}
+
 // Mass matrix over the articulation's MuJoCo dofs.
 Eigen::MatrixXd MjMassMatrix(const ArtRef& r) {
   int nv = r.s.m->nv;
@@ -548,23 +614,19 @@ Eigen::VectorXd Articulation::GetQpos() const {
 void Articulation::SetQpos(const Eigen::VectorXd& qpos) {
   ArtRef r = GetArt(scene_, id_);
   CheckVector(qpos, r.dof(), "qpos", r.owner());
+  // coupled joints follow their sources, so that the coupling holds from the start
+  const Eigen::VectorXd values = WithCouplings(r, qpos, true);
   if (r.a.desc.kinematic) {
-    r.a.kin_qpos = qpos;
+    r.a.kin_qpos = values;
     r.s.UpdateKinematicArticulation(r.a);
     return;
   }
   double* q = r.s.d->qpos;
   for (int k = 0; k < r.dof(); ++k) {
     const CompiledJoint& j = r.c.joints[r.c.dof_links[k]];
-    q[j.qposadr] = qpos[k];
+    q[j.qposadr] = values[k];
     if (j.screw_slide_qposadr >= 0)
-      q[j.screw_slide_qposadr] = r.a.desc.links[r.c.dof_links[k]].joint.pitch * qpos[k];
-  }
-  for (const auto& cp : r.c.couplings) {
-    q[cp.qposadr] = cp.multiplier * qpos[cp.source_dof] + cp.offset;
-    for (size_t i = 0; i < r.c.joints.size(); ++i)
-      if (r.c.joints[i].qposadr == cp.qposadr && r.c.joints[i].screw_slide_qposadr >= 0)
-        q[r.c.joints[i].screw_slide_qposadr] = r.a.desc.links[i].joint.pitch * q[cp.qposadr];
+      q[j.screw_slide_qposadr] = r.a.desc.links[r.c.dof_links[k]].joint.pitch * values[k];
   }
   r.s.Invalidate();
 }
@@ -579,10 +641,10 @@ void Articulation::SetQvel(const Eigen::VectorXd& qvel) {
   ArtRef r = GetArt(scene_, id_);
   CheckVector(qvel, r.dof(), "qvel", r.owner());
   if (r.a.desc.kinematic) {
-    r.a.kin_qvel = qvel;
+    r.a.kin_qvel = WithCouplings(r, qvel, false);
     return;
   }
-  ScatterDofs(r, qvel, r.s.d->qvel);
+  ScatterDofs(r, WithCouplings(r, qvel, false), r.s.d->qvel);
   r.s.Invalidate();
 }
 
@@ -800,6 +862,31 @@ Eigen::MatrixXd Articulation::ComputeLinkJacobian(int index) const {
     J.block<3, 1>(3, i) = jr.col(r.c.mj_dofs[i]);
   }
   return J * r.c.G;
+}
+
+void Articulation::DisableCollision(const Link& a, const Link& b) {
+  ArtRef r = GetArt(scene_, id_);
+  std::string names[2];
+  const Link* links[2] = {&a, &b};
+  for (int k = 0; k < 2; ++k) {
+    const Link& l = *links[k];
+    if (l.GetScene() != scene_ || l.GetArticulationId() != id_)
+      throw Error("disable_collision: the link does not belong to " + r.owner());
+    names[k] = LinkAt(r.s, id_, l.GetIndex()).name;
+    if (names[k].empty())
+      throw Error("disable_collision: link " + std::to_string(l.GetIndex()) + " of " + r.owner() +
+                  " has no name");
+  }
+  auto pair = std::make_pair(names[0], names[1]);
+  auto& pairs = r.a.desc.disabled_collisions;
+  auto swapped = std::make_pair(pair.second, pair.first);
+  if (std::find(pairs.begin(), pairs.end(), pair) != pairs.end() ||
+      std::find(pairs.begin(), pairs.end(), swapped) != pairs.end())
+    return;
+  pairs.push_back(pair);
+  // excluded pairs are part of the compiled model: recompile, keeping the state
+  r.s.dirty = true;
+  r.s.EnsureCompiled();
 }
 
 Eigen::MatrixXd Articulation::ComputeWorldCartesianJacobian() const {

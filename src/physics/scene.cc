@@ -145,7 +145,7 @@ void SceneImpl::EnsureCompiled() {
   std::string xml = GenerateMjcf(*this);
   std::string error;
   mjModel* new_m = LoadMjcf(xml, &error);
-  if (!new_m) throw Error("MuJoCo could not compile the scene: " + error);
+  if (!new_m) throw Error("MuJoCo could not compile the scene: " + DescribeMjNames(*this, error));
   mjData* new_d = mj_makeData(new_m);
   // carry the state of everything that existed before
   if (m && d)

@@ -36,17 +36,17 @@ struct CompiledJoint {
   int mj_joint = -1;  ///< main MuJoCo joint (hinge or slide), -1 for fixed
   int qposadr = -1;
   int dofadr = -1;
-  int dof_index = -1;            ///< index in the articulation's qpos, -1 when fixed or coupled
+  int dof_index = -1;            ///< index in the articulation's qpos, -1 when fixed
   int actuator = -1;             ///< drive actuator
   int screw_slide_qposadr = -1;  ///< screw joints: the coupled slide joint
   int screw_slide_dofadr = -1;
 };
 
-/// A MuJoCo dof that follows a partsim dof: q = multiplier * q[source] + offset.
+/// A coupled joint (URDF mimic): an ordinary dof that an equality constraint holds to
+/// q[dof] = multiplier * q[source_dof] + offset.
 struct CompiledCoupling {
-  int qposadr = -1;
-  int dofadr = -1;
-  int source_dof = -1;  ///< partsim dof index
+  int dof = -1;         ///< partsim dof index of the coupled joint
+  int source_dof = -1;  ///< partsim dof index of its source
   double multiplier = 1.0;
   double offset = 0.0;
 };
@@ -170,6 +170,10 @@ struct SceneImpl {
 
 /// Writes MJCF for the whole scene and fills the compiled tables (ids resolved after loading).
 std::string GenerateMjcf(const SceneImpl& scene);
+/// A MuJoCo message with the names partsim generated (r0_l3, r0_j3, a2_g0, mesh4, ...) replaced
+/// by the user's (link, joint and actor names, mesh files), and MuJoCo's positions in the
+/// generated MJCF dropped.
+std::string DescribeMjNames(const SceneImpl& scene, const std::string& text);
 /// Fills compiled tables from a loaded model.
 void BuildTables(SceneImpl& scene);
 

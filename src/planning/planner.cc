@@ -200,6 +200,31 @@ void SpeedUp(JointTrajectory* t, const Eigen::VectorXd& vmax, const Eigen::Vecto
   for (Eigen::VectorXd& a : t->accelerations) a /= s * s;
 }
 
+/// Rest-to-rest quintic segments between the waypoints: the trajectory keeps exactly to the
+/// straight segments of the path. Each segment lasts as long as its slowest joint needs (peak
+/// velocity 15/8 d/T, peak acceleration 10/sqrt(3) d/T^2).
+JointTrajectory StopAtEveryWaypoint(const std::vector<Eigen::VectorXd>& path,
+                                    const Eigen::VectorXd& vmax, const Eigen::VectorXd& amax) {
+  JointTrajectory t;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(path.front().size());
+  double time = 0.0;
+  for (size_t i = 0; i < path.size(); ++i) {
+    if (i > 0) {
+      double h = 1e-3;
+      for (Eigen::Index k = 0; k < zero.size(); ++k) {
+        const double d = std::abs(path[i][k] - path[i - 1][k]);
+        h = std::max({h, 1.875 * d / vmax[k], std::sqrt(5.7736 * d / amax[k])});
+      }
+      time += h;
+    }
+    t.times.push_back(time);
+    t.positions.push_back(path[i]);
+    t.velocities.push_back(zero);
+    t.accelerations.push_back(zero);
+  }
+  return t;
+}
+
 }  // namespace
 
 MotionPlanner::MotionPlanner(const Articulation& arm, const std::vector<std::string>& joints,
@@ -280,7 +305,7 @@ PlanResult MotionPlanner::PlanToJoints(const Eigen::VectorXd& goal, const Planne
   return impl_->Plan(goal, options, t0);
 }
 
-PlanResult MotionPlanner::Impl::Plan(const Eigen::VectorXd& goal, const PlannerOptions& opt,
+PlanResult MotionPlanner::Impl::Plan(const Eigen::VectorXd& goal_in, const PlannerOptions& opt,
                                      std::chrono::steady_clock::time_point t0) {
   PlanResult r;
   auto fail = [&](const std::string& msg) {
@@ -292,10 +317,13 @@ PlanResult MotionPlanner::Impl::Plan(const Eigen::VectorXd& goal, const PlannerO
   const int n = static_cast<int>(dofs.size());
   Eigen::VectorXd start(n);
   for (int i = 0; i < n; ++i) start[i] = base_q[dofs[i]];
-  // a start a hair outside the limits (physics) is pulled in
-  for (int i = 0; i < n; ++i)
-    if (start[i] >= limits(i, 0) - 1e-3 && start[i] <= limits(i, 1) + 1e-3)
-      start[i] = std::clamp(start[i], limits(i, 0), limits(i, 1));
+  // a start a hair outside the limits (physics: a joint resting on its limit), or a goal taken
+  // from such a state, is pulled in
+  Eigen::VectorXd goal = goal_in;
+  for (Eigen::VectorXd* q : {&start, &goal})
+    for (int i = 0; i < n; ++i)
+      if ((*q)[i] >= limits(i, 0) - 1e-3 && (*q)[i] <= limits(i, 1) + 1e-3)
+        (*q)[i] = std::clamp((*q)[i], limits(i, 0), limits(i, 1));
   std::string why;
   if (!Check(goal, opt.clearance, &why)) return fail("the goal is not valid: " + why);
   if (!Check(start, opt.clearance, &why)) return fail("the start is not valid: " + why);
@@ -326,42 +354,63 @@ PlanResult MotionPlanner::Impl::Plan(const Eigen::VectorXd& goal, const PlannerO
     s1[i] = goal[i];
   }
   ss.setStartAndGoalStates(s0, s1, 1e-4);
-  ob::PlannerStatus status = ss.solve(opt.time_limit);
-  if (!status || !ss.haveExactSolutionPath())
-    return fail("no collision-free path found in " + std::to_string(opt.time_limit) + " s (" +
-                opt.algorithm + ")");
-  if (opt.simplify) ss.simplifySolution(1.0);
-  const og::PathGeometric& path = ss.getSolutionPath();
-  std::vector<Eigen::VectorXd> waypoints;
-  for (std::size_t k = 0; k < path.getStateCount(); ++k) {
-    const auto* v = path.getState(k)->as<ob::RealVectorStateSpace::StateType>();
-    Eigen::VectorXd q(n);
-    for (int i = 0; i < n; ++i) q[i] = v->values[i];
-    waypoints.push_back(q);
-  }
-  waypoints.front() = start;
-  if ((waypoints.back() - goal).cwiseAbs().maxCoeff() > 0) waypoints.push_back(goal);
-  r.path = waypoints;
 
-  // time it: the spline through the waypoints must stay collision-free too; densify until it does
+  // is every state of a timed trajectory, sampled at the path's resolution, collision-free?
   const double dt = opt.resolution / velocity_limits.maxCoeff();
-  double step = 0.8;
-  for (int attempt = 0; attempt < 7; ++attempt, step /= 2) {
-    JointTrajectory t =
-        TimeParameterize(Densify(waypoints, step), velocity_limits, acceleration_limits);
-    SpeedUp(&t, velocity_limits, acceleration_limits);
-    bool ok = true;
+  auto timed_ok = [&](const JointTrajectory& t) {
     Eigen::VectorXd q;
-    for (double time = 0; ok && time < t.Duration() + dt; time += dt) {
+    for (double time = 0; time < t.Duration() + dt; time += dt) {
       t.Sample(std::min(time, t.Duration()), &q);
-      ok = Check(q, clearance, &why);
+      if (!Check(q, clearance, &why)) return false;
     }
-    if (ok) {
+    return true;
+  };
+  // OMPL checks the path's segments at discrete states, so a path found may still graze an
+  // obstacle between them, and the spline through it may cut corners: a path whose timing fails
+  // is planned again while the time limit allows (at least twice)
+  for (int round = 0;; ++round) {
+    const double left = opt.time_limit - Seconds(t0);
+    if (round > 0) {
+      if (round > 2 && left <= 0) break;
+      ss.clear();
+    }
+    ob::PlannerStatus status = ss.solve(std::max(left, round == 0 ? opt.time_limit : 0.25));
+    if (!status || !ss.haveExactSolutionPath()) {
+      if (round > 0) break;
+      return fail("no collision-free path found in " + std::to_string(opt.time_limit) + " s (" +
+                  opt.algorithm + ")");
+    }
+    if (opt.simplify) ss.simplifySolution(1.0);
+    const og::PathGeometric& path = ss.getSolutionPath();
+    std::vector<Eigen::VectorXd> waypoints;
+    for (std::size_t k = 0; k < path.getStateCount(); ++k) {
+      const auto* v = path.getState(k)->as<ob::RealVectorStateSpace::StateType>();
+      Eigen::VectorXd q(n);
+      for (int i = 0; i < n; ++i) q[i] = v->values[i];
+      waypoints.push_back(q);
+    }
+    waypoints.front() = start;
+    if ((waypoints.back() - goal).cwiseAbs().maxCoeff() > 0) waypoints.push_back(goal);
+
+    // time it: a smooth spline through the waypoints, densified until it stays collision-free;
+    // failing that, a stop at every waypoint, which keeps exactly to the straight segments
+    auto done = [&](JointTrajectory t) {
+      r.path = waypoints;
       r.trajectory = std::move(t);
       r.success = true;
+      r.message.clear();
       r.planning_time = Seconds(t0);
       return r;
+    };
+    double step = 0.8;
+    for (int attempt = 0; attempt < 7; ++attempt, step /= 2) {
+      JointTrajectory t =
+          TimeParameterize(Densify(waypoints, step), velocity_limits, acceleration_limits);
+      SpeedUp(&t, velocity_limits, acceleration_limits);
+      if (timed_ok(t)) return done(std::move(t));
     }
+    JointTrajectory stops = StopAtEveryWaypoint(waypoints, velocity_limits, acceleration_limits);
+    if (timed_ok(stops)) return done(std::move(stops));
   }
   return fail("the timed trajectory leaves the collision-free path: " + why);
 }

@@ -15,6 +15,20 @@ namespace partsim::python {
 void BindAssets(py::module_& m) {
   const auto ka = py::keep_alive<0, 1>();
 
+  py::class_<LoadWarning>(m, "LoadWarning", "A defect a loader repaired or ignored.")
+      .def_readonly("file", &LoadWarning::file, "The file at fault.")
+      .def_readonly("message", &LoadWarning::message,
+                    "What was wrong and what the loader did, naming the element.")
+      .def("__str__", &LoadWarning::ToString)
+      .def("__repr__", [](const LoadWarning& w) { return "<LoadWarning " + w.ToString() + ">"; });
+  py::class_<LoadReport>(m, "LoadReport",
+                         "The warnings of one load (UrdfLoader.last_report(), "
+                         "PartNetMobilityLoader.last_report()).")
+      .def_readonly("warnings", &LoadReport::warnings, "list of LoadWarning, in file order.")
+      .def("__len__", [](const LoadReport& r) { return r.warnings.size(); })
+      .def("__bool__", [](const LoadReport& r) { return !r.Empty(); })
+      .def("__str__", &LoadReport::ToString);
+
   py::class_<UrdfLinkOverride>(m, "UrdfLinkOverride", "Per-link overrides of a UrdfLoader.")
       .def(py::init([](std::optional<double> density, std::optional<PhysicalMaterial> material) {
              return UrdfLinkOverride{density, material};
@@ -43,6 +57,13 @@ void BindAssets(py::module_& m) {
                      "dict: link name -> UrdfLinkOverride.")
       .def_readwrite("package_dirs", &UrdfLoader::package_dirs,
                      "dict: package name -> folder, for package:// paths.")
+      .def_readwrite("strict", &UrdfLoader::strict,
+                     "Defects the loader would repair with a warning are errors instead.")
+      .def_readwrite("srdf_file", &UrdfLoader::srdf_file,
+                     "SRDF whose <disable_collisions> pairs apply; \"\" looks for "
+                     "<urdf stem>.srdf beside the URDF file.")
+      .def("last_report", &UrdfLoader::LastReport, py::return_value_policy::copy,
+           "The warnings of the last parse or load (a LoadReport).")
       .def("parse", &UrdfLoader::Parse, py::arg("text"), py::arg("base_dir"),
            py::arg("source") = "<string>",
            "Parses URDF text into an ArticulationDesc; `source` names the text in error "
@@ -78,14 +99,22 @@ void BindAssets(py::module_& m) {
   py::class_<PartNetPart>(m, "PartNetPart",
                           "An annotated part piece: a visual named '<name>-<id>'.")
       .def_readonly("id", &PartNetPart::id)
-      .def_readonly("name", &PartNetPart::name);
+      .def_readonly("name", &PartNetPart::name, "PartNet part name, e.g. 'handle'.")
+      .def_readonly("visuals", &PartNetPart::visuals,
+                    "Indices of the part's visuals in its link's visuals.");
   py::class_<PartNetLink>(m, "PartNetLink",
                           "One entry of mobility_v2.json: a link's motion, axis (file frame, "
                           "y-up), limits (degrees for hinges, metres for sliders) and parts.")
       .def_readonly("id", &PartNetLink::id)
       .def_readonly("parent", &PartNetLink::parent)
-      .def_readonly("joint", &PartNetLink::joint, "hinge, slider, free, heavy or static.")
-      .def_readonly("semantic_label", &PartNetLink::semantic_label)
+      .def_readonly("joint", &PartNetLink::joint,
+                    "mobility_v2.json motion: hinge, slider, free, heavy or static.")
+      .def_readonly("semantic_label", &PartNetLink::semantic_label,
+                    "semantics.txt label ('drawer', 'rotation_door', ...).")
+      .def_readonly("semantic_joint", &PartNetLink::semantic_joint,
+                    "semantics.txt joint kind: hinge, slider, slider+, free, heavy, static.")
+      .def_readonly("partnet_name", &PartNetLink::partnet_name,
+                    "mobility_v2.json name, the PartNet vocabulary ('cabinet_door', ...).")
       .def_readonly("parts", &PartNetLink::parts)
       .def_readonly("has_axis", &PartNetLink::has_axis)
       .def_readonly("axis_origin", &PartNetLink::axis_origin)
@@ -97,8 +126,9 @@ void BindAssets(py::module_& m) {
       .def_readonly("no_rotation_limit", &PartNetLink::no_rotation_limit)
       .def_readonly("rotation_limit", &PartNetLink::rotation_limit);
   py::class_<PartNetMobilityObject>(m, "PartNetMobilityObject",
-                                    "A parsed PartNet-Mobility folder: its articulation (z-up, "
-                                    "root 'base') and its annotations.")
+                                    "A parsed PartNet-Mobility folder: its articulation "
+                                    "(mobility.urdf as it is: z-up, root 'base') and its "
+                                    "annotations (frame X_BF, y-up).")
       .def_readonly("folder", &PartNetMobilityObject::folder)
       .def_readonly("category", &PartNetMobilityObject::category)
       .def_readonly("model_id", &PartNetMobilityObject::model_id)
@@ -106,6 +136,11 @@ void BindAssets(py::module_& m) {
       .def_readonly("links", &PartNetMobilityObject::links)
       .def_readonly("bbox_min", &PartNetMobilityObject::bbox_min)
       .def_readonly("bbox_max", &PartNetMobilityObject::bbox_max)
+      .def_readonly("X_BF", &PartNetMobilityObject::X_BF,
+                    "The annotation files' frame F (y-up) in the root link 'base'.")
+      .def_readonly("report", &PartNetMobilityObject::report, "What the reader worked around.")
+      .def("links_with_label", &PartNetMobilityObject::LinksWithLabel, py::arg("label"),
+           "link ids whose semantics label is `label` (e.g. 'drawer').")
       .def("link", &PartNetMobilityObject::Link, py::arg("id"), py::return_value_policy::copy,
            "The mobility_v2.json entry of link_<id>.")
       .def("link_index", &PartNetMobilityObject::LinkIndex, py::arg("id"),
@@ -118,6 +153,10 @@ void BindAssets(py::module_& m) {
       "made with PartNetMobilityLoader() can only parse. `urdf` holds the URDF options.")
       .def(py::init<>())
       .def_readwrite("urdf", &PartNetMobilityLoader::urdf)
+      .def_readwrite("strict", &PartNetMobilityLoader::strict,
+                     "Cross-file disagreements and missing files become errors (dataset QA).")
+      .def("last_report", &PartNetMobilityLoader::LastReport, py::return_value_policy::copy,
+           "The warnings of the last parse or load (a LoadReport).")
       .def("parse", &PartNetMobilityLoader::Parse, py::arg("folder"),
            "Reads and cross-checks a folder; raises PartsimError naming the file and entry.")
       .def("load", &PartNetMobilityLoader::Load, py::arg("folder"), ka,
@@ -126,6 +165,14 @@ void BindAssets(py::module_& m) {
       .def(
           "create_partnet_mobility_loader",
           [](Scene& scene) { return PartNetMobilityLoader(&scene); }, ka);
+  m.def("standing_root_pose", &StandingRootPose, py::arg("articulation"), py::arg("altitude") = 0.0,
+        "Root pose that makes the articulation stand on z = altitude at its current joint "
+        "positions (orientation and x, y kept).");
+  m.def(
+      "place_on_ground",
+      [](Articulation articulation, double altitude) { PlaceOnGround(articulation, altitude); },
+      py::arg("articulation"), py::arg("altitude") = 0.0,
+      "Moves the articulation's root so that its lowest point touches z = altitude.");
   py::class_<PartNetBatchEntry>(m, "PartNetBatchEntry")
       .def_readonly("folder", &PartNetBatchEntry::folder)
       .def_readonly("ok", &PartNetBatchEntry::ok)

@@ -4,6 +4,7 @@
 
 #include "bindings.h"
 #include "partsim/core/error.h"
+#include "partsim/core/log.h"
 #include "partsim/core/pose.h"
 
 namespace partsim::python {
@@ -52,6 +53,25 @@ void BindCore(py::module_& m) {
                         return Pose::FromPQ(t[0].cast<Eigen::Vector3d>(),
                                             t[1].cast<Eigen::Vector4d>());
                       }));
+
+  m.def(
+      "set_log_level", [](const std::string& level) { SetLogLevel(ParseLogLevel(level)); },
+      py::arg("level"),
+      "What partsim writes to standard error: 'warning' (default: loaders' repairs and "
+      "numerical trouble), 'error' or 'off' (warnings are still kept in load reports).");
+  m.def(
+      "get_log_level",
+      []() {
+        switch (GetLogLevel()) {
+          case LogLevel::kWarning:
+            return "warning";
+          case LogLevel::kError:
+            return "error";
+          default:
+            return "off";
+        }
+      },
+      "The current log level: 'warning', 'error' or 'off'.");
 }
 
 }  // namespace partsim::python

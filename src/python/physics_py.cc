@@ -102,7 +102,17 @@ void BindShapeAdders(PyClass& c) {
       .def("set_mass_and_inertia", &Builder::SetMassAndInertia, py::arg("mass"),
            py::arg("cmass_local_pose"), py::arg("inertia"), ri,
            "Explicit mass (kg), centre-of-mass pose in the body and principal inertia (3,) "
-           "(kg m^2). Returns self.");
+           "(kg m^2). Returns self.")
+      .def("set_collision_groups", &Builder::SetCollisionGroups, py::arg("groups"), ri,
+           "SAPIEN's collision groups [g0, g1, g2, g3] (uint32) for every collision shape of "
+           "the body, added before or after. Returns self.")
+      .def(
+          "set_collision_groups",
+          [](Builder& self, uint32_t group0, uint32_t group1, uint32_t group2,
+             uint32_t group3) -> Builder& {
+            return self.SetCollisionGroups({group0, group1, group2, group3});
+          },
+          py::arg("group0"), py::arg("group1"), py::arg("group2"), py::arg("group3"), ri);
 }
 
 void BindDescription(py::module_& m) {
@@ -171,6 +181,9 @@ void BindDescription(py::module_& m) {
           "CONVEX_MESH: the mesh (vertices already scaled), or None.")
       .def_readwrite("material", &CollisionShape::material, "None: the scene's default.")
       .def_readwrite("density", &CollisionShape::density, "kg/m^3, > 0.")
+      .def_readwrite("collision_groups", &CollisionShape::collision_groups,
+                     "SAPIEN's [g0, g1, g2, g3]: shapes A and B collide when (A.g0 & B.g1 or "
+                     "A.g1 & B.g0) and not (A.g2 & B.g2 and A.g3 == B.g3).")
       .def_readwrite("name", &CollisionShape::name);
 
   py::class_<RenderMaterial>(m, "RenderMaterial", "Texture and surface parameters for rendering.")
@@ -210,6 +223,9 @@ void BindDescription(py::module_& m) {
       .def_readwrite("name", &BodyDesc::name)
       .def_readwrite("semantic_label", &BodyDesc::semantic_label,
                      "Part label (e.g. \"drawer\"), \"\" if none.")
+      .def_readwrite("partnet_name", &BodyDesc::partnet_name,
+                     "Name of the part in the PartNet hierarchy (mobility_v2.json's \"name\", "
+                     "e.g. \"cabinet_door\"), \"\" if none.")
       .def_readwrite("collisions", &BodyDesc::collisions)
       .def_readwrite("visuals", &BodyDesc::visuals)
       .def_readwrite("inertial", &BodyDesc::inertial, "None: from the collision shapes.");
@@ -280,7 +296,9 @@ void BindDescription(py::module_& m) {
       .def_readwrite("fix_root", &ArticulationDesc::fix_root)
       .def_readwrite("kinematic", &ArticulationDesc::kinematic)
       .def_readwrite("root_pose", &ArticulationDesc::root_pose, "X_WR at creation.")
-      .def_readwrite("couplings", &ArticulationDesc::couplings);
+      .def_readwrite("couplings", &ArticulationDesc::couplings)
+      .def_readwrite("disabled_collisions", &ArticulationDesc::disabled_collisions,
+                     "Pairs of link names that never collide with each other.");
 
   m.def("validate", py::overload_cast<const ActorDesc&, const std::string&>(&Validate),
         py::arg("actor"), py::arg("where") = "",
@@ -292,6 +310,27 @@ void BindDescription(py::module_& m) {
 
 void BindHandles(py::module_& m) {
   const auto ka = py::keep_alive<0, 1>();
+
+  // registered before Actor and Link, which return it
+  py::class_<Shape> shape(m, "Shape",
+                          "Handle to one collision shape of an actor or a link (SAPIEN's "
+                          "CollisionShape); its description is get_desc().");
+  shape.def("get_index", &Shape::GetIndex, "Index in the body's collisions.")
+      .def("get_desc", &Shape::GetDesc, "A copy of the shape's description.")
+      .def("get_collision_groups", &Shape::GetCollisionGroups,
+           "SAPIEN's collision groups [g0, g1, g2, g3].")
+      .def("set_collision_groups", &Shape::SetCollisionGroups, py::arg("groups"),
+           "SAPIEN's collision groups [g0, g1, g2, g3] (uint32): shapes A and B collide when "
+           "(A.g0 & B.g1 or A.g1 & B.g0) and not (A.g2 & B.g2 and A.g3 == B.g3). The scene's "
+           "state is kept.")
+      .def(
+          "set_collision_groups",
+          [](Shape& self, uint32_t group0, uint32_t group1, uint32_t group2, uint32_t group3) {
+            self.SetCollisionGroups({group0, group1, group2, group3});
+          },
+          py::arg("group0"), py::arg("group1"), py::arg("group2"), py::arg("group3"))
+      .def("__repr__",
+           [](const Shape& self) { return "<Shape " + std::to_string(self.GetIndex()) + ">"; });
 
   py::class_<Actor>(m, "Actor", "Handle to an actor; valid until the actor is removed.")
       .def("get_id", &Actor::GetId)
@@ -313,6 +352,12 @@ void BindHandles(py::module_& m) {
            "Adds a world-frame force (N) at the centre of mass and a torque (N m) for the next "
            "step.")
       .def("get_desc", &Actor::GetDesc, "A copy of the actor's description.")
+      .def(
+          "get_collision_shapes",
+          [](py::object self) {
+            return HandleList(self.cast<const Actor&>().GetCollisionShapes(), self);
+          },
+          "One Shape per collision shape, in the order of get_desc().collisions.")
       .def("__eq__", &Actor::operator==)
       .def("__hash__",
            [](const Actor& self) {
@@ -337,6 +382,19 @@ void BindHandles(py::module_& m) {
       .def("add_force_at_point", &Link::AddForceAtPoint, py::arg("force"), py::arg("point"),
            "Adds a world-frame force (N) at a world point (m) for the next step.")
       .def("get_desc", &Link::GetDesc, "A copy of the link's description.")
+      .def(
+          "get_collision_shapes",
+          [](py::object self) {
+            return HandleList(self.cast<const Link&>().GetCollisionShapes(), self);
+          },
+          "One Shape per collision shape, in the order of get_desc().collisions.")
+      .def(
+          "get_semantic_label", [](const Link& self) { return self.GetDesc().semantic_label; },
+          "The part label (semantics.txt's vocabulary for PartNet-Mobility objects: "
+          "\"drawer\", \"rotation_door\", ...), \"\" if none.")
+      .def(
+          "get_partnet_name", [](const Link& self) { return self.GetDesc().partnet_name; },
+          "The PartNet part name (mobility_v2.json's \"name\"), \"\" if none.")
       .def("__repr__", [](const Link& self) { return "<Link '" + self.GetName() + "'>"; });
 
   py::class_<Joint>(m, "Joint",
@@ -346,7 +404,7 @@ void BindHandles(py::module_& m) {
       .def_property_readonly("name", &Joint::GetName)
       .def_property_readonly("type", &Joint::GetType, "JointType.")
       .def("get_index", &Joint::GetIndex)
-      .def("get_dof", &Joint::GetDof, "0 or 1 (a coupled joint has 0).")
+      .def("get_dof", &Joint::GetDof, "0 for a fixed joint, else 1 (coupled joints included).")
       .def("get_dof_index", &Joint::GetDofIndex, "Index in qpos, -1 if the joint has no dof.")
       .def("get_parent_link", &Joint::GetParentLink, ka)
       .def("get_child_link", &Joint::GetChildLink, ka)
@@ -454,6 +512,10 @@ void BindHandles(py::module_& m) {
            "angular).")
       .def("compute_world_cartesian_jacobian", &Articulation::ComputeWorldCartesianJacobian,
            "Stacked link Jacobians (6 nlinks, dof).")
+      .def("disable_collision", &Articulation::DisableCollision, py::arg("link_a"),
+           py::arg("link_b"),
+           "The two links of this articulation never collide with each other from now on "
+           "(links joined by a joint never do); the scene's state is kept.")
       .def("get_desc", &Articulation::GetDesc, "A copy of the articulation's description.")
       .def("__eq__", &Articulation::operator==)
       .def("__hash__",

@@ -14,6 +14,11 @@ void BindTasks(py::module_& m) {
       .value("PULL_DRAWER", TaskType::kPullDrawer)
       .value("OPEN_DOOR", TaskType::kOpenDoor);
   m.def("parse_task_type", &ParseTaskType, py::arg("name"), "'drawer' or 'door' to a TaskType.");
+  m.def("task_target_label", &TaskTargetLabel, py::arg("type"),
+        "The semantics.txt label of the task's targets: 'drawer' or 'rotation_door'.");
+  m.def("find_task_targets", &FindTaskTargets, py::arg("object"), py::arg("type"),
+        "link ids N (of link_N) of a PartNetMobilityObject that the task can target: labelled "
+        "task_target_label(type), with a handle and a finite joint range.");
 
   py::class_<TaskOptions>(m, "TaskOptions", "Settings of a door or drawer task.")
       .def(py::init<>())
@@ -21,6 +26,9 @@ void BindTasks(py::module_& m) {
       .def_readwrite("object_index", &TaskOptions::object_index,
                      "Index of the generated StorageFurniture object.")
       .def_readwrite("dataset_seed", &TaskOptions::dataset_seed)
+      .def_readwrite("object_folder", &TaskOptions::object_folder,
+                     "A PartNet-Mobility folder (real or generated) instead of the generator's "
+                     "object; '' uses object_index and dataset_seed.")
       .def_readwrite("target", &TaskOptions::target,
                      "Which drawer (door) of the object; -1: drawn by reset's seed.")
       .def_readwrite("asset_dir", &TaskOptions::asset_dir,

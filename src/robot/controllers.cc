@@ -73,7 +73,7 @@ Controller::Controller(const Articulation& robot, const std::vector<std::string>
     for (const std::string& n : joints) {
       Joint j = robot.FindJointByName(n);  // throws naming a missing joint
       if (j.GetDof() != 1)
-        throw Error(who + ": joint '" + n + "' has no degree of freedom (fixed or coupled)");
+        throw Error(who + ": joint '" + n + "' has no degree of freedom (fixed)");
       if (std::find(joint_names_.begin(), joint_names_.end(), n) != joint_names_.end())
         throw Error(who + ": joint '" + n + "' is listed twice");
       dofs_.push_back(j.GetDofIndex());

@@ -25,7 +25,7 @@ struct KinematicModel::Data {
     Pose X_PJ;  ///< pose_in_parent
     Pose X_JC;  ///< pose_in_child^-1
     double pitch = 0.0;
-    int dof = -1;  ///< dof index, -1 for fixed, coupled or root
+    int dof = -1;  ///< dof index, -1 for fixed or root
     // coupled joints: q = multiplier * q[source link] + offset
     int coupling_source_link = -1;
     double multiplier = 1.0;
@@ -86,7 +86,7 @@ KinematicModel::KinematicModel(const ArticulationDesc& art) : root_pose_(art.roo
     li.pitch = l.joint.pitch;
     data->link_by_joint.emplace(l.joint.name, static_cast<int>(i));
   }
-  // couplings: the coupled joint follows its source and has no dof
+  // couplings: the coupled joint keeps its dof, but its motion follows its source
   for (const JointCoupling& c : art.couplings) {
     auto j = data->link_by_joint.find(c.joint), s = data->link_by_joint.find(c.source);
     if (j == data->link_by_joint.end() || s == data->link_by_joint.end())
@@ -100,14 +100,10 @@ KinematicModel::KinematicModel(const ArticulationDesc& art) : root_pose_(art.roo
   // dofs in link order, as the compiler numbers them
   for (size_t i = 0; i < n; ++i) {
     Data::LinkInfo& li = data->links[i];
-    if (li.parent < 0 || !Moves(li.type) || li.coupling_source_link >= 0) continue;
+    if (li.parent < 0 || !Moves(li.type)) continue;
     li.dof = static_cast<int>(data->dof_links.size());
     data->dof_links.push_back(static_cast<int>(i));
   }
-  for (const auto& li : data->links)
-    if (li.coupling_source_link >= 0 && data->links[li.coupling_source_link].dof < 0)
-      throw Error("KinematicModel: joint '" + li.joint_name + "' is coupled to joint '" +
-                  data->links[li.coupling_source_link].joint_name + "', which has no dof");
   data->limits.resize(static_cast<Eigen::Index>(data->dof_links.size()), 2);
   for (size_t k = 0; k < data->dof_links.size(); ++k) {
     const JointDesc& j = art.links[data->dof_links[k]].joint;

@@ -27,6 +27,27 @@ using WsServer = websocketpp::server<websocketpp::config::asio>;
 using Hdl = websocketpp::connection_hdl;
 using WallClock = std::chrono::steady_clock;
 
+// Deepest nesting of arrays and objects a client message may have: ROS messages nest a handful
+// of levels; a deeper one is refused while it is parsed, before a deep tree exists whose copy or
+// serialisation would recurse that deep.
+constexpr int kMaxJsonDepth = 64;
+
+// Text of a JSON value; bytes that are not UTF-8 (a client's string quoted back in an error)
+// become U+FFFD instead of throwing.
+std::string Dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+// Parses a client's message; throws json::exception when it is malformed or nested deeper than
+// kMaxJsonDepth.
+json ParseClientJson(const std::string& text) {
+  json::parser_callback_t depth_guard = [](int depth, json::parse_event_t, json&) {
+    if (depth > kMaxJsonDepth)
+      throw json::out_of_range::create(
+          406, "nested deeper than " + std::to_string(kMaxJsonDepth) + " levels", nullptr);
+    return true;
+  };
+  return json::parse(text, depth_guard);
+}
+
 // topics the simulation publishes, and the commands it takes
 const char* kClockType = "rosgraph_msgs/Clock";
 const char* kJointStateType = "sensor_msgs/JointState";
@@ -232,7 +253,7 @@ struct RosbridgeServer::Impl {
     json j = {{"op", "status"}, {"level", level}, {"msg", msg}};
     if (!id.is_null()) j["id"] = id;
     if (level == "error") ++errors;
-    Enqueue(c, j.dump(), 0);
+    Enqueue(c, Dump(j), 0);
   }
 
   // ---- topics ----
@@ -348,7 +369,7 @@ struct RosbridgeServer::Impl {
         Enqueue(c, cbor, s.queue_length, true);
         continue;
       }
-      if (text.empty()) text = TextForm(msg).dump();
+      if (text.empty()) text = Dump(TextForm(msg));
       if (s.fragment_size > 0 && text.size() > s.fragment_size)
         EnqueueFragments(c, text, s);
       else
@@ -370,12 +391,11 @@ struct RosbridgeServer::Impl {
     const size_t bound = (s.queue_length ? s.queue_length : options.max_client_queue) * n;
     for (size_t i = 0; i < n; ++i)
       Enqueue(c,
-              json{{"op", "fragment"},
-                   {"id", id},
-                   {"data", text.substr(i * s.fragment_size, s.fragment_size)},
-                   {"num", i},
-                   {"total", n}}
-                  .dump(),
+              Dump(json{{"op", "fragment"},
+                        {"id", id},
+                        {"data", text.substr(i * s.fragment_size, s.fragment_size)},
+                        {"num", i},
+                        {"total", n}}),
               bound);
   }
   static json Header(double t, const std::string& frame) {
@@ -612,7 +632,7 @@ struct RosbridgeServer::Impl {
     json r = {
         {"op", "service_response"}, {"service", service}, {"values", values}, {"result", true}};
     if (!id.is_null()) r["id"] = id;
-    Enqueue(c, r.dump(), 0);
+    Enqueue(c, Dump(r), 0);
     return true;
   }
 
@@ -670,7 +690,7 @@ struct RosbridgeServer::Impl {
       json out = {
           {"op", "service_response"}, {"service", service}, {"values", values}, {"result", true}};
       if (!id.is_null()) out["id"] = id;
-      Enqueue(cp, out.dump(), 0);
+      Enqueue(cp, Dump(out), 0);
     });
   }
 
@@ -699,14 +719,23 @@ struct RosbridgeServer::Impl {
       if (it == clients.end()) return;
       c = it->second;
     }
-    HandleText(c, m->get_payload());
+    // nothing a client sends may end the network thread
+    try {
+      HandleText(c, m->get_payload());
+    } catch (const std::exception& e) {
+      try {
+        Status(c, "error", std::string("could not handle the message: ") + e.what());
+      } catch (...) {
+      }
+    } catch (...) {
+    }
   }
 
   /// One whole message (or one fragment of one) from a client.
   void HandleText(const ClientPtr& c, const std::string& payload) {
     json j;
     try {
-      j = json::parse(payload);
+      j = ParseClientJson(payload);
     } catch (const std::exception& e) {
       Status(c, "error", std::string("malformed JSON: ") + e.what());
       return;
@@ -739,7 +768,7 @@ struct RosbridgeServer::Impl {
         !j["total"].is_number_unsigned() || j["total"].get<size_t>() == 0 ||
         j["num"].get<size_t>() >= j["total"].get<size_t>())
       throw Error("fragment needs integers 0 <= num < total");
-    const std::string key = j["id"].is_string() ? j["id"].get<std::string>() : j["id"].dump();
+    const std::string key = j["id"].is_string() ? j["id"].get<std::string>() : Dump(j["id"]);
     const size_t total = j["total"].get<size_t>(), num = j["num"].get<size_t>();
     if (total > options.max_message_bytes) throw Error("fragment: total is too large");
     auto it = c->partial.find(key);
@@ -814,7 +843,7 @@ struct RosbridgeServer::Impl {
       }
       const std::string sub_id = id.is_null()     ? ""
                                  : id.is_string() ? id.get<std::string>()
-                                                  : id.dump();
+                                                  : Dump(id);
       std::lock_guard<std::mutex> lock(clients_mutex);
       Subscription& sub = c->subs[topic];
       sub.requests[sub_id] = s;
@@ -826,7 +855,7 @@ struct RosbridgeServer::Impl {
       auto it = c->subs.find(topic);
       if (it == c->subs.end()) return;
       if (!id.is_null()) {
-        it->second.requests.erase(id.is_string() ? id.get<std::string>() : id.dump());
+        it->second.requests.erase(id.is_string() ? id.get<std::string>() : Dump(id));
         if (!it->second.requests.empty()) {
           it->second.Merge();
           return;
@@ -859,7 +888,7 @@ struct RosbridgeServer::Impl {
         return;
       }
       // a client's own topic: relay to its subscribers
-      std::string text = json{{"op", "publish"}, {"topic", topic}, {"msg", j["msg"]}}.dump();
+      std::string text = Dump(json{{"op", "publish"}, {"topic", topic}, {"msg", j["msg"]}});
       std::lock_guard<std::mutex> lock(clients_mutex);
       for (auto& [h, other] : clients) {
         auto it = other->subs.find(topic);
@@ -876,8 +905,8 @@ struct RosbridgeServer::Impl {
         std::string call_id = "partsim_call_" + std::to_string(next_call++);
         pending_calls[call_id] = {c, id};
         Enqueue(provider,
-                json{{"op", "call_service"}, {"service", service}, {"args", args}, {"id", call_id}}
-                    .dump(),
+                Dump(json{
+                    {"op", "call_service"}, {"service", service}, {"args", args}, {"id", call_id}}),
                 0);
         return;
       }
@@ -902,7 +931,7 @@ struct RosbridgeServer::Impl {
         r.erase("id");
       else
         r["id"] = it->second.id;
-      if (ClientPtr caller = it->second.caller.lock()) Enqueue(caller, r.dump(), 0);
+      if (ClientPtr caller = it->second.caller.lock()) Enqueue(caller, Dump(r), 0);
       pending_calls.erase(it);
     } else {
       throw Error("unknown op '" + op + "'");

@@ -20,6 +20,10 @@ namespace partsim {
 
 const char* TaskTypeName(TaskType t) { return t == TaskType::kPullDrawer ? "drawer" : "door"; }
 
+const char* TaskTargetLabel(TaskType t) {
+  return t == TaskType::kPullDrawer ? "drawer" : "rotation_door";
+}
+
 TaskType ParseTaskType(const std::string& name) {
   if (name == "drawer") return TaskType::kPullDrawer;
   if (name == "door") return TaskType::kOpenDoor;
@@ -29,7 +33,7 @@ TaskType ParseTaskType(const std::string& name) {
 namespace internal {
 
 std::vector<int> TargetLinks(const GeneratedObject& object, TaskType type) {
-  const std::string label = TaskTypeName(type);
+  const std::string label = TaskTargetLabel(type);
   std::vector<int> out;
   for (const GeneratedLink& l : object.links) {
     if (l.name != label) continue;
@@ -43,7 +47,9 @@ std::vector<int> TargetLinks(const GeneratedObject& object, TaskType type) {
 std::string EnsureObjectFolder(const GeneratedObject& object, const std::string& asset_dir) {
   fs::path root =
       asset_dir.empty() ? fs::temp_directory_path() / "partsim-assets" : fs::path(asset_dir);
-  fs::path dir = root / (object.category + "_s" + std::to_string(object.seed)) / object.model_id;
+  // the layout version in the path keeps folders written by older partsim out of the way
+  fs::path dir =
+      root / (object.category + "_s" + std::to_string(object.seed) + "_pm2") / object.anno_id;
   if (fs::exists(dir / "mobility_v2.json")) return dir.string();
   // write beside, then rename: tasks on several threads may ask for the same object
   static std::atomic<int> counter{0};
@@ -98,6 +104,24 @@ std::vector<int> FindTaskObjects(TaskType type, int count, std::uint64_t dataset
                   std::string(TaskTypeName(type)));
     GeneratedObject o = GenerateObject("StorageFurniture", i, dataset_seed);
     if (!internal::TargetLinks(o, type).empty()) out.push_back(i);
+  }
+  return out;
+}
+
+std::vector<int> FindTaskTargets(const PartNetMobilityObject& object, TaskType type) {
+  std::vector<int> out;
+  for (const PartNetLink& l : object.links) {
+    if (l.semantic_label != TaskTargetLabel(type)) continue;
+    const LinkDesc& link = object.articulation.links[object.LinkIndex(l.id)];
+    // a joint with a finite range: the link's own, or its helper's for a rotating slider
+    const JointDesc& j =
+        l.rotates && link.parent >= 0 ? object.articulation.links[link.parent].joint : link.joint;
+    const bool moves = j.type == JointType::kPrismatic || j.type == JointType::kRevolute;
+    if (!moves || !(j.upper - j.lower > 0) || !std::isfinite(j.upper - j.lower)) continue;
+    bool handle = false;
+    for (const PartNetPart& p : l.parts) handle = handle || p.name == "handle";
+    for (const VisualShape& v : link.visuals) handle = handle || v.name.rfind("handle-", 0) == 0;
+    if (handle) out.push_back(l.id);
   }
   return out;
 }
@@ -178,32 +202,41 @@ TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
     throw Error("task: success_fraction must be in (0, 1]");
   substeps = std::max(1, static_cast<int>(std::lround(1.0 / (o.control_rate * o.timestep))));
 
-  GeneratedObject gen = GenerateObject("StorageFurniture", o.object_index, o.dataset_seed);
-  std::vector<int> targets = TargetLinks(gen, o.type);
+  // the object: a PartNet-Mobility folder, or the generator's object written as one
+  std::string folder = o.object_folder, what = "'" + o.object_folder + "'";
+  if (folder.empty()) {
+    GeneratedObject gen = GenerateObject("StorageFurniture", o.object_index, o.dataset_seed);
+    folder = EnsureObjectFolder(gen, o.asset_dir);
+    what = "StorageFurniture object " + std::to_string(o.object_index) + " (seed " +
+           std::to_string(o.dataset_seed) + ")";
+  }
+  PartNetMobilityLoader loader;
+  PartNetMobilityObject obj = loader.Parse(folder);
+  std::vector<int> targets = FindTaskTargets(obj, o.type);
   if (targets.empty())
-    throw Error("task: StorageFurniture object " + std::to_string(o.object_index) + " (seed " +
-                std::to_string(o.dataset_seed) + ") has no " + TaskTypeName(o.type) +
-                " with a handle; FindTaskObjects lists those that do");
+    throw Error(
+        "task: " + what + " has no " + TaskTypeName(o.type) + " (a link labelled '" +
+        TaskTargetLabel(o.type) + "' in semantics.txt, with a handle and a joint range)" +
+        (o.object_folder.empty() ? "; FindTaskObjects lists the objects that have one" : ""));
   if (o.target >= static_cast<int>(targets.size()))
-    throw Error("task: target " + std::to_string(o.target) + " is out of range: object " +
-                std::to_string(o.object_index) + " has " + std::to_string(targets.size()) + " " +
-                TaskTypeName(o.type) + (targets.size() == 1 ? "" : "s"));
-  std::string folder = EnsureObjectFolder(gen, o.asset_dir);
+    throw Error("task: target " + std::to_string(o.target) + " is out of range: " + what + " has " +
+                std::to_string(targets.size()) + " " + TaskTypeName(o.type) +
+                (targets.size() == 1 ? "" : "s"));
 
   SceneConfig cfg;
   cfg.timestep = o.timestep;
   scene = std::make_shared<Scene>(cfg);
-  PartNetMobilityLoader loader;
-  PartNetMobilityObject obj = loader.Parse(folder);
-  // the loader turns the file's y-up into z-up with the front facing -y; face +x instead
-  obj.articulation.root_pose =
-      Pose(Eigen::Vector3d::Zero(),
-           Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())));
+  // mobility.urdf turns the meshes' front (+z of the annotation frame F) to world -x: a half
+  // turn about z makes it face +x; then the bounds' centre goes over the origin
+  const Eigen::Quaterniond half_turn(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+  const Eigen::Vector3d centre_W = half_turn * (obj.X_BF.q * (0.5 * (obj.bbox_min + obj.bbox_max)));
+  obj.articulation.root_pose = Pose(Eigen::Vector3d(-centre_W.x(), -centre_W.y(), 0), half_turn);
   object = scene->AddArticulation(obj.articulation);
+  PlaceOnGround(object, 0.0);
   for (int id : targets) candidates.push_back(obj.LinkIndex(id));
-  // cabinet size from its bounding box (file frame: x width, y height, z depth)
+  // cabinet size from its bounds (frame F: x width, y height, z depth)
   cabinet_half_depth = 0.5 * (obj.bbox_max.z() - obj.bbox_min.z());
-  cabinet_height = obj.bbox_max.y();
+  cabinet_height = obj.bbox_max.y() - obj.bbox_min.y();
   cabinet_half_width = 0.5 * (obj.bbox_max.x() - obj.bbox_min.x());
 
   robot_model = BuildFlyingGripper();

@@ -19,19 +19,21 @@ namespace {
 
 constexpr char kAssetsUsage[] = R"(usage:
   partsim assets generate --out DIR [--categories all|Cat1,Cat2] [--per-category N|paper]
-                          [--seed S] [--jobs J]
+                          [--seed S] [--jobs J] [--by-category]
   partsim assets categories
   partsim assets check DIR [--jobs J] [--no-visibility] [--backend B] [--report FILE]
   partsim assets decompose MESH --out DIR [--concavity C] [--max-pieces N]
 
-generate     writes DIR/<Category>/<model_id>/ folders in the PartNet-Mobility format
-             (mobility.urdf, mobility_v2.json, semantics.txt, meta.json, bounding_box.json,
-             textured_objs/). Same arguments and seed, same bytes.
+generate     writes DIR/<anno_id>/ folders in the PartNet-Mobility format, laid out as the
+             dataset is (mobility.urdf, mobility_v2.json, semantics.txt, meta.json,
+             bounding_box.json, result.json, result_after_merging.json, textured_objs/); the
+             category is meta.json's model_cat. Same arguments and seed, same bytes.
   --out DIR               output folder (required)
   --categories LIST       comma-separated category names, or all (default all)
   --per-category N|paper  objects per category, or the paper's model count (default 1)
   --seed S                dataset seed, an unsigned integer (default 0)
   --jobs J                worker threads (default 1)
+  --by-category           DIR/<Category>/<anno_id>/ instead
 categories   lists the 46 categories with the paper's model and part counts.
 check        runs the quality checks on every object folder under DIR and prints the models and
              movable parts per category beside the paper's (`check --help` for more).
@@ -105,6 +107,8 @@ int Generate(const std::vector<std::string>& args) {
       opt.seed = s;
     } else if (flag == "--jobs") {
       opt.jobs = static_cast<int>(ParseInt(flag, next(), 1));
+    } else if (flag == "--by-category" && !inline_value) {
+      opt.by_category = true;
     } else {
       throw AssetsUsageError("partsim assets generate: unknown argument '" + args[i] + "'");
     }
@@ -120,8 +124,8 @@ int Generate(const std::vector<std::string>& args) {
     if (done == total || t - last_print >= 0.5) {
       last_print = t;
       double eta = done > 0 ? t / done * (total - done) : 0.0;
-      std::fprintf(stderr, "\r[%d/%d] %s/%s  elapsed %s  eta %s   ", done, total,
-                   o.category.c_str(), o.model_id.c_str(), Clock(t).c_str(), Clock(eta).c_str());
+      std::fprintf(stderr, "\r[%d/%d] %s %s  elapsed %s  eta %s   ", done, total,
+                   o.category.c_str(), o.anno_id.c_str(), Clock(t).c_str(), Clock(eta).c_str());
       if (done == total) std::fprintf(stderr, "\n");
       std::fflush(stderr);
     }

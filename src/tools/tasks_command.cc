@@ -24,6 +24,7 @@ constexpr char kTasksUsage[] = R"(usage:
   partsim tasks demo [--task drawer|door] [--object N] [--seed S] [--out DIR] [--every K]
   partsim tasks evaluate [--task drawer|door] [--count N] [--seed S] [--jobs J]
                          [--no-cameras] [--csv FILE]
+                         [--dataset ROOT [--ids A,B,...] [--targets all]]
 
 demo       generates a cabinet (StorageFurniture object N, default the first with a drawer or
            door), runs the heuristic solver with the flying gripper, writes the front camera's
@@ -32,6 +33,10 @@ evaluate   runs the heuristic solver on the first N cabinets (default 20) that h
            (door), one target each drawn by the seed, and prints the success rate beside the
            SAPIEN paper's (95.3% drawer, 81.8% door). --no-cameras perceives the handle from the
            meshes instead of the segmented point clouds. --csv writes one row per episode.
+           With --dataset, the objects are the PartNet-Mobility folders under ROOT (real or
+           generated, sorted by name; --ids keeps the named folders): the first N (all with
+           --ids) that have a target, i.e. a link labelled 'drawer' ('rotation_door') in
+           semantics.txt with a handle; --targets all runs every target of each object.
   --task drawer|door   which task (default drawer)
   --seed S             episode seed (default 0)
   --jobs J             episodes in parallel (default 1)
@@ -60,6 +65,10 @@ struct TasksArgs {
   bool cameras = true;
   std::string out = "out/demo";
   std::string csv;
+  std::string dataset;
+  std::vector<std::string> ids;
+  bool all_targets = false;
+  bool count_given = false;
 };
 
 TasksArgs Parse(int argc, char** argv) {
@@ -84,6 +93,26 @@ TasksArgs Parse(int argc, char** argv) {
       a.object = static_cast<int>(ParseCount(f, value(), 0));
     } else if (f == "--count") {
       a.count = static_cast<int>(ParseCount(f, value(), 1));
+      a.count_given = true;
+    } else if (f == "--dataset") {
+      a.dataset = value();
+    } else if (f == "--ids") {
+      std::string v = value(), id;
+      for (size_t k = 0; k <= v.size(); ++k) {
+        if (k == v.size() || v[k] == ',') {
+          if (id.empty())
+            throw TasksUsageError("partsim tasks: --ids has an empty id in '" + v + "'");
+          a.ids.push_back(id);
+          id.clear();
+        } else {
+          id += v[k];
+        }
+      }
+    } else if (f == "--targets") {
+      std::string v = value();
+      if (v != "all" && v != "one")
+        throw TasksUsageError("partsim tasks: --targets expects all or one, got '" + v + "'");
+      a.all_targets = v == "all";
     } else if (f == "--seed") {
       a.seed = static_cast<unsigned long long>(ParseCount(f, value(), 0));
     } else if (f == "--jobs") {
@@ -100,7 +129,78 @@ TasksArgs Parse(int argc, char** argv) {
       throw TasksUsageError("partsim tasks: unknown option '" + f + "'");
     }
   }
+  if (a.dataset.empty() && (!a.ids.empty() || a.all_targets))
+    throw TasksUsageError("partsim tasks: --ids and --targets need --dataset");
+  if (!a.dataset.empty() && a.command != "evaluate")
+    throw TasksUsageError("partsim tasks: --dataset goes with evaluate");
   return a;
+}
+
+// One episode of evaluate: a generated object by index, or a dataset folder; a target index in
+// the object's FindTaskTargets list (-1: drawn by the episode's seed).
+struct Episode {
+  std::string object;  // the CSV's object column: generator index or folder name
+  int index = -1;
+  std::string folder;
+  int target = -1;
+};
+
+// The episodes of --dataset: folders under ROOT holding mobility.urdf, by name.
+std::vector<Episode> DatasetEpisodes(const TasksArgs& a) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(a.dataset, ec))
+    throw std::runtime_error("--dataset '" + a.dataset + "' is not a folder");
+  std::vector<fs::path> folders;
+  for (auto it = fs::recursive_directory_iterator(a.dataset, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+    if (it->path().filename() == "mobility.urdf") folders.push_back(it->path().parent_path());
+  std::sort(folders.begin(), folders.end());
+  if (!a.ids.empty()) {
+    std::vector<fs::path> keep;
+    for (const std::string& id : a.ids) {
+      auto it = std::find_if(folders.begin(), folders.end(),
+                             [&](const fs::path& f) { return f.filename() == id; });
+      if (it == folders.end())
+        throw std::runtime_error("--ids: no PartNet-Mobility folder '" + id + "' under '" +
+                                 a.dataset + "'");
+      keep.push_back(*it);
+    }
+    folders = keep;
+  }
+  const size_t wanted = !a.ids.empty() && !a.count_given ? folders.size() : a.count;
+  std::vector<Episode> out;
+  size_t objects = 0;
+  PartNetMobilityLoader loader;
+  for (const fs::path& f : folders) {
+    if (objects >= wanted) break;
+    std::vector<int> targets;
+    try {
+      targets = FindTaskTargets(loader.Parse(f.string()), a.type);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "  %s: skipped: %s\n", f.filename().c_str(), e.what());
+      continue;
+    }
+    if (targets.empty()) {
+      if (!a.ids.empty())
+        std::fprintf(stderr, "  %s: skipped: no %s with a handle\n", f.filename().c_str(),
+                     TaskTargetLabel(a.type));
+      continue;
+    }
+    ++objects;
+    const int n = a.all_targets ? static_cast<int>(targets.size()) : 1;
+    for (int t = 0; t < n; ++t) {
+      Episode e;
+      e.object = f.filename().string();
+      e.folder = f.string();
+      e.target = a.all_targets ? t : -1;
+      out.push_back(e);
+    }
+  }
+  if (out.empty())
+    throw std::runtime_error("no object under '" + a.dataset + "' has a " + TaskTypeName(a.type) +
+                             " (a link labelled '" + TaskTargetLabel(a.type) + "' with a handle)");
+  return out;
 }
 
 int RunDemo(const TasksArgs& a) {
@@ -131,7 +231,17 @@ int RunDemo(const TasksArgs& a) {
 }
 
 int RunEvaluate(const TasksArgs& a) {
-  std::vector<int> objects = FindTaskObjects(a.type, a.count);
+  std::vector<Episode> objects;
+  if (!a.dataset.empty()) {
+    objects = DatasetEpisodes(a);
+  } else {
+    for (int i : FindTaskObjects(a.type, a.count)) {
+      Episode e;
+      e.object = std::to_string(i);
+      e.index = i;
+      objects.push_back(e);
+    }
+  }
   std::vector<SolverResult> results(objects.size());
   std::vector<std::string> targets(objects.size());
   std::atomic<size_t> next{0};
@@ -142,7 +252,9 @@ int RunEvaluate(const TasksArgs& a) {
       try {
         TaskOptions o;
         o.type = a.type;
-        o.object_index = objects[i];
+        o.object_index = std::max(0, objects[i].index);
+        o.object_folder = objects[i].folder;
+        o.target = objects[i].target;
         o.cameras = a.cameras;
         ArticulationTask task(o);
         task.Reset(a.seed + i);
@@ -155,9 +267,10 @@ int RunEvaluate(const TasksArgs& a) {
         results[i].stage = "error";
       }
       std::lock_guard<std::mutex> lock(io);
-      std::fprintf(stderr, "  object %4d %-8s %s progress %5.1f%%  %s %s\n", objects[i],
-                   targets[i].c_str(), results[i].success ? "ok  " : "FAIL",
-                   100 * results[i].progress, results[i].stage.c_str(), results[i].message.c_str());
+      std::fprintf(stderr, "  object %4s %-8s %s progress %5.1f%%  %s %s\n",
+                   objects[i].object.c_str(), targets[i].c_str(),
+                   results[i].success ? "ok  " : "FAIL", 100 * results[i].progress,
+                   results[i].stage.c_str(), results[i].message.c_str());
     }
   };
   std::vector<std::thread> pool;
@@ -177,7 +290,7 @@ int RunEvaluate(const TasksArgs& a) {
     if (!f) throw std::runtime_error("cannot write '" + a.csv + "'");
     f << "object,target,success,progress,seconds,stage,message\n";
     for (size_t i = 0; i < results.size(); ++i)
-      f << objects[i] << ',' << targets[i] << ',' << results[i].success << ','
+      f << objects[i].object << ',' << targets[i] << ',' << results[i].success << ','
         << results[i].progress << ',' << results[i].seconds << ',' << results[i].stage << ",\""
         << results[i].message << "\"\n";
   }

@@ -1,7 +1,9 @@
 // Tests of the procedural object generator: every category generates and writes a
-// PartNet-Mobility folder whose files parse and agree with each other, meshes are closed,
-// outward-facing and convex, output is deterministic, moving parts keep clear of everything
-// over their range, and objects rest still in a scene.
+// PartNet-Mobility folder with the real dataset's structure (flat layout, z-up root joint over
+// y-up annotations, both label vocabularies, <part>-<id> visuals with one OBJ each, result.json,
+// a bounding box centred on the origin) whose files agree with each other and load with no
+// warning; meshes are closed, outward-facing, convex and not flat; output is deterministic;
+// moving parts keep clear of everything over their range; objects rest still in a scene.
 #include "partsim/assets/generator.h"
 
 #include <gtest/gtest.h>
@@ -19,8 +21,10 @@
 #include <string>
 #include <vector>
 
+#include "partsim/assets/partnet_mobility.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/core/error.h"
+#include "partsim/core/pose.h"
 #include "partsim/physics/scene.h"
 
 namespace partsim {
@@ -292,22 +296,122 @@ TEST(GeneratorTest, UnknownCategoryNamesIt) {
   EXPECT_THROW(GenerateObject("Chair", -1, 0), Error);
 }
 
+/// Objects per category for the sweeping tests: PARTSIM_GENERATOR_TEST_N, default `n`.
+int ObjectsPerCategory(int n) {
+  const char* env = std::getenv("PARTSIM_GENERATOR_TEST_N");
+  return env ? std::max(1, std::atoi(env)) : n;
+}
+
+// ---------------------------------------------------------------------------------------------
+// the written folder against the object it came from, and against the real dataset's structure
+
+/// The movable-part vocabulary of semantics.txt (the columns of the SAPIEN paper's tables,
+/// written the dataset's way) and the kinds of its joint column.
+const std::set<std::string> kMovableLabels = {"rotation_door",
+                                              "translation_door",
+                                              "drawer",
+                                              "rotation_lid",
+                                              "translation_lid",
+                                              "rotation_handle",
+                                              "translation_handle",
+                                              "translation_tray",
+                                              "rotation_screen",
+                                              "screen",
+                                              "rotation_bar",
+                                              "rotation",
+                                              "handle",
+                                              "caster",
+                                              "wheel",
+                                              "seat",
+                                              "knob",
+                                              "lever",
+                                              "button",
+                                              "slider",
+                                              "switch",
+                                              "key",
+                                              "leg",
+                                              "lens",
+                                              "hand",
+                                              "spout",
+                                              "rotor",
+                                              "cap",
+                                              "container",
+                                              "blade",
+                                              "sphere",
+                                              "frame",
+                                              "head",
+                                              "pad",
+                                              "window",
+                                              "stapler_body"};
+const std::set<std::string> kSemanticsKinds = {"hinge", "slider", "slider+",
+                                               "free",  "heavy",  "static"};
+
+/// The root joint's rotation in the dataset: rpy (pi/2, 0, -pi/2), F's y up to z, +z to -x.
+Eigen::Quaterniond DatasetRootRotation() {
+  return Eigen::AngleAxisd(-kPi / 2, V3::UnitZ()) * Eigen::AngleAxisd(kPi / 2, V3::UnitX());
+}
+
+/// Poses of the links at q = 0 in the root: X_BL.
+std::vector<Pose> RestPoses(const ArticulationDesc& art) {
+  std::vector<Pose> X(art.links.size());
+  for (size_t i = 0; i < art.links.size(); ++i) {
+    const LinkDesc& l = art.links[i];
+    X[i] = l.parent < 0 ? Pose()
+                        : X[l.parent] * l.joint.pose_in_parent * l.joint.pose_in_child.Inverse();
+  }
+  return X;
+}
+
+V3 Vec(const nlohmann::json& j) {
+  return V3(j[0].get<double>(), j[1].get<double>(), j[2].get<double>());
+}
+
+/// Every node of a result.json tree: leaves have objs and no children, internal nodes children
+/// and no objs; collects leaf ids -> (name, objs).
+void CollectLeaves(const nlohmann::json& node, std::set<int>* ids,
+                   std::map<int, std::pair<std::string, std::set<std::string>>>* leaves) {
+  ASSERT_TRUE(node.is_object());
+  for (const char* key : {"text", "name", "id"}) ASSERT_TRUE(node.contains(key)) << node.dump();
+  EXPECT_TRUE(node["text"].is_string());
+  EXPECT_TRUE(node["name"].is_string());
+  EXPECT_TRUE(ids->insert(node["id"].get<int>()).second) << "id " << node["id"] << " twice";
+  if (node.contains("children")) {
+    EXPECT_FALSE(node.contains("objs")) << node["name"];
+    ASSERT_FALSE(node["children"].empty()) << node["name"];
+    for (const auto& c : node["children"]) CollectLeaves(c, ids, leaves);
+    return;
+  }
+  ASSERT_TRUE(node.contains("objs")) << node["name"];
+  std::set<std::string> objs;
+  for (const auto& o : node["objs"]) objs.insert(o.get<std::string>());
+  (*leaves)[node["id"].get<int>()] = {node["name"].get<std::string>(), objs};
+}
+
 /// Checks one written folder against the object it came from.
 void CheckFolder(const GeneratedObject& o, const fs::path& dir) {
   SCOPED_TRACE(o.category);
-  for (const char* f :
-       {"mobility.urdf", "mobility_v2.json", "semantics.txt", "meta.json", "bounding_box.json"}) {
+  for (const char* f : {"mobility.urdf", "mobility_v2.json", "semantics.txt", "meta.json",
+                        "bounding_box.json", "result.json", "result_after_merging.json"}) {
     ASSERT_TRUE(fs::exists(dir / f)) << f;
   }
-  // meta and bounding box
+  // meta.json: the dataset's keys, string values; the folder is named by anno_id
   nlohmann::json meta = nlohmann::json::parse(ReadFile(dir / "meta.json"));
+  for (const char* key : {"model_id", "anno_id", "user_id", "time_in_sec", "version", "model_cat"})
+    ASSERT_TRUE(meta.contains(key) && meta[key].is_string()) << key;
   EXPECT_EQ(meta["model_cat"], o.category);
   EXPECT_EQ(meta["model_id"], o.model_id);
-  EXPECT_TRUE(meta.contains("anno_id"));
+  EXPECT_EQ(meta["anno_id"], o.anno_id);
+  EXPECT_EQ(o.model_id.size(), 32u);
+  EXPECT_EQ(o.model_id.find_first_not_of("0123456789abcdef"), std::string::npos) << o.model_id;
+  // bounding box: centred on the origin (to the generator's 0.1 mm grid)
   nlohmann::json bbox = nlohmann::json::parse(ReadFile(dir / "bounding_box.json"));
-  for (int k = 0; k < 3; ++k) EXPECT_LT(bbox["min"][k].get<double>(), bbox["max"][k].get<double>());
+  const V3 lo = Vec(bbox["min"]), hi = Vec(bbox["max"]);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LT(lo[k], hi[k]);
+    EXPECT_NEAR(lo[k] + hi[k], 0.0, 2.1e-4) << "axis " << k;
+  }
 
-  // mobility_v2.json against semantics.txt
+  // mobility_v2.json: PartNet names; semantics.txt: movable-part labels and kinds
   nlohmann::json mob = nlohmann::json::parse(ReadFile(dir / "mobility_v2.json"));
   ASSERT_EQ(mob.size(), o.links.size());
   std::istringstream sem(ReadFile(dir / "semantics.txt"));
@@ -315,56 +419,116 @@ void CheckFolder(const GeneratedObject& o, const fs::path& dir) {
   std::set<int> part_ids;
   for (size_t i = 0; i < mob.size(); ++i) {
     const nlohmann::json& e = mob[i];
+    const GeneratedLink& l = o.links[i];
     EXPECT_EQ(e["id"].get<int>(), static_cast<int>(i));
-    std::string link, joint, label;
-    sem >> link >> joint >> label;
-    EXPECT_EQ(link, "link_" + std::to_string(i));
-    EXPECT_EQ(joint, e["joint"].get<std::string>());
-    EXPECT_EQ(label, e["name"].get<std::string>());
+    const std::string joint = e["joint"];
     EXPECT_TRUE(joint == "hinge" || joint == "slider" || joint == "heavy" || joint == "static" ||
                 joint == "free")
         << joint;
+    const bool rotates = joint == "slider" && e["jointData"]["limit"]["rotates"].get<bool>();
+    std::string link, kind, label;
+    sem >> link >> kind >> label;
+    EXPECT_EQ(link, "link_" + std::to_string(i));
+    EXPECT_TRUE(kSemanticsKinds.count(kind)) << kind;
+    EXPECT_EQ(kind, rotates ? "slider+" : joint) << link;
+    EXPECT_EQ(label, l.name) << link;
+    EXPECT_EQ(e["name"].get<std::string>(), l.partnet_name) << link;
     if (joint == "heavy") {
       ++heavy;
       EXPECT_EQ(e["parent"].get<int>(), -1);
+      EXPECT_FALSE(kMovableLabels.count(label) && label != "leg") << label;
+    } else {
+      EXPECT_GE(e["parent"].get<int>(), 0) << link << ": only the body hangs from base";
+      EXPECT_TRUE(kMovableLabels.count(label)) << link << " '" << label << "'";
     }
     EXPECT_LT(e["parent"].get<int>(), static_cast<int>(i));
     for (const auto& p : e["parts"]) EXPECT_TRUE(part_ids.insert(p["id"].get<int>()).second);
   }
   EXPECT_EQ(heavy, 1);
 
-  // the URDF: link_N and joint_N agree with the JSON (types, limits, axes)
+  // mobility.urdf: base -> body turned z-up as the dataset does, everything below in F
   UrdfLoader loader;
   ArticulationDesc art = loader.ParseFile((dir / "mobility.urdf").string());
-  std::map<std::string, const LinkDesc*> by_name;
-  for (const LinkDesc& l : art.links) by_name[l.name] = &l;
-  ASSERT_TRUE(by_name.count("base"));
-  EXPECT_EQ(art.links[0].name, "base");
+  EXPECT_TRUE(loader.LastReport().Empty()) << loader.LastReport().ToString();
+  std::map<std::string, int> index;
+  for (size_t i = 0; i < art.links.size(); ++i) index[art.links[i].name] = static_cast<int>(i);
+  ASSERT_TRUE(index.count("base"));
+  const LinkDesc& base = art.links[index["base"]];
+  EXPECT_LT(base.parent, 0);
+  EXPECT_TRUE(base.visuals.empty() && base.collisions.empty());
+  std::vector<Pose> X = RestPoses(art);
+  int body = -1;
+  for (size_t i = 0; i < art.links.size(); ++i) {
+    if (art.links[i].parent != index["base"]) continue;
+    EXPECT_EQ(body, -1) << "base has a second child " << art.links[i].name;
+    body = static_cast<int>(i);
+  }
+  ASSERT_GE(body, 0);
+  EXPECT_EQ(art.links[body].joint.type, JointType::kFixed);
+  EXPECT_LT(X[body].p.norm(), 1e-9);
+  EXPECT_NEAR(std::abs(X[body].q.dot(DatasetRootRotation())), 1.0, 1e-9);
+  const Pose X_FB = X[body].Inverse();
+  // every joint_N has child link_N (a rotating slider: the turn; its slide comes after the
+  // links); every link is link_N or link_N_helper
+  std::map<std::string, std::string> joint_child;
+  for (const LinkDesc& l : art.links)
+    if (l.parent >= 0) joint_child[l.joint.name] = l.name;
+  for (size_t i = 0; i < o.links.size(); ++i)
+    EXPECT_EQ(joint_child["joint_" + std::to_string(i)], "link_" + std::to_string(i));
+  std::set<std::string> files_in_urdf;
+  std::map<int, std::set<std::string>> part_files;  // part id -> OBJ names of its visuals
   for (size_t i = 0; i < mob.size(); ++i) {
     const nlohmann::json& e = mob[i];
     const std::string name = "link_" + std::to_string(i);
-    ASSERT_TRUE(by_name.count(name)) << name;
-    const LinkDesc& l = *by_name[name];
-    std::string joint = e["joint"];
-    // every part has visuals named <name>-<id>
+    ASSERT_TRUE(index.count(name)) << name;
+    const LinkDesc& l = art.links[index[name]];
+    const Pose X_FL = X_FB * X[index[name]];
+    // visuals <part>-<id>, one OBJ each, the same files as collisions, all in F
+    EXPECT_EQ(l.collisions.size(), l.visuals.size()) << name;
     std::set<std::string> visual_names;
-    for (const VisualShape& v : l.visuals) visual_names.insert(v.name);
+    for (const VisualShape& v : l.visuals) {
+      visual_names.insert(v.name);
+      ASSERT_TRUE(v.mesh) << name << " " << v.name;
+      const std::string file = fs::path(v.mesh->source).stem().string();
+      EXPECT_TRUE(files_in_urdf.insert(file).second) << file << " in two visuals";
+      const size_t dash = v.name.rfind('-');
+      ASSERT_NE(dash, std::string::npos) << v.name;
+      part_files[std::stoi(v.name.substr(dash + 1))].insert(file);
+      const Pose X_FV = X_FL * v.pose;
+      EXPECT_LT(X_FV.p.norm(), 1e-6) << name << " " << v.name << " is not in F";
+      EXPECT_NEAR(std::abs(X_FV.q.w()), 1.0, 1e-9) << name << " " << v.name;
+    }
+    for (const CollisionShape& c : l.collisions) {
+      ASSERT_TRUE(c.mesh) << name;
+      EXPECT_TRUE(files_in_urdf.count(fs::path(c.mesh->source).stem().string())) << name;
+      EXPECT_LT((X_FL * c.pose).p.norm(), 1e-6) << name;
+    }
     for (const auto& p : e["parts"]) {
       std::string want = p["name"].get<std::string>() + "-" + std::to_string(p["id"].get<int>());
       EXPECT_TRUE(visual_names.count(want)) << name << " lacks visual " << want;
     }
-    EXPECT_EQ(l.collisions.size(), l.visuals.size()) << name;
+    const std::string joint = e["joint"];
     if (joint != "hinge" && joint != "slider") {
       EXPECT_EQ(l.joint.type, JointType::kFixed) << name;
       EXPECT_TRUE(e["jointData"].empty()) << name;
       continue;
     }
     const nlohmann::json& lim = e["jointData"]["limit"];
-    bool rotates = joint == "slider" && lim["rotates"].get<bool>();
-    // a rotating slider: prismatic to link_N_helper, then the rotation
-    const LinkDesc& moving = rotates ? *by_name[name + "_helper"] : l;
+    const bool rotates = joint == "slider" && lim["rotates"].get<bool>();
+    // a rotating slider: prismatic to link_N_helper, then the turn about the same axis
+    const int motion = rotates ? l.parent : index[name];
+    const LinkDesc& moving = art.links[motion];
+    if (rotates) {
+      EXPECT_EQ(moving.name, name + "_helper");
+      EXPECT_TRUE(moving.visuals.empty() && moving.collisions.empty());
+      EXPECT_EQ(l.joint.type,
+                lim["noRotationLimit"].get<bool>() ? JointType::kContinuous : JointType::kRevolute);
+    }
+    const std::string parent =
+        e["parent"].get<int>() < 0 ? "base" : "link_" + std::to_string(e["parent"].get<int>());
+    EXPECT_EQ(art.links[moving.parent].name, parent) << name;
     if (joint == "hinge") {
-      bool no_limit = lim["noLimit"].get<bool>();
+      const bool no_limit = lim["noLimit"].get<bool>();
       EXPECT_EQ(l.joint.type, no_limit ? JointType::kContinuous : JointType::kRevolute) << name;
       if (!no_limit) {
         double a = lim["a"].get<double>(), b = lim["b"].get<double>();
@@ -378,23 +542,59 @@ void CheckFolder(const GeneratedObject& o, const fs::path& dir) {
       double a = lim["a"].get<double>(), b = lim["b"].get<double>();
       EXPECT_NEAR(moving.joint.lower, std::min(a, b), 1e-6) << name;
       EXPECT_NEAR(moving.joint.upper, std::max(a, b), 1e-6) << name;
-      if (rotates) EXPECT_EQ(l.joint.type, JointType::kContinuous) << name;
     }
-    // the JSON axis is parallel to the joint axis (the joint frame's x axis), in the file frame
-    V3 dir(e["jointData"]["axis"]["direction"][0].get<double>(),
-           e["jointData"]["axis"]["direction"][1].get<double>(),
-           e["jointData"]["axis"]["direction"][2].get<double>());
-    V3 x_axis = moving.joint.pose_in_parent.q * V3::UnitX();
-    EXPECT_NEAR(std::abs(x_axis.dot(dir.normalized())), 1.0, 1e-6) << name;
+    // the joint frame sits at the JSON axis origin, its x axis along the JSON direction (in F)
+    const Pose X_FJ = X_FB * X[moving.parent] * moving.joint.pose_in_parent;
+    const V3 dir = Vec(e["jointData"]["axis"]["direction"]).normalized();
+    EXPECT_NEAR(std::abs((X_FJ.q * V3::UnitX()).dot(dir)), 1.0, 1e-6) << name;
+    EXPECT_LT((X_FJ.p - Vec(e["jointData"]["axis"]["origin"])).norm(), 2e-6) << name;
+  }
+  // links are link_N and link_N_helper only
+  for (const LinkDesc& l : art.links) {
+    if (l.name == "base") continue;
+    std::string n = l.name;
+    if (n.size() > 7 && n.compare(n.size() - 7, 7, "_helper") == 0) n.resize(n.size() - 7);
+    EXPECT_EQ(n.rfind("link_", 0), 0u) << l.name;
+    EXPECT_LT(std::stoul(n.substr(5)), o.links.size()) << l.name;
   }
 
-  // meshes: every OBJ closed, outward and convex
+  // result.json: the PartNet part hierarchy, leaves = the parts of mobility_v2.json with the
+  // OBJ files of their visuals
+  nlohmann::json result = nlohmann::json::parse(ReadFile(dir / "result.json"));
+  ASSERT_TRUE(result.is_array());
+  ASSERT_EQ(result.size(), 1u);
+  EXPECT_EQ(result[0]["id"], 0);
+  EXPECT_EQ(result[0]["text"], o.category);
+  std::set<int> ids;
+  std::map<int, std::pair<std::string, std::set<std::string>>> leaves;
+  CollectLeaves(result[0], &ids, &leaves);
+  EXPECT_EQ(leaves.size(), part_ids.size());
+  std::set<std::string> leaf_files;
+  for (const auto& e : mob) {
+    for (const auto& p : e["parts"]) {
+      const int id = p["id"].get<int>();
+      ASSERT_TRUE(leaves.count(id)) << "part " << id << " is no leaf of result.json";
+      EXPECT_EQ(leaves[id].first, p["name"].get<std::string>());
+      EXPECT_EQ(leaves[id].second, part_files[id]) << "part " << id;
+      leaf_files.insert(leaves[id].second.begin(), leaves[id].second.end());
+    }
+  }
+  EXPECT_EQ(leaf_files, files_in_urdf);
+  nlohmann::json merged = nlohmann::json::parse(ReadFile(dir / "result_after_merging.json"));
+  ASSERT_TRUE(merged.is_array() && merged.size() == 1u);
+  EXPECT_EQ(merged[0]["objs"].size(), files_in_urdf.size());
+  EXPECT_EQ(merged[0]["ori_id"], 0);
+
+  // meshes: every OBJ closed, outward and convex, a plate at least 0.5 mm thick (no flat pieces)
   int files = 0;
   for (const auto& entry : fs::directory_iterator(dir / "textured_objs")) {
     if (entry.path().extension() != ".obj") continue;
     ++files;
+    EXPECT_TRUE(fs::exists(fs::path(entry.path()).replace_extension(".mtl")));
     ObjMesh m = ReadObj(entry.path());
     std::string f = entry.path().filename().string();
+    EXPECT_TRUE(files_in_urdf.count(entry.path().stem().string())) << f << " is not used";
+    ASSERT_GE(m.v.size(), 4u) << f;
     ASSERT_GE(m.f.size(), 4u) << f;
     std::map<std::pair<int, int>, int> edges;
     double volume = 0;
@@ -409,16 +609,34 @@ void CheckFolder(const GeneratedObject& o, const fs::path& dir) {
       ASSERT_EQ(count, 2) << f << " edge " << e.first << "-" << e.second;
     }
     EXPECT_GT(volume, 0.0) << f;
+    double thickness = 1e30;
     for (const auto& t : m.f) {
       V3 n = (m.v[t[1]] - m.v[t[0]]).cross(m.v[t[2]] - m.v[t[0]]);
       ASSERT_GT(n.norm(), 0.0) << f << " degenerate triangle";
       n.normalize();
-      double worst = -1e30;
-      for (const V3& p : m.v) worst = std::max(worst, n.dot(p - m.v[t[0]]));
+      double worst = -1e30, depth = 1e30;
+      for (const V3& p : m.v) {
+        worst = std::max(worst, n.dot(p - m.v[t[0]]));
+        depth = std::min(depth, n.dot(p - m.v[t[0]]));
+      }
       ASSERT_LE(worst, 1e-6) << f << " not convex";
+      thickness = std::min(thickness, -depth);
     }
+    EXPECT_GE(thickness, 0.0005 - 1e-9) << f << " is a flat piece";
   }
-  EXPECT_GT(files, 0);
+  EXPECT_EQ(files, static_cast<int>(files_in_urdf.size()));
+
+  // partsim's reader takes it with no warning, even strict, with both vocabularies
+  PartNetMobilityLoader reader;
+  reader.strict = true;
+  PartNetMobilityObject obj = reader.Parse(dir.string());
+  EXPECT_TRUE(obj.report.Empty()) << obj.report.ToString();
+  EXPECT_EQ(obj.category, o.category);
+  ASSERT_EQ(obj.links.size(), o.links.size());
+  for (const GeneratedLink& l : o.links) {
+    EXPECT_EQ(obj.Link(l.id).semantic_label, l.name);
+    EXPECT_EQ(obj.Link(l.id).partnet_name, l.partnet_name);
+  }
 }
 
 TEST(GeneratorTest, EveryCategoryWritesAConsistentFolder) {
@@ -427,17 +645,103 @@ TEST(GeneratorTest, EveryCategoryWritesAConsistentFolder) {
     GeneratedObject o = GenerateObject(c, 0, 0);
     EXPECT_EQ(o.category, c);
     ASSERT_GE(o.links.size(), 2u) << c;
-    fs::path dir = root / c / o.model_id;
+    fs::path dir = root / o.anno_id;
     WriteObject(o, dir.string());
     CheckFolder(o, dir);
   }
   fs::remove_all(root);
 }
 
-/// Objects per category for the sweeping tests: PARTSIM_GENERATOR_TEST_N, default `n`.
-int ObjectsPerCategory(int n) {
-  const char* env = std::getenv("PARTSIM_GENERATOR_TEST_N");
-  return env ? std::max(1, std::atoi(env)) : n;
+TEST(GeneratorTest, FoldersHoldWhatTheRealDatasetHolds) {
+  // the same files, keys and root joint as the real object in ../shared/realdata
+  const fs::path real =
+      fs::path(PARTSIM_SOURCE_DIR) / ".." / "shared" / "realdata" / "partnet-mobility-3763";
+  if (!fs::exists(real / "mobility.urdf")) GTEST_SKIP() << "no " << real;
+  fs::path dir = TempDir("like_real");
+  GeneratedObject o = GenerateObject("Bottle", 0, 0);
+  WriteObject(o, dir.string());
+  for (const char* f : {"mobility.urdf", "mobility_v2.json", "semantics.txt", "meta.json",
+                        "bounding_box.json", "result.json", "result_after_merging.json"}) {
+    EXPECT_TRUE(fs::exists(real / f)) << f;
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
+  }
+  auto keys = [](const nlohmann::json& j) {
+    std::set<std::string> k;
+    for (const auto& [key, value] : j.items()) k.insert(key);
+    return k;
+  };
+  // meta.json: every key of the real one
+  nlohmann::json rm = nlohmann::json::parse(ReadFile(real / "meta.json"));
+  nlohmann::json gm = nlohmann::json::parse(ReadFile(dir / "meta.json"));
+  for (const std::string& k : keys(rm)) EXPECT_TRUE(gm.contains(k)) << k;
+  // mobility_v2.json: the same keys per entry and in jointData
+  nlohmann::json rj = nlohmann::json::parse(ReadFile(real / "mobility_v2.json"));
+  nlohmann::json gj = nlohmann::json::parse(ReadFile(dir / "mobility_v2.json"));
+  EXPECT_EQ(keys(gj[0]), keys(rj[0]));
+  EXPECT_EQ(keys(gj[1]["jointData"]), keys(rj[0]["jointData"]));
+  EXPECT_EQ(keys(gj[1]["jointData"]["axis"]), keys(rj[0]["jointData"]["axis"]));
+  EXPECT_EQ(keys(gj[0]["parts"][0]), keys(rj[0]["parts"][0]));
+  // result.json and result_after_merging.json: the same keys on the root, internal nodes and
+  // leaves
+  for (const char* f : {"result.json", "result_after_merging.json"}) {
+    nlohmann::json r = nlohmann::json::parse(ReadFile(real / f));
+    nlohmann::json g = nlohmann::json::parse(ReadFile(dir / f));
+    EXPECT_EQ(keys(g[0]), keys(r[0])) << f;
+    EXPECT_EQ(keys(g[0]["children"][0]), keys(r[0]["children"][0]["children"][0])) << f;
+  }
+  // mobility.urdf: the same rotation from base to the body
+  UrdfLoader loader;
+  for (const fs::path& d : {real, dir}) {
+    ArticulationDesc art = loader.ParseFile((d / "mobility.urdf").string());
+    std::vector<Pose> X = RestPoses(art);
+    int children = 0;
+    for (size_t i = 0; i < art.links.size(); ++i) {
+      if (art.links[i].parent != 0) continue;
+      ++children;
+      EXPECT_EQ(art.links[i].joint.type, JointType::kFixed) << d;
+      EXPECT_NEAR(std::abs(X[i].q.dot(DatasetRootRotation())), 1.0, 1e-9) << d;
+    }
+    EXPECT_EQ(children, 1) << d;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(GeneratorTest, LinksCarryBothVocabularies) {
+  // semantics labels from the movable-part vocabulary, PartNet names beside them; where the
+  // dataset's two names differ, the generator's do too
+  std::map<std::string, std::set<std::string>> names_of;  // label -> PartNet names
+  for (const std::string& c : GeneratorCategories()) {
+    for (int i = 0; i < ObjectsPerCategory(8); ++i) {
+      GeneratedObject o = GenerateObject(c, i, 11);
+      for (const GeneratedLink& l : o.links) {
+        EXPECT_FALSE(l.partnet_name.empty()) << c << " link_" << l.id;
+        names_of[l.name].insert(l.partnet_name);
+        if (l.parent < 0) continue;
+        EXPECT_TRUE(kMovableLabels.count(l.name)) << c << " '" << l.name << "'";
+        // the motion prefix follows the motion
+        if (l.name.rfind("translation_", 0) == 0) EXPECT_TRUE(l.joint == "slider" && !l.rotates);
+        if (l.name.rfind("rotation_", 0) == 0) EXPECT_TRUE(l.joint == "hinge" || l.rotates);
+      }
+    }
+  }
+  EXPECT_EQ(names_of["drawer"], std::set<std::string>{"drawer"});
+  EXPECT_TRUE(names_of["rotation_door"].count("cabinet_door"));
+  EXPECT_TRUE(names_of["rotation_door"].count("door"));
+  EXPECT_EQ(names_of["rotation_lid"].count("lid"), 1u);
+  EXPECT_EQ(names_of["translation_lid"].count("lid"), 1u);
+  EXPECT_EQ(names_of["furniture_body"], (std::set<std::string>{"cabinet_frame", "table_frame"}));
+  EXPECT_EQ(names_of["bottle_body"], std::set<std::string>{"body"});
+  // the bottle's screw cap is a slider that also turns, labelled as the dataset's
+  int screw = 0;
+  for (int i = 0; i < 12; ++i) {
+    for (const GeneratedLink& l : GenerateObject("Bottle", i, 0).links) {
+      if (!l.rotates) continue;
+      ++screw;
+      EXPECT_EQ(l.name, "rotation_lid");
+      EXPECT_EQ(l.partnet_name, "lid");
+    }
+  }
+  EXPECT_GT(screw, 0);
 }
 
 TEST(GeneratorTest, MovingPartsKeepClear) {
@@ -481,6 +785,34 @@ TEST(GeneratorTest, SameSeedSameBytes) {
     }
   }
   EXPECT_GT(compared, 0);
+  // the dataset's flat layout: one folder per object named by its anno_id, the category in
+  // meta.json; unique ids across categories
+  std::set<std::string> categories;
+  int folders = 0;
+  for (const auto& e : fs::directory_iterator(a)) {
+    ++folders;
+    const std::string id = e.path().filename().string();
+    EXPECT_EQ(id.find_first_not_of("0123456789"), std::string::npos) << id;
+    nlohmann::json meta = nlohmann::json::parse(ReadFile(e.path() / "meta.json"));
+    EXPECT_EQ(meta["anno_id"], id);
+    categories.insert(meta["model_cat"].get<std::string>());
+  }
+  EXPECT_EQ(folders, 8);
+  EXPECT_EQ(categories.size(), 4u);
+  // the old layout on request: <out>/<category>/<anno_id>/, same bytes
+  fs::path d = TempDir("det_d");
+  opt.out_dir = d.string();
+  opt.by_category = true;
+  EXPECT_EQ(GenerateDataset(opt), 2);
+  GeneratedObject faucet = GenerateObject("Faucet", 1, 42);
+  EXPECT_EQ(ReadFile(d / "Faucet" / faucet.anno_id / "mobility.urdf"),
+            ReadFile(a / faucet.anno_id / "mobility.urdf"));
+  // ids: anno_id from (category, index), model_id from the seed as well
+  EXPECT_EQ(GenerateObject("Faucet", 1, 7).anno_id, faucet.anno_id);
+  EXPECT_NE(GenerateObject("Faucet", 1, 7).model_id, faucet.model_id);
+  EXPECT_NE(GenerateObject("Faucet", 2, 42).anno_id, faucet.anno_id);
+  EXPECT_NE(GenerateObject("Knife", 1, 42).anno_id, faucet.anno_id);
+  fs::remove_all(d);
   // another seed gives another object
   GeneratedObject o1 = GenerateObject("StorageFurniture", 0, 1),
                   o2 = GenerateObject("StorageFurniture", 0, 2);
@@ -488,23 +820,24 @@ TEST(GeneratorTest, SameSeedSameBytes) {
   for (const fs::path& p : {a, b, c}) fs::remove_all(p);
 }
 
-TEST(GeneratorTest, ObjectsRestStillInAScene) {
-  // gravity along the file frame's -y (the reader turns y up into z up)
+TEST(GeneratorTest, ObjectsLoadWithoutWarningAndRestStillInAScene) {
+  // through partsim's reader, strict: any warning would be an error; mobility.urdf turns the file
+  // frame's y up into the world's z up, so gravity is along world -z
   fs::path root = TempDir("scene");
   const int n = ObjectsPerCategory(1);
   for (const std::string& c : GeneratorCategories()) {
     for (int i = 0; i < n; ++i) {
       SCOPED_TRACE(c + " " + std::to_string(i));
       GeneratedObject o = GenerateObject(c, i, 0);
-      fs::path dir = root / (c + std::to_string(i));
+      fs::path dir = root / o.anno_id;
       WriteObject(o, dir.string());
-      SceneConfig config;
-      config.gravity = V3(0, -9.81, 0);
-      Scene scene(config);
-      UrdfLoader loader(&scene);
-      loader.fix_root_link = true;
-      loader.load_multiple_collisions_from_file = true;
-      Articulation art = loader.Load((dir / "mobility.urdf").string());
+      Scene scene;
+      PartNetMobilityLoader loader(&scene);
+      loader.strict = true;
+      loader.urdf.fix_root_link = true;
+      loader.urdf.load_multiple_collisions_from_file = true;
+      Articulation art = loader.Load(dir.string());
+      EXPECT_TRUE(loader.LastReport().Empty()) << loader.LastReport().ToString();
       Eigen::VectorXd q0 = art.GetQpos();
       scene.Step(100);
       Eigen::VectorXd q1 = art.GetQpos();

@@ -4,9 +4,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
+#include <tuple>
 
+#include "partsim/assets/convex_decomposition.h"
 #include "partsim/core/error.h"
+#include "shape_meshes.h"
 
 namespace partsim {
 namespace {
@@ -184,6 +188,106 @@ TEST(MeshTest, BrokenFileNamesTheFile) {
 }
 
 TEST(MeshTest, DirectoryIsNotAMesh) { EXPECT_THROW(LoadMeshFile(kMeshDir), Error); }
+
+// ---------------------------------------------------------------------------------------------
+// convex collision pieces
+
+std::shared_ptr<const MeshData> Shared(MeshData m) {
+  return std::make_shared<const MeshData>(std::move(m));
+}
+
+// A mesh of points with a fan of triangles over them.
+MeshData Points(const std::vector<Eigen::Vector3f>& points) {
+  MeshData m;
+  m.vertices = points;
+  for (int i = 1; i + 1 < static_cast<int>(points.size()); ++i) m.faces.emplace_back(0, i, i + 1);
+  if (points.size() < 3) m.faces.emplace_back(0, 0, static_cast<int>(points.size()) - 1);
+  return m;
+}
+
+// Extent of a mesh's vertices along a unit direction (m).
+double ExtentAlong(const MeshData& m, const Eigen::Vector3d& d) {
+  double lo = 1e30, hi = -1e30;
+  for (const Eigen::Vector3f& v : m.vertices) {
+    lo = std::min(lo, v.cast<double>().dot(d));
+    hi = std::max(hi, v.cast<double>().dot(d));
+  }
+  return hi - lo;
+}
+
+TEST(ConvexPieceTest, FlatQuadGetsAThinHullAlongItsNormal) {
+  // a 0.4 m square in a tilted plane: 4 points, no volume
+  const Eigen::Vector3d n = Eigen::Vector3d(1, 2, 3).normalized();
+  const Eigen::Vector3d u = n.unitOrthogonal(), w = n.cross(u);
+  std::vector<Eigen::Vector3f> quad;
+  const int corners[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (const auto& c : corners)
+    quad.push_back((0.4 * (c[0] * u + c[1] * w) + Eigen::Vector3d(1, 1, 1)).cast<float>());
+  ConvexPieceCheck c = CheckConvexPiece(Shared(Points(quad)));
+  ASSERT_TRUE(c.piece);
+  EXPECT_NE(c.repair.find("flat"), std::string::npos) << c.repair;
+  EXPECT_FALSE(c.non_convex);
+  // 3% of its size, at most 5 mm, along the normal; the square itself is unchanged
+  EXPECT_DOUBLE_EQ(c.thickness, 0.005);
+  EXPECT_NEAR(ExtentAlong(*c.piece, n), 0.005, 1e-5);
+  EXPECT_NEAR(ExtentAlong(*c.piece, u), 0.4, 1e-5);
+  EXPECT_NEAR(ExtentAlong(*c.piece, w), 0.4, 1e-5);
+  // a closed hull that MuJoCo accepts
+  EXPECT_GT(MeshVolume(*c.piece), 0.4 * 0.4 * 0.005 * 0.99);
+}
+
+TEST(ConvexPieceTest, TriangleLineAndTinyPieces) {
+  // three points: a flat triangle, thickened
+  ConvexPieceCheck tri =
+      CheckConvexPiece(Shared(Points({{0, 0, 0}, {0.03f, 0, 0}, {0, 0.03f, 0}})));
+  ASSERT_TRUE(tri.piece);
+  EXPECT_NE(tri.repair.find("fewer than 4"), std::string::npos) << tri.repair;
+  // 3% of its largest extent, 0.03 * sqrt(2) m, along its normal
+  EXPECT_NEAR(tri.thickness, 0.03 * 0.03 * std::sqrt(2.0), 1e-7);
+  EXPECT_NEAR(ExtentAlong(*tri.piece, Eigen::Vector3d::UnitZ()), tri.thickness, 1e-6);
+  // points on a line: thickened across both of its thin directions
+  ConvexPieceCheck line =
+      CheckConvexPiece(Shared(Points({{0, 0, 0}, {0.5f, 0, 0}, {1, 0, 0}, {0.2f, 0, 0}})));
+  ASSERT_TRUE(line.piece);
+  EXPECT_NE(line.repair.find("line"), std::string::npos) << line.repair;
+  EXPECT_NEAR(ExtentAlong(*line.piece, Eigen::Vector3d::UnitY()), 0.005, 1e-6);
+  EXPECT_NEAR(ExtentAlong(*line.piece, Eigen::Vector3d::UnitZ()), 0.005, 1e-6);
+  // a tetrahedron 10 micrometres across: dropped
+  ConvexPieceCheck tiny =
+      CheckConvexPiece(Shared(Points({{0, 0, 0}, {1e-5f, 0, 0}, {0, 1e-5f, 0}, {0, 0, 1e-5f}})));
+  EXPECT_FALSE(tiny.piece);
+  EXPECT_NE(tiny.repair.find("dropped"), std::string::npos) << tiny.repair;
+  // no vertices at all
+  EXPECT_FALSE(CheckConvexPiece(Shared(MeshData())).piece);
+}
+
+TEST(ConvexPieceTest, ConvexShapesPassAndNonConvexOnesAreFlagged) {
+  for (const MeshData& convex :
+       {testing::Box(), Points({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}})}) {
+    ConvexPieceCheck c = CheckConvexPiece(Shared(convex));
+    EXPECT_TRUE(c.piece);
+    EXPECT_TRUE(c.repair.empty()) << c.repair;
+    EXPECT_FALSE(c.non_convex);
+    EXPECT_EQ(c.deep_area_fraction, 0.0);
+  }
+  // the box is closed: its volume is its hull's
+  EXPECT_NEAR(CheckConvexPiece(Shared(testing::Box())).volume_ratio, 1.0, 1e-6);
+  // an L fills 0.3 x 0.05 + 0.25 x 0.05 of its hull's triangle-topped 0.3 x 0.3 profile
+  ConvexPieceCheck l = CheckConvexPiece(Shared(testing::LShape()));
+  EXPECT_TRUE(l.non_convex);
+  const double profile = 0.3 * 0.3 - 0.5 * 0.25 * 0.25;
+  EXPECT_NEAR(l.volume_ratio, (0.3 * 0.05 + 0.25 * 0.05) / profile, 1e-6);
+  // the same L as an open surface (half its triangles): depth alone decides
+  MeshData open = testing::LShape();
+  open.faces.resize(open.faces.size() / 2);
+  ConvexPieceCheck lo = CheckConvexPiece(Shared(open));
+  EXPECT_TRUE(std::isnan(lo.volume_ratio));
+  EXPECT_GT(lo.deep_area_fraction, 0.1);
+  EXPECT_TRUE(lo.non_convex);
+  // a torus is closed and clearly not convex; a thin-walled cup too
+  EXPECT_TRUE(CheckConvexPiece(Shared(testing::Torus(0.2, 0.05))).non_convex);
+  EXPECT_TRUE(CheckConvexPiece(Shared(testing::Cup(0.05, 0.1, 0.004, 32))).non_convex);
+}
 
 }  // namespace
 }  // namespace partsim

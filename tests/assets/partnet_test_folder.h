@@ -1,5 +1,7 @@
-// A hand-written PartNet-Mobility folder for tests (docs/partnet_mobility_format.md): a cabinet
-// in the y-up file frame with a hinged door (negative limit), a drawer and a body.
+// A hand-written PartNet-Mobility folder for tests (docs/partnet_mobility_format.md), laid out
+// as the real dataset is: mobility.urdf turns the y-up meshes z-up at the fixed joint from
+// "base" to the body; mobility_v2.json (PartNet names) and semantics.txt (movable-part labels)
+// speak two vocabularies. A cabinet with a hinged door (negative limit), a drawer and a body.
 #pragma once
 
 #include <Eigen/Core>
@@ -45,7 +47,10 @@ struct Folder {
     <visual name="body-1"><geometry><mesh filename="textured_objs/original-1.obj"/></geometry></visual>
     <collision><geometry><mesh filename="textured_objs/original-1.obj"/></geometry></collision>
   </link>
-  <joint name="joint_2" type="fixed"><parent link="base"/><child link="link_2"/></joint>
+  <joint name="joint_2" type="fixed">
+    <origin rpy="1.570796326794897 0 -1.570796326794897" xyz="0 0 0"/>
+    <parent link="base"/><child link="link_2"/>
+  </joint>
   <link name="link_0">
     <visual name="door-2"><geometry><mesh filename="textured_objs/original-2.obj"/></geometry></visual>
     <visual name="handle-3"><geometry><mesh filename="textured_objs/original-3.obj"/></geometry></visual>
@@ -68,7 +73,7 @@ struct Folder {
 </robot>
 )";
     json = R"([
- {"id": 0, "parent": 2, "joint": "hinge", "name": "rotation_door",
+ {"id": 0, "parent": 2, "joint": "hinge", "name": "cabinet_door",
   "parts": [{"id": 2, "name": "door", "children": []}, {"id": 3, "name": "handle", "children": []}],
   "jointData": {"axis": {"origin": [-0.3, 0.5, 0.21], "direction": [0, 1, 0]},
                 "limit": {"a": -90, "b": 0, "noLimit": false}}},
@@ -76,10 +81,10 @@ struct Folder {
   "parts": [{"id": 4, "name": "drawer", "children": []}],
   "jointData": {"axis": {"origin": [0, 0, 0], "direction": [0, 0, 1]},
                 "limit": {"a": 0, "b": 0.3, "noLimit": false, "rotates": false}}},
- {"id": 2, "parent": -1, "joint": "heavy", "name": "cabinet_body",
+ {"id": 2, "parent": -1, "joint": "heavy", "name": "cabinet_frame",
   "parts": [{"id": 1, "name": "body", "children": []}], "jointData": {}}
 ])";
-    semantics = "link_0 hinge rotation_door\nlink_1 slider drawer\nlink_2 heavy cabinet_body\n";
+    semantics = "link_0 hinge rotation_door\nlink_1 slider drawer\nlink_2 heavy furniture_body\n";
     WriteAll();
   }
 

@@ -31,12 +31,17 @@ TEST(QualityTest, AGoodObjectPassesEveryCheck) {
 
 TEST(QualityTest, APartThatJamsFailsTheRangeCheck) {
   Folder f("quality_jam");
-  // a collision-only stop in front of the drawer, 0.1 m into its 0.3 m travel
-  f.urdf.replace(f.urdf.find("</link>"), 7,
+  // a collision-only stop on the door, 0.1 m into the drawer's 0.3 m travel (nothing rigidly
+  // attached to the drawer's parent, the body, collides with it: links joined by a joint do not
+  // collide). The door's axis points down, so that the drawer pushes it into its limit.
+  f.urdf.replace(f.urdf.find("<axis xyz=\"0 1 0\"/>"), 19, "<axis xyz=\"0 -1 0\"/>");
+  f.json.replace(f.json.find("\"direction\": [0, 1, 0]"), 22, "\"direction\": [0, -1, 0]");
+  f.urdf.replace(f.urdf.find("</link>\n  <joint name=\"joint_0\""), 7,
                  "<collision><geometry><mesh filename=\"textured_objs/original-5.obj\"/>"
                  "</geometry></collision></link>");
   f.WriteAll();
-  Write(f.dir / "textured_objs/original-5.obj", BoxObj({0, -0.2, 0.27}, {0.2, 0.05, 0.01}));
+  // in the door's frame, at the hinge: body (0, -0.2, 0.27) is (0.3, -0.4, 0.06)
+  Write(f.dir / "textured_objs/original-5.obj", BoxObj({0.3, -0.4, 0.06}, {0.2, 0.05, 0.02}));
   ObjectQualityReport r = CheckPartNetObject(f.Path());
   EXPECT_FALSE(r.Passed());
   const QualityCheck* range = Find(r, "range");
@@ -65,15 +70,42 @@ TEST(QualityTest, AHiddenPartFailsTheVisibilityCheck) {
   EXPECT_FALSE(visible->passed) << r.ToString();
 }
 
-TEST(QualityTest, AnInconsistentFolderFailsToLoadWithTheReason) {
+TEST(QualityTest, AStiffHingeThatAStrongerDriveOpensPassesWithTheForceItNeeded) {
+  Folder f("quality_stiff");
+  // dry friction the gentle drive's stiffness cannot beat near the end of the range, which a
+  // plain PD opens and closes: not a jammed part
+  f.urdf.replace(f.urdf.find("<limit lower=\"-1.5707963267948966\""), 0,
+                 "<dynamics friction=\"3\"/>");
+  f.WriteAll();
+  ObjectQualityReport r = CheckPartNetObject(f.Path());
+  const QualityCheck* range = Find(r, "range");
+  ASSERT_NE(range, nullptr) << r.ToString();
+  EXPECT_TRUE(range->passed) << r.ToString();
+  EXPECT_NE(range->detail.find("'joint_0' needed"), std::string::npos) << range->detail;
+  EXPECT_NE(range->detail.find("N m"), std::string::npos) << range->detail;
+}
+
+TEST(QualityTest, AnInconsistentFolderFailsTheLabelsCheckWithTheReason) {
   Folder f("quality_bad");
-  f.semantics = "link_0 hinge door\nlink_1 slider drawer\nlink_2 heavy cabinet_body\n";
+  f.semantics = "link_0 slider rotation_door\nlink_1 slider drawer\nlink_2 heavy furniture_body\n";
   f.WriteAll();
   ObjectQualityReport r = CheckPartNetObject(f.Path());
   EXPECT_FALSE(r.Passed());
+  const QualityCheck* labels = Find(r, "labels");
+  ASSERT_NE(labels, nullptr) << r.ToString();
+  EXPECT_FALSE(labels->passed);
+  EXPECT_NE(labels->detail.find("semantics.txt"), std::string::npos) << labels->detail;
+  EXPECT_NE(labels->detail.find("link_0"), std::string::npos) << labels->detail;
+  // the physics checks still ran
+  ASSERT_NE(Find(r, "range"), nullptr);
+  EXPECT_TRUE(Find(r, "range")->passed) << r.ToString();
+  // a folder that cannot be read fails to load, with the reason
+  Folder g("quality_unreadable");
+  Write(g.dir / "mobility_v2.json", "[");
+  r = CheckPartNetObject(g.Path());
   ASSERT_FALSE(r.checks.empty());
   EXPECT_EQ(r.checks[0].name, "load");
-  EXPECT_NE(r.checks[0].detail.find("semantics.txt"), std::string::npos);
+  EXPECT_NE(r.checks[0].detail.find("mobility_v2.json"), std::string::npos);
 }
 
 TEST(QualityTest, AGeneratedObjectOfEveryCategoryPassesEveryCheck) {

@@ -1,13 +1,17 @@
 #include "partsim/assets/urdf.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 
+#include "partsim/assets/generator.h"
 #include "partsim/core/error.h"
+#include "partsim/core/log.h"
 
 namespace partsim {
 namespace {
@@ -72,6 +76,52 @@ std::vector<Pose> ForwardKinematics(const ArticulationDesc& d,
     x[i] = x[l.parent] * JointMotion(l.joint, it == q.end() ? 0.0 : it->second);
   }
   return x;
+}
+
+// A folder of its own under the system's temporary folder, removed at the end of the test.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& name)
+      : path_(std::filesystem::temp_directory_path() /
+              ("partsim_urdf_" + name + "_" + std::to_string(getpid()))) {
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() { std::filesystem::remove_all(path_); }
+  std::string operator/(const std::string& file) const { return (path_ / file).string(); }
+  std::string str() const { return path_.string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Writes an OBJ file of vertices (m) and triangles (0-based).
+void WriteObj(const std::string& path, const std::vector<Eigen::Vector3d>& vertices,
+              const std::vector<Eigen::Vector3i>& faces) {
+  std::ofstream out(path);
+  for (const Eigen::Vector3d& v : vertices)
+    out << "v " << v.x() << " " << v.y() << " " << v.z() << "\n";
+  for (const Eigen::Vector3i& f : faces)
+    out << "f " << f[0] + 1 << " " << f[1] + 1 << " " << f[2] + 1 << "\n";
+}
+
+// A link whose collision is the mesh `file`, with a 1 kg inertial.
+std::string MeshLink(const std::string& name, const std::string& file) {
+  return "<link name=\"" + name + "\"><collision><geometry><mesh filename=\"" + file +
+         "\"/></geometry></collision><inertial><mass value=\"1\"/><inertia ixx=\"0.01\" "
+         "iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>\n";
+}
+
+// The warnings of a report that contain every one of `needles`.
+int CountWarnings(const LoadReport& report, const std::vector<std::string>& needles) {
+  int n = 0;
+  for (const LoadWarning& w : report.warnings) {
+    bool all = true;
+    for (const std::string& needle : needles)
+      all = all && w.message.find(needle) != std::string::npos;
+    n += all;
+  }
+  return n;
 }
 
 void ExpectPoseNear(const Pose& a, const Pose& b, double tol = 1e-9) {
@@ -523,6 +573,203 @@ TEST(UrdfTest, MeshPathResolution) {
   EXPECT_NO_THROW(UrdfLoader().Parse(Robot(head + "../meshes/box.gltf" + tail), kDataDir + "/arm"));
 }
 
+// ---------------------------------------------------------------------------------------------
+// files as they are found: what the loader repairs, and warns about
+
+TEST(UrdfTest, MimicOnAFixedJointIsIgnoredWithAWarning) {
+  UrdfLoader loader;
+  ArticulationDesc d =
+      loader.Parse(Robot(BoxLink("a") + BoxLink("b") + BoxLink("c") +
+                         Joint("j1", "revolute", "a", "b", "<limit lower=\"-1\" upper=\"1\"/>") +
+                         Joint("weld", "fixed", "a", "c", "<mimic joint=\"j1\"/>")),
+                   kMeshDir, "gripper.urdf");
+  EXPECT_TRUE(d.couplings.empty());
+  ASSERT_EQ(loader.LastReport().warnings.size(), 1u);
+  EXPECT_EQ(loader.LastReport().warnings[0].file, "gripper.urdf");
+  EXPECT_EQ(CountWarnings(loader.LastReport(), {"joint 'weld'", "fixed", "<mimic>", "ignored"}), 1);
+  // a later parse starts a new report
+  loader.Parse(Robot(BoxLink("a")), kMeshDir);
+  EXPECT_TRUE(loader.LastReport().Empty());
+}
+
+TEST(UrdfTest, InertiaThatBreaksTheTriangleInequalityIsBalanced) {
+  // principal moments 0.001 + 0.002 < 0.01 (a rotated tensor, as exported files have them)
+  const std::string urdf =
+      Robot(BoxLink("base") +
+            "<link name=\"hatch\"><collision><geometry><box size=\"0.1 0.1 0.1\"/></geometry>"
+            "</collision><inertial><origin rpy=\"0.3 0.2 0.1\"/><mass value=\"2\"/>"
+            "<inertia ixx=\"0.001\" iyy=\"0.002\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+            "</inertial></link>" +
+            Joint("hinge", "revolute", "base", "hatch", "<limit lower=\"-1\" upper=\"1\"/>"));
+  UrdfLoader loader;
+  ArticulationDesc d = loader.Parse(urdf, kMeshDir, "robot.urdf");
+  const Inertial& in = *FindLink(d, "hatch").inertial;
+  // all three set to their mean, as MuJoCo's balanceinertia does; mass unchanged
+  const double mean = (0.001 + 0.002 + 0.01) / 3;
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(in.inertia[k], mean, 1e-12);
+  EXPECT_DOUBLE_EQ(in.mass, 2.0);
+  ASSERT_EQ(loader.LastReport().warnings.size(), 1u);
+  const std::string& msg = loader.LastReport().warnings[0].message;
+  EXPECT_EQ(
+      CountWarnings(loader.LastReport(), {"link 'hatch'", "A + B >= C", "0.01", "0.00433333"}), 1)
+      << msg;
+  // MuJoCo takes the result
+  Scene scene;
+  Articulation art = scene.AddArticulation(d);
+  scene.Step(10);
+  EXPECT_TRUE(art.GetQpos().allFinite());
+}
+
+TEST(UrdfTest, InertiaOnTheTriangleEqualityNeedsNoRepair) {
+  // a thin disc (A + B = C) turned by its origin: rounding alone must not make MuJoCo refuse it
+  UrdfLoader loader;
+  ArticulationDesc d = loader.Parse(
+      Robot("<link name=\"disc\"><inertial><origin rpy=\"0.7 -0.4 1.1\"/><mass value=\"1\"/>"
+            "<inertia ixx=\"0.0025\" iyy=\"0.0025\" izz=\"0.005\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+            "</inertial></link>"),
+      kMeshDir);
+  EXPECT_TRUE(loader.LastReport().Empty()) << loader.LastReport().ToString();
+  const Eigen::Vector3d m = d.links[0].inertial->inertia;
+  EXPECT_NEAR(m[2], 0.005, 1e-12);
+  EXPECT_GE(m[0] + m[1], m[2]);
+  d.fix_root = false;
+  Scene scene;
+  EXPECT_NO_THROW(scene.AddArticulation(d));
+}
+
+TEST(UrdfTest, LimitWithoutLowerOrUpperLeavesTheJointUnlimited) {
+  // ANYmal's joints give effort and velocity only; URDF's defaults 0, 0 would lock them
+  UrdfLoader loader;
+  ArticulationDesc d = loader.Parse(
+      Robot(BoxLink("a") + BoxLink("b") +
+            Joint("HAA", "revolute", "a", "b", "<limit effort=\"80\" velocity=\"20\"/>")),
+      kMeshDir);
+  const JointDesc& j = FindLink(d, "b").joint;
+  EXPECT_EQ(j.lower, -kInf);
+  EXPECT_EQ(j.upper, kInf);
+  EXPECT_DOUBLE_EQ(j.drive.force_limit, 80.0);
+  EXPECT_EQ(CountWarnings(loader.LastReport(), {"joint 'HAA'", "unlimited"}), 1);
+  // one bound given: the other is URDF's default 0
+  d = loader.Parse(
+      Robot(BoxLink("a") + BoxLink("b") + Joint("j", "revolute", "a", "b", "<limit upper=\"1\"/>")),
+      kMeshDir);
+  EXPECT_EQ(FindLink(d, "b").joint.lower, 0.0);
+  EXPECT_TRUE(loader.LastReport().Empty());
+}
+
+TEST(UrdfTest, StrictLoadingTurnsRepairsIntoErrors) {
+  UrdfLoader loader;
+  loader.strict = true;
+  ExpectParseError(Robot(BoxLink("a") + BoxLink("b") + BoxLink("c") +
+                         Joint("j1", "revolute", "a", "b", "<limit lower=\"-1\" upper=\"1\"/>") +
+                         Joint("weld", "fixed", "a", "c", "<mimic joint=\"j1\"/>")),
+                   {"joint 'weld'", "<mimic>", "strict"}, loader);
+  ExpectParseError(Robot("<link name=\"lopsided\"><inertial><mass value=\"1\"/><inertia "
+                         "ixx=\"0.001\" iyy=\"0.001\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>"
+                         "</inertial></link>"),
+                   {"link 'lopsided'", "A + B >= C", "strict"}, loader);
+}
+
+TEST(UrdfErrorTest, AllMissingMeshFilesInOneError) {
+  TempDir dir("missing");
+  std::ofstream(dir / "empty.stl").close();
+  const std::string urdf = Robot(
+      MeshLink("base", "meshes/gone_0.stl") + MeshLink("arm", "package://nowhere/gone_1.obj") +
+      "<link name=\"hand\"><visual><geometry><mesh filename=\"meshes/gone_2.dae\"/></geometry>"
+      "</visual><collision><geometry><mesh filename=\"empty.stl\"/></geometry></collision></link>" +
+      Joint("j1", "fixed", "base", "arm") + Joint("j2", "fixed", "arm", "hand"));
+  try {
+    UrdfLoader().Parse(urdf, dir.str(), "bad.urdf");
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("4 files"), std::string::npos) << msg;
+    for (const char* needle :
+         {"link 'base' <collision>", "meshes/gone_0.stl", "link 'arm' <collision>",
+          "package://nowhere/gone_1.obj", "link 'hand' <visual>", "meshes/gone_2.dae",
+          "link 'hand' <collision>", "'empty.stl' is empty"})
+      EXPECT_NE(msg.find(needle), std::string::npos) << needle << " not in: " << msg;
+  }
+}
+
+TEST(UrdfTest, NonConvexMeshWarnsOncePerFileAndConvexOnesNever) {
+  // an L-shaped bracket (closed, 0.3 m), used by two links; a cube mesh beside it
+  TempDir dir("nonconvex");
+  std::vector<Eigen::Vector3d> v;
+  std::vector<Eigen::Vector3i> f;
+  {
+    // the L's profile in xz, extruded 0.1 m along y
+    const double p[6][2] = {{0, 0}, {0.3, 0}, {0.3, 0.05}, {0.05, 0.05}, {0.05, 0.3}, {0, 0.3}};
+    for (double y : {0.0, 0.1})
+      for (const auto& q : p) v.emplace_back(q[0], y, q[1]);
+    // the two caps (a fan from the inner corner 3 covers the L), then the sides
+    const int fan[4][2] = {{4, 5}, {5, 0}, {0, 1}, {1, 2}};
+    for (const auto& t : fan) {
+      f.emplace_back(3, t[1], t[0]);
+      f.emplace_back(9, t[0] + 6, t[1] + 6);
+    }
+    for (int k = 0; k < 6; ++k) {
+      const int a = k, b = (k + 1) % 6;
+      f.emplace_back(a, b, b + 6);
+      f.emplace_back(a, b + 6, a + 6);
+    }
+  }
+  WriteObj(dir / "bracket.obj", v, f);
+  const std::string urdf = Robot(MeshLink("a", "bracket.obj") + MeshLink("b", "bracket.obj") +
+                                 MeshLink("c", kMeshDir + "/cube.obj") +
+                                 Joint("j1", "fixed", "a", "b") + Joint("j2", "fixed", "a", "c"));
+  UrdfLoader loader;
+  loader.Parse(urdf, dir.str(), "robot.urdf");
+  EXPECT_EQ(CountWarnings(loader.LastReport(), {"not convex"}), 1)
+      << loader.LastReport().ToString();
+  EXPECT_EQ(CountWarnings(loader.LastReport(),
+                          {"link 'a'", "mesh 'bracket.obj'", "load_multiple_collisions_from_file",
+                           "partsim assets decompose"}),
+            1)
+      << loader.LastReport().ToString();
+  EXPECT_EQ(CountWarnings(loader.LastReport(), {"cube.obj"}), 0);
+  // no defect of the file: a warning even when loading strictly
+  loader.strict = true;
+  loader.Parse(urdf, dir.str(), "robot.urdf");
+  EXPECT_EQ(CountWarnings(loader.LastReport(), {"not convex"}), 1);
+  loader.strict = false;
+  // as connected pieces the L is still one non-convex piece: decompose it
+  loader.load_multiple_collisions_from_file = true;
+  loader.Parse(urdf, dir.str(), "robot.urdf");
+  EXPECT_EQ(
+      CountWarnings(loader.LastReport(), {"1 of 1", "not convex", "partsim assets decompose"}), 0);
+  EXPECT_EQ(CountWarnings(loader.LastReport(), {"not convex", "partsim assets decompose"}), 1)
+      << loader.LastReport().ToString();
+  // the boxes of the test data are convex, alone or as pieces
+  for (bool multiple : {false, true}) {
+    loader.load_multiple_collisions_from_file = multiple;
+    // parts.obj holds two boxes apart: as one hull it is not convex, as pieces it is
+    for (const char* mesh : {"cube.obj", "box.stl", "box.gltf", "box_cm.dae", "parts.obj"}) {
+      if (!multiple && std::string(mesh) == "parts.obj") continue;
+      loader.Parse(Robot(MeshLink("a", mesh)), kMeshDir);
+      EXPECT_TRUE(loader.LastReport().Empty()) << mesh << ": " << loader.LastReport().ToString();
+    }
+  }
+}
+
+TEST(UrdfTest, GeneratedObjectsLoadWithoutWarnings) {
+  // the generator's pieces are closed convex meshes: nothing to repair, nothing non-convex,
+  // whether each file is one piece or its connected parts are
+  TempDir dir("generated");
+  const std::vector<std::string> categories = GeneratorCategories();
+  for (size_t k = 0; k < categories.size(); k += 5) {
+    const std::string folder = dir / categories[k];
+    WriteObject(GenerateObject(categories[k], 0, 7), folder);
+    for (bool multiple : {false, true}) {
+      UrdfLoader loader;
+      loader.load_multiple_collisions_from_file = multiple;
+      loader.ParseFile(folder + "/mobility.urdf");
+      EXPECT_TRUE(loader.LastReport().Empty())
+          << categories[k] << ": " << loader.LastReport().ToString();
+    }
+  }
+}
+
 TEST(UrdfTest, ParseFileNamesTheFileInErrors) {
   try {
     UrdfLoader().ParseFile(kDataDir + "/no_such_robot.urdf");
@@ -688,8 +935,9 @@ TEST(UrdfSceneTest, ArmLoadsWithItsDofsAndKinematics) {
   EXPECT_EQ(arm.GetName(), "panda");
   EXPECT_TRUE(arm.HasFixedRoot());
   EXPECT_EQ(arm.GetLinks().size(), 12u);
-  // 7 arm joints and one finger; the mimicking finger has no dof of its own
-  ASSERT_EQ(arm.Dof(), 8);
+  // 7 arm joints and two fingers; the mimicking finger keeps a dof of its own
+  ASSERT_EQ(arm.Dof(), 9);
+  EXPECT_EQ(arm.GetActiveJoints()[8].GetName(), "panda_finger_joint2");
   Eigen::MatrixX2d lim = arm.GetQlimits();
   EXPECT_NEAR(lim(3, 0), -3.0718, 1e-12);
   EXPECT_NEAR(lim(3, 1), -0.0698, 1e-12);
@@ -699,7 +947,7 @@ TEST(UrdfSceneTest, ArmLoadsWithItsDofsAndKinematics) {
   // the scene's forward kinematics agree with the published DH chain
   std::srand(11);
   for (int trial = 0; trial < 5; ++trial) {
-    Eigen::VectorXd q = Eigen::VectorXd::Zero(8);
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(9);
     for (int i = 0; i < 7; ++i) {
       q[i] = lim(i, 0) + (lim(i, 1) - lim(i, 0)) * (0.5 + 0.4 * Eigen::VectorXd::Random(1)[0]);
     }
@@ -728,6 +976,123 @@ TEST(UrdfSceneTest, FloatingWorldJointFallsUnderGravity) {
   const double t = 0.2;
   scene.Step(static_cast<int>(std::lround(t / scene.GetTimestep())));
   EXPECT_NEAR(a.GetRootPose().p.z(), 2.0 - 0.5 * 9.81 * t * t, 0.01);
+}
+
+TEST(UrdfSceneTest, FlatAndTinyCollisionPiecesStillSimulate) {
+  // a 0.2 m square (4 points, no volume) and a speck 10 micrometres across, in one file and as
+  // separate pieces
+  TempDir dir("flat");
+  WriteObj(dir / "quad.obj", {{-0.1, -0.1, 0}, {0.1, -0.1, 0}, {0.1, 0.1, 0}, {-0.1, 0.1, 0}},
+           {{0, 1, 2}, {0, 2, 3}});
+  WriteObj(dir / "speck.obj", {{0, 0, 0}, {1e-5, 0, 0}, {0, 1e-5, 0}, {0, 0, 1e-5}},
+           {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}});
+  for (bool multiple : {false, true}) {
+    Scene scene;
+    scene.AddGround(0.0);
+    UrdfLoader loader = scene.CreateUrdfLoader();
+    loader.fix_root_link = false;
+    loader.load_multiple_collisions_from_file = multiple;
+    Articulation plate = loader.LoadFromString(
+        Robot(MeshLink("plate", "quad.obj") + MeshLink("dust", "speck.obj") +
+              Joint("glue", "fixed", "plate", "dust", "<origin xyz=\"0 0 0.05\"/>")),
+        dir.str());
+    const LoadReport& report = loader.LastReport();
+    EXPECT_EQ(CountWarnings(report, {"link 'plate'", "mesh 'quad.obj'", "flat", "thick"}), 1)
+        << report.ToString();
+    EXPECT_EQ(CountWarnings(report, {"link 'dust'", "mesh 'speck.obj'", "dropped"}), 1)
+        << report.ToString();
+    // the plate keeps a thin hull, the speck is gone
+    EXPECT_EQ(plate.FindLinkByName("plate").GetDesc().collisions.size(), 1u);
+    EXPECT_TRUE(plate.FindLinkByName("dust").GetDesc().collisions.empty());
+    // dropped from 0.2 m beside its twin made of a box as thick as its hull (3% of 0.2 m, at
+    // most 5 mm), the plate comes to rest on the ground at the twin's height
+    const std::string inertial =
+        "<inertial><mass value=\"1\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" "
+        "ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
+    Articulation twin = loader.LoadFromString(
+        Robot("<link name=\"plate\"><collision><geometry><box size=\"0.2 0.2 0.005\"/>"
+              "</geometry></collision>" +
+              inertial + "</link><link name=\"dust\">" + inertial + "</link>" +
+              Joint("glue", "fixed", "plate", "dust", "<origin xyz=\"0 0 0.05\"/>")),
+        dir.str());
+    plate.SetRootPose(Pose(Eigen::Vector3d(0, 0, 0.2)));
+    twin.SetRootPose(Pose(Eigen::Vector3d(1, 0, 0.2)));
+    scene.Step(1000);
+    EXPECT_NEAR(plate.GetRootPose().p.z(), twin.GetRootPose().p.z(), 5e-4);
+    EXPECT_NEAR(plate.GetRootPose().p.z(), 0.0025, 1e-3);
+    EXPECT_LT(plate.GetRootVelocity().norm(), 1e-2);
+  }
+}
+
+TEST(UrdfSceneTest, MimicJointIsADofThatFollowsItsSource) {
+  // a two-finger gripper: the right finger mimics the left
+  const std::string urdf =
+      Robot(BoxLink("palm") + BoxLink("left") + BoxLink("right") +
+            Joint("left_joint", "prismatic", "palm", "left",
+                  "<origin xyz=\"0 0.05 0.1\"/><axis xyz=\"0 1 0\"/>"
+                  "<limit lower=\"0\" upper=\"0.04\" effort=\"50\" velocity=\"1\"/>") +
+            Joint("right_joint", "prismatic", "palm", "right",
+                  "<origin xyz=\"0 -0.05 0.1\"/><axis xyz=\"0 -1 0\"/>"
+                  "<limit lower=\"0\" upper=\"0.04\" effort=\"50\" velocity=\"1\"/>"
+                  "<mimic joint=\"left_joint\" multiplier=\"1\" offset=\"0\"/>"));
+  Scene scene;
+  UrdfLoader loader = scene.CreateUrdfLoader();
+  Articulation g = loader.LoadFromString(urdf, kMeshDir);
+  // dof counts every non-fixed joint, as SAPIEN does
+  ASSERT_EQ(g.Dof(), 2);
+  std::vector<partsim::Joint> active = g.GetActiveJoints();
+  ASSERT_EQ(active.size(), 2u);
+  EXPECT_EQ(active[0].GetName(), "left_joint");
+  EXPECT_EQ(active[1].GetName(), "right_joint");
+  EXPECT_EQ(g.GetQlimits()(1, 1), 0.04);
+  // only the source is driven; gravity pulls both fingers along -z, not along their axes
+  active[0].SetDriveProperty(2000, 100);
+  active[0].SetDriveTarget(0.03);
+  scene.Step(500);  // 1 s
+  Eigen::VectorXd q = g.GetQpos();
+  EXPECT_NEAR(q[0], 0.03, 1e-3);
+  EXPECT_NEAR(q[1], q[0], 1e-3);
+  const double gap =
+      (g.FindLinkByName("left").GetPose().p - g.FindLinkByName("right").GetPose().p).norm();
+  EXPECT_NEAR(gap, 0.1 + 2 * 0.03, 2e-3);
+  // each finger carries its own rows in the dynamics queries
+  EXPECT_EQ(g.ComputeManipulatorInertiaMatrix().rows(), 2);
+  EXPECT_EQ(g.ComputeLinkJacobian(2).cols(), 2);
+}
+
+TEST(UrdfSceneTest, MuJoCoErrorsNameTheUrdfsJoints) {
+  // a revolute joint whose limits coincide: MuJoCo refuses it; the message names the URDF joint
+  Scene scene;
+  UrdfLoader loader = scene.CreateUrdfLoader();
+  loader.LoadFromString(Robot(BoxLink("a")), kMeshDir);  // so the robot is not the first one
+  try {
+    loader.LoadFromString(
+        Robot(BoxLink("base") + BoxLink("lid") +
+              Joint("stuck", "revolute", "base", "lid", "<limit lower=\"0.3\" upper=\"0.3\"/>")),
+        kMeshDir);
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("joint 'stuck'"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("r1_"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("line ="), std::string::npos) << msg;
+  }
+  // an inertia that breaks A + B >= C given directly, past the URDF loader's repair
+  ArticulationDesc d = loader.Parse(
+      Robot(BoxLink("base") + BoxLink("lid") +
+            Joint("hinge", "revolute", "base", "lid", "<limit lower=\"0\" upper=\"1\"/>")),
+      kMeshDir);
+  d.links[1].inertial->inertia = Eigen::Vector3d(0.001, 0.001, 0.01);
+  try {
+    scene.AddArticulation(d);
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("A + B >= C"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("link 'lid'"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("r1_"), std::string::npos) << msg;
+  }
+  EXPECT_EQ(scene.GetArticulations().size(), 1u);
 }
 
 TEST(UrdfSceneTest, ErrorsLeaveTheSceneUsable) {

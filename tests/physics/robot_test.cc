@@ -17,9 +17,9 @@ TEST(RobotTest, ArmHoldsItsPoseUnderGravityWithDrivesOnTheInitialPose) {
   UrdfLoader loader = scene.CreateUrdfLoader();
   loader.fix_root_link = true;
   Articulation arm = loader.Load(kPanda);
-  // 7 arm joints + 1 finger (the second finger follows the first)
-  ASSERT_EQ(arm.Dof(), 8);
-  EXPECT_EQ(arm.FindJointByName("panda_finger_joint2").GetDof(), 0);
+  // 7 arm joints + 2 fingers (the second a dof of its own that follows the first)
+  ASSERT_EQ(arm.Dof(), 9);
+  EXPECT_EQ(arm.FindJointByName("panda_finger_joint2").GetDof(), 1);
   int visuals = 0, meshes = 0;
   for (const Link& l : arm.GetLinks()) {
     visuals += static_cast<int>(l.GetDesc().visuals.size());
@@ -29,8 +29,8 @@ TEST(RobotTest, ArmHoldsItsPoseUnderGravityWithDrivesOnTheInitialPose) {
   EXPECT_GE(visuals, 10);
   EXPECT_GE(meshes, 10);
 
-  Eigen::VectorXd home(8);
-  home << 0.0, -0.4, 0.0, -2.1, 0.0, 1.8, 0.8, 0.03;
+  Eigen::VectorXd home(9);
+  home << 0.0, -0.4, 0.0, -2.1, 0.0, 1.8, 0.8, 0.03, 0.03;
   arm.SetQpos(home);
   std::vector<Joint> joints = arm.GetActiveJoints();
   for (size_t k = 0; k < joints.size(); ++k) {
@@ -43,7 +43,7 @@ TEST(RobotTest, ArmHoldsItsPoseUnderGravityWithDrivesOnTheInitialPose) {
   Pose hand0 = arm.FindLinkByName("panda_hand").GetPose();
   scene.Step(1000);  // 2 s
   Eigen::VectorXd q = arm.GetQpos();
-  for (int k = 0; k < 8; ++k) EXPECT_NEAR(q[k], home[k], 0.02) << "dof " << k;
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR(q[k], home[k], 0.02) << "dof " << k;
   Pose hand = arm.FindLinkByName("panda_hand").GetPose();
   EXPECT_LT((hand.p - hand0.p).norm(), 0.01);
   EXPECT_LT(arm.GetQvel().norm(), 1e-2);
@@ -56,8 +56,8 @@ TEST(RobotTest, ArmHoldsItsPoseUnderGravityWithDrivesOnTheInitialPose) {
 TEST(RobotTest, ArmWithoutDrivesFallsUnderGravity) {
   Scene scene;
   Articulation arm = scene.CreateUrdfLoader().Load(kPanda);
-  Eigen::VectorXd home(8);
-  home << 0.0, -0.4, 0.0, -2.1, 0.0, 1.8, 0.8, 0.03;
+  Eigen::VectorXd home(9);
+  home << 0.0, -0.4, 0.0, -2.1, 0.0, 1.8, 0.8, 0.03, 0.03;
   arm.SetQpos(home);
   scene.Step(250);
   EXPECT_GT((arm.GetQpos() - home).norm(), 0.1);

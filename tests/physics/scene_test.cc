@@ -387,15 +387,22 @@ TEST(SceneTest, MimicCouplingMakesJointFollow) {
   }
   desc.couplings.push_back({"finger_joint1", "finger_joint0", -1.0, 0.04});
   Articulation art = scene.AddArticulation(desc);
-  EXPECT_EQ(art.Dof(), 1);
-  EXPECT_EQ(art.FindJointByName("finger_joint1").GetDof(), 0);
+  // the coupled finger is a dof of its own (as in SAPIEN), with its own drive
+  EXPECT_EQ(art.Dof(), 2);
+  EXPECT_EQ(art.FindJointByName("finger_joint1").GetDof(), 1);
+  EXPECT_EQ(art.GetActiveJoints()[1].GetName(), "finger_joint1");
+  // only the source is driven; the engine makes the other follow
   Joint j0 = art.FindJointByName("finger_joint0");
   j0.SetDriveProperty(1000, 50);
   j0.SetDriveTarget(0.03);
   scene.Step(1000);
   EXPECT_NEAR(art.GetQpos()[0], 0.03, 1e-3);
+  EXPECT_NEAR(art.GetQpos()[1], -1.0 * 0.03 + 0.04, 2e-3);
   double x1 = art.GetLink(2).GetPose().p.x();
   EXPECT_NEAR(x1, -1.0 * 0.03 + 0.04, 2e-3);
+  // set_qpos places the coupled joint from its source, whatever its own entry says
+  art.SetQpos(Eigen::Vector2d(0.01, 0.5));
+  EXPECT_NEAR(art.GetQpos()[1], 0.03, 1e-12);
 }
 
 TEST(SceneTest, BadInputThrowsNamedErrorsAndSceneSurvives) {

@@ -201,6 +201,21 @@ TEST(MotionPlanner, BadRequests) {
   EXPECT_NE(r.message.find("panda_joint4"), std::string::npos) << r.message;
 }
 
+TEST(MotionPlanner, AGoalAHairOutsideALimitIsPulledIn) {
+  // a goal read from a state that rests on a limit (physics holds limits a hair softly)
+  PandaWorld w;
+  MotionPlanner planner(w.arm, w.robot.arm_joints);
+  VectorXd goal = w.start;
+  goal[3] = -0.0698 + 5e-4;  // panda_joint4's upper limit is -0.0698
+  goal[0] = -0.5;
+  PlanResult r = planner.PlanToJoints(goal);
+  EXPECT_TRUE(r.success) << r.message;
+  ASSERT_FALSE(r.path.empty());
+  EXPECT_LE(r.path.back()[3], -0.0698 + 1e-12);
+  goal[3] = -0.0698 + 0.01;  // clearly beyond: refused
+  EXPECT_FALSE(planner.PlanToJoints(goal).success);
+}
+
 TEST(MotionPlanner, OtherAlgorithmsFindAPath) {
   PandaWorld w;
   MotionPlanner planner(w.arm, w.robot.arm_joints);

@@ -123,3 +123,42 @@ def test_builders_from_files(scene, cube_obj):
 def test_loader_without_scene_cannot_load():
     with pytest.raises(partsim.PartsimError, match="no scene"):
         partsim.UrdfLoader().load_from_string(CABINET_URDF, ".")
+
+
+# two fingers, the second mimicking the first, and a fixed joint that carries a <mimic> too
+MIMIC_URDF = """<robot name="gripper">
+  <link name="palm"><collision><geometry><box size="0.1 0.1 0.02"/></geometry></collision></link>
+  <link name="left"><collision><geometry><box size="0.02 0.02 0.06"/></geometry></collision></link>
+  <link name="right"><collision><geometry><box size="0.02 0.02 0.06"/></geometry></collision></link>
+  <link name="tip"/>
+  <joint name="left_joint" type="prismatic"><parent link="palm"/><child link="left"/>
+    <origin xyz="0 0.03 0.05"/><axis xyz="0 1 0"/><limit lower="0" upper="0.04"/></joint>
+  <joint name="right_joint" type="prismatic"><parent link="palm"/><child link="right"/>
+    <origin xyz="0 -0.03 0.05"/><axis xyz="0 -1 0"/><limit lower="0" upper="0.04"/>
+    <mimic joint="left_joint"/></joint>
+  <joint name="tip_joint" type="fixed"><parent link="left"/><child link="tip"/>
+    <mimic joint="left_joint"/></joint>
+</robot>
+"""
+
+
+def test_strict_and_last_report(scene):
+    loader = scene.create_urdf_loader()
+    assert loader.strict is False
+    assert len(loader.last_report()) == 0 and not loader.last_report()
+    art = loader.load_from_string(MIMIC_URDF, ".")
+    # the mimic joint is a dof of its own; the fixed joint's <mimic> is ignored with a warning
+    assert art.dof == 2
+    assert [j.name for j in art.get_active_joints()] == ["left_joint", "right_joint"]
+    report = loader.last_report()
+    assert len(report) == 1
+    w = report.warnings[0]
+    assert w.file == "<string>"
+    assert "joint 'tip_joint'" in w.message and "<mimic>" in w.message
+    assert str(w) == w.file + ": " + w.message
+    assert w.message in str(report)
+    # strict loading refuses what it would otherwise repair, and the scene is left as it was
+    loader.strict = True
+    with pytest.raises(partsim.PartsimError, match="tip_joint.*strict"):
+        loader.load_from_string(MIMIC_URDF, ".")
+    assert len(scene.get_articulations()) == 1

@@ -500,3 +500,29 @@ def test_vector_env_fewer_workers_than_envs():
         assert np.array_equal(ra[0], rb[0]) and np.array_equal(ra[1], rb[1])
     a.close()
     b.close()
+
+
+def test_env_on_a_partnet_mobility_folder(tmp_path):
+    """objects may name PartNet-Mobility folders: the generator's first drawer cabinet, written
+    as one by a task, gives the same targets as its index."""
+    import partsim
+
+    index = partsim.find_task_objects(partsim.TaskType.PULL_DRAWER, 1, 0)[0]
+    o = partsim.TaskOptions()
+    o.object_index, o.asset_dir, o.cameras = index, str(tmp_path), False
+    partsim.ArticulationTask(o)
+    folder = next(p.parent for p in tmp_path.rglob("mobility.urdf"))
+    by_folder = make(objects=[folder])
+    by_index = make(objects=index)
+    try:
+        obs, info = by_folder.reset(seed=SEED)
+        _, info_index = by_index.reset(seed=SEED)
+        assert info["object"] == folder.name
+        assert info["target"] == info_index["target"]
+        obs, reward, terminated, truncated, info = by_folder.step(np.zeros(7, np.float32))
+        assert by_folder.observation_space.contains(obs.astype(np.float32))
+    finally:
+        by_folder.close()
+        by_index.close()
+    with pytest.raises(ValueError, match="not a PartNet-Mobility folder"):
+        make(objects=[str(tmp_path / "nothing")])

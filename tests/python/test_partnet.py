@@ -1,10 +1,12 @@
 """PartNet-Mobility reader and quality checks from Python (the binding surface)."""
 import json
 import math
+import os
 
 import pytest
 
 import partsim
+from conftest import REPO
 
 
 def box_obj(c, h):
@@ -23,7 +25,9 @@ URDF = """<?xml version="1.0"?>
     <visual name="body-1"><geometry><mesh filename="textured_objs/original-1.obj"/></geometry></visual>
     <collision><geometry><mesh filename="textured_objs/original-1.obj"/></geometry></collision>
   </link>
-  <joint name="joint_1" type="fixed"><parent link="base"/><child link="link_1"/></joint>
+  <joint name="joint_1" type="fixed">
+    <origin rpy="1.570796326794897 0 -1.570796326794897"/><parent link="base"/><child link="link_1"/>
+  </joint>
   <link name="link_0">
     <visual name="lid-2"><geometry><mesh filename="textured_objs/original-2.obj"/></geometry></visual>
     <visual name="handle-3"><geometry><mesh filename="textured_objs/original-3.obj"/></geometry></visual>
@@ -38,7 +42,7 @@ URDF = """<?xml version="1.0"?>
 """
 
 
-def write_box(root, semantics_label="lid"):
+def write_box(root, semantics_label="rotation_lid", semantics_kind="hinge"):
     d = root / "Box" / "100"
     (d / "textured_objs").mkdir(parents=True)
     (d / "mobility.urdf").write_text(URDF)
@@ -51,7 +55,9 @@ def write_box(root, semantics_label="lid"):
          "parts": [{"id": 1, "name": "body", "children": []}], "jointData": {}},
     ]
     (d / "mobility_v2.json").write_text(json.dumps(entries))
-    (d / "semantics.txt").write_text("link_0 hinge %s\nlink_1 heavy box_body\n" % semantics_label)
+    (d / "semantics.txt").write_text(
+        "link_0 %s %s\nlink_1 heavy box_body\n" % (semantics_kind, semantics_label)
+    )
     (d / "meta.json").write_text(json.dumps({"model_cat": "Box", "model_id": "100"}))
     (d / "bounding_box.json").write_text(json.dumps({"min": [-0.1, -0.1, -0.1], "max": [0.1, 0.12, 0.1]}))
     # body: a floor (open box would be truer; a slab suffices), lid above it hinged at its back
@@ -66,27 +72,65 @@ def test_reader_gives_labels_axes_and_parts(tmp_path):
     obj = partsim.PartNetMobilityLoader().parse(str(folder))
     assert obj.category == "Box" and obj.model_id == "100"
     lid = obj.link(0)
-    assert lid.joint == "hinge" and lid.semantic_label == "lid"
+    assert lid.joint == "hinge" and lid.semantic_label == "rotation_lid"
+    assert lid.partnet_name == "lid" and lid.semantic_joint == "hinge"
+    assert [p.visuals for p in lid.parts] == [[0], [1]]
     assert lid.limit_a == -100
     assert [p.name for p in lid.parts] == ["lid", "handle"]
     assert obj.part_visuals(0, "handle") == [1]
     desc = obj.articulation.links[obj.link_index(0)]
     # the file's axis is +x with limits [-100, 0] deg; the URDF's is -x with [0, 100] deg
-    assert desc.semantic_label == "lid"
+    assert desc.semantic_label == "rotation_lid" and desc.partnet_name == "lid"
     assert desc.joint.upper == pytest.approx(math.radians(100))
+    assert len(obj.report) == 0 and obj.links_with_label("rotation_lid") == [0]
 
     scene = partsim.Scene()
-    art = scene.create_partnet_mobility_loader().load(str(folder))
+    loader = scene.create_partnet_mobility_loader()
+    art = loader.load(str(folder))
+    assert not loader.last_report()
     assert art.dof == 1
     assert art.get_name() == "Box_100"
+    lid_link = art.find_link_by_name("link_0")
+    assert lid_link.get_semantic_label() == "rotation_lid"
+    assert lid_link.get_partnet_name() == "lid"
+    # standing on a plane at z = 0.5: the body's slab spans 0.2 m about the root
+    partsim.place_on_ground(art, 0.5)
+    assert art.get_root_pose().p[2] == pytest.approx(0.6, abs=1e-6)
 
 
-def test_inconsistent_folder_raises_naming_the_file(tmp_path):
-    folder = write_box(tmp_path, semantics_label="door")
+def test_disagreeing_folder_warns_and_strict_loading_raises(tmp_path):
+    folder = write_box(tmp_path, semantics_kind="slider")
+    loader = partsim.PartNetMobilityLoader()
+    obj = loader.parse(str(folder))
+    report = loader.last_report()
+    assert len(report) == 1 and len(obj.report) == 1
+    warning = report.warnings[0]
+    assert warning.file.endswith("semantics.txt") and "link_0" in warning.message
+    assert "semantics.txt" in str(report)
+    loader.strict = True
     with pytest.raises(partsim.PartsimError, match="semantics.txt"):
-        partsim.PartNetMobilityLoader().parse(str(folder))
+        loader.parse(str(folder))
+    (folder / "mobility_v2.json").write_text("[{")
     batch = partsim.parse_partnet_mobility_batch(str(tmp_path), partsim.PartNetMobilityLoader())
-    assert len(batch) == 1 and not batch[0].ok and "semantics.txt" in batch[0].error
+    assert len(batch) == 1 and not batch[0].ok and "mobility_v2.json" in batch[0].error
+
+
+REAL = os.path.join(REPO, "..", "shared", "realdata", "partnet-mobility-3763")
+
+
+@pytest.mark.skipif(not os.path.isdir(REAL), reason="no ../shared/realdata")
+def test_real_object_loads_with_both_vocabularies():
+    scene = partsim.Scene()
+    loader = scene.create_partnet_mobility_loader()
+    loader.urdf.fix_root_link = False
+    art = loader.load(REAL)
+    assert art.dof == 2
+    lid = art.find_link_by_name("link_0")
+    assert lid.get_semantic_label() == "rotation_lid" and lid.get_partnet_name() == "lid"
+    assert any("continuous" in w.message for w in loader.last_report().warnings)
+    # z-up: the cap slides along the world's vertical
+    axis = art.find_joint_by_name("joint_2").get_global_axis()
+    assert abs(axis[2]) == pytest.approx(1.0, abs=1e-9)
 
 
 def test_quality_checks_report_each_check(tmp_path):

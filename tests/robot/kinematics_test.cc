@@ -76,16 +76,20 @@ TEST(KinematicModel, ForwardKinematicsMatchesKinematicArticulationAndCoupling) {
   b.GetDesc().couplings.push_back({"b", "a", -1.0, 0.0});
   Articulation g = b.BuildKinematic();
   KinematicModel model = KinematicModel::FromArticulation(g);
-  ASSERT_EQ(model.Dof(), 1);
-  Eigen::VectorXd q(1);
-  q << 0.03;
+  // the coupled joint keeps its dof, as in the articulation
+  ASSERT_EQ(model.Dof(), 2);
+  ASSERT_EQ(g.Dof(), 2);
+  // its own entry is ignored: it moves as its source dictates, in both
+  Eigen::VectorXd q(2);
+  q << 0.03, 0.5;
   g.SetQpos(q);
   std::vector<Pose> fk = model.ForwardKinematics(q);
   for (int i = 0; i < 3; ++i) EXPECT_LT((fk[i].p - g.GetLink(i).GetPose().p).norm(), 1e-9);
   EXPECT_NEAR(fk[2].p.x(), -0.03, 1e-12);
-  // the coupled joint's motion lands in its source's Jacobian column
+  // the coupled joint's motion lands in its source's Jacobian column; its own column is zero
   Eigen::MatrixXd J = model.Jacobian(q, 2);
   EXPECT_NEAR(J(0, 0), -1.0, 1e-12);
+  EXPECT_LT(J.col(1).norm(), 1e-12);
 }
 
 TEST(KinematicModel, JacobianMatchesFiniteDifferencesAndScene) {

@@ -98,6 +98,10 @@ class TestClient {
     c_.send(con_->get_handle(), text, websocketpp::frame::opcode::text, ec);
   }
   void Send(const json& j) { Send(j.dump()); }
+  void SendBinary(const std::string& bytes) {
+    websocketpp::lib::error_code ec;
+    c_.send(con_->get_handle(), bytes, websocketpp::frame::opcode::binary, ec);
+  }
   std::vector<json> Messages() {
     std::lock_guard<std::mutex> lock(mutex_);
     return messages_;
@@ -288,6 +292,34 @@ TEST_F(RosbridgeTest, MalformedJsonUnknownOpAndWrongTypesGetErrorsAndServerKeeps
   }
   json unknown = c.WaitMessage([](const json& m) { return m.value("id", "") == "u1"; });
   EXPECT_NE(unknown["msg"].get<std::string>().find("unknown op 'fly'"), std::string::npos);
+  // still serving the same client
+  c.Send(json{{"op", "subscribe"}, {"topic", "/clock"}});
+  EXPECT_TRUE(ClockAdvances(c, 0.05));
+  EXPECT_FALSE(c.Closed());
+}
+
+TEST_F(RosbridgeTest, NonUtf8AndDeeplyNestedMessagesGetErrorsAndServerKeepsRunning) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  // JSON-breaking non-ASCII text: the error quotes part of a UTF-8 sequence
+  c.Send(std::string("[1,2,\xC3\xA9]"));
+  c.Send(std::string("\xC3\xA9"));
+  // a binary frame that is not UTF-8
+  c.SendBinary(std::string("\xFF\xFE{", 3));
+  // nesting 100,000 deep, alone and in a message's id
+  const std::string open(100000, '['), close(100000, ']');
+  c.Send(open + close);
+  c.Send("{\"op\": \"subscribe\", \"topic\": \"/clock\", \"id\": " + open + "1" + close + "}");
+  json deep = c.WaitMessage([](const json& m) {
+    return IsError(m) &&
+           m["msg"].get<std::string>().find("nested deeper than") != std::string::npos;
+  });
+  EXPECT_FALSE(deep.is_null());
+  int malformed = 0;
+  for (const json& m : c.Messages())
+    malformed +=
+        IsError(m) && m["msg"].get<std::string>().find("malformed JSON") != std::string::npos;
+  EXPECT_GE(malformed, 3);
   // still serving the same client
   c.Send(json{{"op", "subscribe"}, {"topic", "/clock"}});
   EXPECT_TRUE(ClockAdvances(c, 0.05));

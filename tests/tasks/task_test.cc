@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <thread>
 
+#include "partsim/assets/generator.h"
 #include "partsim/core/error.h"
 #include "partsim/tasks/tasks.h"
 
@@ -188,6 +191,51 @@ TEST(TaskTest, HeuristicSolverOpensADoorFromItsPointCloud) {
   task.Reset(0);
   SolverResult r = SolveOpenDoor(task);
   EXPECT_TRUE(r.success) << r.stage << ": " << r.message << " progress " << r.progress;
+}
+
+TEST(TaskTest, RunsOnAPartNetMobilityFolderAsOnTheGeneratorsIndex) {
+  // the generator's object written as a dataset folder: same targets, and the solver opens one
+  const int index = FindTaskObjects(TaskType::kPullDrawer, 1).front();
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "partsim_task_folder" / "obj";
+  std::filesystem::remove_all(dir.parent_path());
+  WriteObject(GenerateObject("StorageFurniture", index, 0), dir.string());
+  TaskOptions by_folder = Options(TaskType::kPullDrawer);
+  by_folder.object_folder = dir.string();
+  by_folder.object_index = 12345;  // unused with a folder
+  ArticulationTask a(by_folder);
+  ArticulationTask b(Options(TaskType::kPullDrawer));
+  EXPECT_EQ(a.GetTargetCandidates(), b.GetTargetCandidates());
+  EXPECT_EQ(a.GetTargetLink().GetDesc().semantic_label, "drawer");
+  a.Reset(0);
+  // the cabinet stands on the ground with its front facing +x
+  const Eigen::Vector3d handle = a.GetTargetLink().GetPose().p;
+  EXPECT_GT(handle.x(), 0.0);
+  SolverOptions so;
+  so.use_cameras = false;
+  SolverResult r = SolvePullDrawer(a, so);
+  EXPECT_TRUE(r.success) << r.stage << ": " << r.message << " progress " << r.progress;
+
+  // a folder whose semantics.txt labels no link 'drawer' is refused, naming the folder and the
+  // label (the drawers become trays: the PartNet name in mobility_v2.json does not count)
+  std::filesystem::path no_drawer = dir.parent_path() / "no_drawer";
+  std::filesystem::copy(dir, no_drawer, std::filesystem::copy_options::recursive);
+  {
+    std::ifstream in(no_drawer / "semantics.txt");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (size_t at = text.find(" drawer"); at != std::string::npos; at = text.find(" drawer"))
+      text.replace(at, 7, " translation_tray");
+    std::ofstream(no_drawer / "semantics.txt") << text;
+  }
+  TaskOptions bad = by_folder;
+  bad.object_folder = no_drawer.string();
+  try {
+    ArticulationTask task(bad);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("no_drawer"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'drawer'"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

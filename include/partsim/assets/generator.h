@@ -1,12 +1,14 @@
 // Procedural articulated objects in the 46 categories of the PartNet-Mobility dataset (SAPIEN,
-// Xiang et al. 2020), written as PartNet-Mobility folders (docs/partnet_mobility_format.md).
+// Xiang et al. 2020), written as PartNet-Mobility folders with the real dataset's structure
+// (docs/partnet_mobility_format.md).
 //
-// Objects are built in the files' frame: y up, metres, the object's front facing +z, its base
-// resting on y = 0 (wall-mounted objects such as doors and windows stand on y = 0 too). Every
-// part piece is a closed, outward-facing, convex triangle mesh, so that it is both the visual and
-// the exact collision shape of the piece. Every joint is at rest at q = 0, which lies inside its
-// limits, and moving parts keep a few millimetres of clearance from the rest of the object over
-// their whole range.
+// Objects are built in the raw mesh frame F of the files: y up, metres, the object's front facing
+// +z, its bounding box at rest centred on the origin (mobility.urdf turns F z-up at the joint from
+// "base" to the body, so that the front faces world -x). Every part piece is a closed,
+// outward-facing, convex triangle mesh at least half a millimetre thick, so that it is both the
+// visual and the exact collision shape of the piece. Every joint is at rest at q = 0, which lies
+// inside its limits, and moving parts keep a few millimetres of clearance from the rest of the
+// object over their whole range.
 #pragma once
 
 #include <Eigen/Core>
@@ -28,22 +30,28 @@ struct GeneratedPiece {
   double density = 1000.0;                                 ///< kg/m^3
 };
 
-/// One annotated part of a link ("handle", "door", "drawer", ...), made of convex pieces.
+/// One annotated part of a link ("handle", "door", "drawer_front", ...), made of convex pieces:
+/// a leaf of result.json's part hierarchy.
 struct GeneratedPart {
-  int id = 0;        ///< unique in the object; visuals are named "<name>-<id>"
-  std::string name;  ///< part name
+  int id = 0;        ///< node id in result.json, unique in the object; visuals "<name>-<id>"
+  std::string name;  ///< PartNet part name
   std::vector<GeneratedPiece> pieces;
 };
 
-/// One link_N of the object and the joint that attaches it to its parent.
+/// One link_N of the object and the joint that attaches it to its parent. A link has two names,
+/// as in the real dataset: its semantics.txt label (the movable-part vocabulary of tasks and
+/// benchmarks) and its mobility_v2.json name (the PartNet vocabulary of parts).
 struct GeneratedLink {
   int id = 0;         ///< N of link_N
-  int parent = -1;    ///< id of the parent link, -1 for base
-  std::string joint;  ///< hinge | slider | heavy | static | free
-  std::string name;   ///< semantic label, e.g. "drawer", "rotation_door"
+  int parent = -1;    ///< id of the parent link, -1 for base (the body only)
+  std::string joint;  ///< mobility_v2.json motion: hinge | slider | heavy | static | free
+  /// semantics.txt label, e.g. "drawer", "rotation_door", "rotation_lid", "furniture_body"
+  std::string name;
+  /// mobility_v2.json "name", the PartNet name, e.g. "drawer", "cabinet_door", "lid", "body"
+  std::string partnet_name;
   std::vector<GeneratedPart> parts;
-  Eigen::Vector3d axis_origin = Eigen::Vector3d::Zero();      ///< file frame (m)
-  Eigen::Vector3d axis_direction = Eigen::Vector3d::UnitY();  ///< file frame, unit
+  Eigen::Vector3d axis_origin = Eigen::Vector3d::Zero();      ///< frame F (m)
+  Eigen::Vector3d axis_direction = Eigen::Vector3d::UnitY();  ///< frame F, unit
   double limit_a = 0.0;            ///< lower limit: degrees (hinge) or metres (slider)
   double limit_b = 0.0;            ///< upper limit: degrees (hinge) or metres (slider)
   bool no_limit = false;           ///< continuous hinge
@@ -58,8 +66,13 @@ struct GeneratedLink {
 
 /// One generated object, in memory.
 struct GeneratedObject {
-  std::string category;  ///< e.g. "StorageFurniture"
-  std::string model_id;  ///< folder name, unique per (category, index)
+  std::string category;  ///< meta.json model_cat, e.g. "StorageFurniture"
+  /// meta.json model_id: 32 hexadecimal digits, like the dataset's ShapeNet model ids; depends on
+  /// (category, index, seed)
+  std::string model_id;
+  /// meta.json anno_id and folder name: a number, unique across categories, that depends on
+  /// (category, index) only: 1CCIIII with CC the category's place in the paper's table and IIII
+  /// the index (the dataset's own ids are below 200000)
   std::string anno_id;
   int index = 0;                     ///< index within its category
   std::uint64_t seed = 0;            ///< dataset seed it was generated with
@@ -71,8 +84,9 @@ struct GeneratorOptions {
   std::vector<std::string> categories;  ///< empty: all 46
   int per_category = 1;                 ///< objects per category; <= 0: the paper's #M
   std::uint64_t seed = 0;
-  std::string out_dir;  ///< objects go to <out_dir>/<category>/<model_id>/
-  int jobs = 1;         ///< worker threads, >= 1
+  std::string out_dir;       ///< objects go to <out_dir>/<anno_id>/, the dataset's flat layout
+  bool by_category = false;  ///< <out_dir>/<category>/<anno_id>/ instead
+  int jobs = 1;              ///< worker threads, >= 1
 };
 
 /// Progress of GenerateDataset: objects written so far, of `total`.
@@ -94,9 +108,10 @@ int PaperPartCount(const std::string& category);
 /// Throws partsim::Error naming an unknown category or a negative index.
 GeneratedObject GenerateObject(const std::string& category, int index, std::uint64_t seed);
 
-/// Writes `object` into folder `dir` (created with its parents): mobility.urdf,
-/// mobility_v2.json, semantics.txt, meta.json, bounding_box.json, textured_objs/original-K.obj
-/// and .mtl. Same object, same bytes. Throws partsim::Error naming the file it cannot write.
+/// Writes `object` into folder `dir` (created with its parents), as the dataset holds an object:
+/// mobility.urdf, mobility_v2.json, semantics.txt, meta.json, bounding_box.json, result.json,
+/// result_after_merging.json, textured_objs/original-K.obj and .mtl (one piece per file). Same
+/// object, same bytes. Throws partsim::Error naming the file it cannot write.
 void WriteObject(const GeneratedObject& object, const std::string& dir);
 
 /// Generates and writes the objects of `options` on `options.jobs` threads; calls `progress`

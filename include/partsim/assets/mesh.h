@@ -35,4 +35,33 @@ std::vector<std::shared_ptr<MeshData>> SplitConnectedComponents(const MeshData& 
 std::vector<std::shared_ptr<MeshData>> LoadConvexPieces(
     const std::string& path, const Eigen::Vector3d& scale = Eigen::Vector3d::Ones());
 
+/// What CheckConvexPiece found about a mesh meant to collide as one convex piece (MuJoCo collides
+/// the convex hull of its vertices, and refuses vertices that span no volume).
+struct ConvexPieceCheck {
+  /// The piece to collide with: the input itself; for a flat or line-like input, the convex hull
+  /// of its points pushed out by `thickness` along its thin directions; nullptr when the input is
+  /// dropped (smaller than 0.1 mm across, or no points).
+  std::shared_ptr<const MeshData> piece;
+  /// What was wrong and what was done, "" when the input is kept as it is (e.g. "flat: 4 points
+  /// on one plane, 0.5 m across; given a convex hull 0.001 m thick").
+  std::string repair;
+  double thickness = 0.0;  ///< m, of the thin hull when one was made
+  /// The input clearly differs from its convex hull (see ConvexityOf); false for repaired pieces.
+  bool non_convex = false;
+  /// Volume of the input over its hull's (closed, consistently wound inputs, a few cracks
+  /// allowed), else NaN.
+  double volume_ratio = 0.0;
+  /// Fraction of the input's surface area deeper inside the hull than 5% of its size.
+  double deep_area_fraction = 0.0;
+};
+
+/// Checks a mesh as one convex collision piece (m): fewer than 4 distinct points, all points on
+/// one plane or line (or within 1e-6 of its size of one), or a hull under 1e-13 m^3 make it
+/// degenerate; such a piece gets a thin hull (thickness 3% of its size, between 0.02 mm and 5 mm)
+/// unless it is under 0.1 mm across, when it is dropped. A sound piece is measured for convexity:
+/// a closed, consistently wound surface (a few cracks allowed) is non-convex when it encloses
+/// under 80% of its hull's volume; an open one when over 10% of its area lies deeper inside the
+/// hull than 5% of its size. Boxes, cylinders and other convex shapes never are.
+ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh);
+
 }  // namespace partsim

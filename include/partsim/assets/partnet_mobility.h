@@ -1,33 +1,42 @@
 // PartNet-Mobility objects: a folder with mobility.urdf, mobility_v2.json, semantics.txt,
-// meta.json, bounding_box.json and textured_objs/ (docs/partnet_mobility_format.md).
+// meta.json, textured_objs/ and optionally bounding_box.json, result.json and images/
+// (docs/partnet_mobility_format.md).
 #pragma once
 
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
+#include "partsim/assets/load_report.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/physics/description.h"
 #include "partsim/physics/scene.h"
 
 namespace partsim {
 
-/// One annotated part piece of a link (a visual named "<name>-<id>").
+/// One annotated part piece of a link (visuals named "<name>-<id>").
 struct PartNetPart {
   int id = -1;
-  std::string name;  ///< e.g. "handle"
+  std::string name;          ///< PartNet part name, e.g. "handle"
+  std::vector<int> visuals;  ///< indices in the link's visuals named "*-<id>"
 };
 
-/// One entry of mobility_v2.json: a link's motion, axis, limits and parts.
+/// One link_N: its entry of mobility_v2.json (motion, axis, limits, parts) and its line of
+/// semantics.txt.
 struct PartNetLink {
-  int id = -1;                 ///< N of link_N
-  int parent = -1;             ///< id of the parent link, -1 for base
-  std::string joint;           ///< hinge | slider | free | heavy | static
-  std::string semantic_label;  ///< e.g. "drawer", "rotation_door"
+  int id = -1;        ///< N of link_N
+  int parent = -1;    ///< id of the parent link, -1 for base
+  std::string joint;  ///< mobility_v2.json motion: hinge | slider | free | heavy | static
+  /// semantics.txt label, the movable-part vocabulary ("drawer", "rotation_door",
+  /// "rotation_lid", "furniture_body", ...); the PartNet name when semantics.txt has no line.
+  std::string semantic_label;
+  /// semantics.txt joint kind: hinge | slider | slider+ | free | heavy | static ("" if no line)
+  std::string semantic_joint;
+  std::string partnet_name;  ///< mobility_v2.json "name", the PartNet vocabulary ("cabinet_door")
   std::vector<PartNetPart> parts;
   bool has_axis = false;
-  Eigen::Vector3d axis_origin = Eigen::Vector3d::Zero();      ///< file frame (y-up), m
-  Eigen::Vector3d axis_direction = Eigen::Vector3d::UnitX();  ///< file frame, unit
+  Eigen::Vector3d axis_origin = Eigen::Vector3d::Zero();      ///< file frame F (y-up), m
+  Eigen::Vector3d axis_direction = Eigen::Vector3d::UnitX();  ///< file frame F, unit
   double limit_a = 0.0;  ///< degrees (hinge) or metres (slider), as in the file
   double limit_b = 0.0;
   bool no_limit = false;
@@ -36,15 +45,20 @@ struct PartNetLink {
   double rotation_limit = 0.0;  ///< degrees
 };
 
-/// A parsed object: its articulation (z-up, root "base") and its annotations.
+/// A parsed object: its articulation (mobility.urdf as it is: z-up, root "base") and its
+/// annotations. The annotation files use the raw mesh frame F (y-up), which mobility.urdf turns
+/// z-up at the joint from "base" to the object's body: X_BF is that joint's rotation.
 struct PartNetMobilityObject {
   std::string folder;
-  std::string category;  ///< meta.json model_cat
+  std::string category;  ///< meta.json model_cat ("" when meta.json is missing)
   std::string model_id;
   ArticulationDesc articulation;
-  std::vector<PartNetLink> links;                      ///< mobility_v2.json entries, by id order
-  Eigen::Vector3d bbox_min = Eigen::Vector3d::Zero();  ///< bounding_box.json (file frame)
+  std::vector<PartNetLink> links;  ///< mobility_v2.json entries, by id order
+  Pose X_BF;                       ///< the annotation frame F in the root link "base"
+  /// Bounds at rest in F (bounding_box.json, else computed from the visual meshes), m.
+  Eigen::Vector3d bbox_min = Eigen::Vector3d::Zero();
   Eigen::Vector3d bbox_max = Eigen::Vector3d::Zero();
+  LoadReport report;  ///< what the reader repaired or ignored
 
   /// The entry of link_N; throws if there is none.
   const PartNetLink& Link(int id) const;
@@ -55,25 +69,42 @@ struct PartNetMobilityObject {
   std::vector<int> PartVisuals(int id, const std::string& part_name) const;
   /// The partsim joint type a mobility_v2.json motion maps to.
   static JointType MotionJointType(const PartNetLink& link);
+  /// link_N ids whose semantics label is `label` (e.g. "drawer"), in id order.
+  std::vector<int> LinksWithLabel(const std::string& label) const;
 };
 
-/// Reads PartNet-Mobility folders (SAPIEN's loader of the dataset). The URDF options
+/// Reads PartNet-Mobility folders (SAPIEN's loader of the dataset). mobility.urdf is the
+/// physical truth: the other files give labels and parts, and a disagreement between them that
+/// does not change the physics (labels, names, axes or limits that differ, an optional file
+/// missing) is a warning in LastReport(); with `strict` it is an error. The URDF options
 /// (load_multiple_collisions_from_file, scale, density, material) apply to mobility.urdf; the
 /// root "base" is fixed unless fix_root_link is false.
 class PartNetMobilityLoader {
  public:
   explicit PartNetMobilityLoader(Scene* scene = nullptr) : scene_(scene) {}
 
-  UrdfLoader urdf;  ///< options for mobility.urdf
+  UrdfLoader urdf;      ///< options for mobility.urdf
+  bool strict = false;  ///< cross-file disagreements and missing files become errors (dataset QA)
 
-  /// Reads and cross-checks a folder; throws partsim::Error naming the file and entry at fault.
+  /// Reads and cross-checks a folder; throws partsim::Error naming the file and entry at fault
+  /// for what cannot be read (malformed JSON, missing mobility.urdf, a broken URDF).
   PartNetMobilityObject Parse(const std::string& folder) const;
   /// Parses and adds the articulation to the scene (named "<category>_<model_id>").
   Articulation Load(const std::string& folder);
+  /// Warnings of the last Parse or Load.
+  const LoadReport& LastReport() const { return last_report_; }
 
  private:
   Scene* scene_;
+  mutable LoadReport last_report_;
 };
+
+/// The pose of an articulation's root that makes its geometry stand on the plane z = `altitude`
+/// at the current joint positions: the root's orientation and x, y stay; z moves so that the
+/// lowest point of its collision shapes (visuals when it has none) touches the plane.
+Pose StandingRootPose(const Articulation& articulation, double altitude = 0.0);
+/// Moves the articulation's root to StandingRootPose.
+void PlaceOnGround(Articulation& articulation, double altitude = 0.0);
 
 /// Result of reading one folder of a batch.
 struct PartNetBatchEntry {
@@ -83,7 +114,7 @@ struct PartNetBatchEntry {
   PartNetMobilityObject object;
 };
 
-/// Parses every object folder under `root` (a folder holding mobility_v2.json, at any depth),
+/// Parses every object folder under `root` (a folder holding mobility.urdf, at any depth),
 /// sorted by path; a bad folder is reported in its entry and the rest are still read.
 std::vector<PartNetBatchEntry> ParsePartNetMobilityBatch(const std::string& root,
                                                          const PartNetMobilityLoader& loader);

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "partsim/assets/load_report.h"
 #include "partsim/physics/description.h"
 #include "partsim/physics/scene.h"
 
@@ -20,7 +21,12 @@ struct UrdfLinkOverride {
 /// continuous, prismatic, fixed; `floating` joining the root to the world makes a free root;
 /// `mimic` joints become couplings; `planar` is rejected). Mesh paths may be relative to the file
 /// or use package://NAME/..., resolved through `package_dirs` or by searching the file's parent
-/// folders for a folder NAME.
+/// folders for a folder NAME. What the loader repairs or ignores (a mimic on a fixed joint, an
+/// inertia that breaks the triangle inequality, a flat, line-like or tiny collision piece, a
+/// <limit> without bounds) is a warning in LastReport(); with `strict` those are errors. A mesh
+/// that is not convex, and so collides as its convex hull, is a warning in either case. Every
+/// mesh or texture file that is missing or unreadable is listed in one error. A mimic joint
+/// keeps a dof of its own (see JointCoupling).
 class UrdfLoader {
  public:
   explicit UrdfLoader(Scene* scene = nullptr) : scene_(scene) {}
@@ -33,6 +39,11 @@ class UrdfLoader {
   std::optional<PhysicalMaterial> material;                ///< default material of collision shapes
   std::map<std::string, UrdfLinkOverride> link_overrides;  ///< by link name
   std::map<std::string, std::string> package_dirs;         ///< package name -> folder
+  /// Defects that do not change what the file means become errors instead of warnings.
+  bool strict = false;
+  /// SRDF whose <disable_collisions> pairs apply; "" looks for "<urdf stem>.srdf" beside a URDF
+  /// file.
+  std::string srdf_file;
 
   /// Parses a URDF into a description. `source` names the text in error messages;
   /// `base_dir` resolves relative mesh paths.
@@ -44,8 +55,12 @@ class UrdfLoader {
   Articulation Load(const std::string& path);
   Articulation LoadFromString(const std::string& text, const std::string& base_dir = ".");
 
+  /// Warnings of the last Parse / ParseFile / Load (empty before the first).
+  const LoadReport& LastReport() const { return last_report_; }
+
  private:
   Scene* scene_;
+  mutable LoadReport last_report_;
 };
 
 }  // namespace partsim

@@ -4,10 +4,13 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "partsim/core/pose.h"
@@ -54,6 +57,9 @@ struct CollisionShape {
   std::optional<PhysicalMaterial> material;  ///< unset: the scene's default material
   double density = 1000.0;                   ///< kg/m^3, > 0
   std::string name;
+  /// SAPIEN's collision groups g0..g3: shapes A and B collide when (A.g0 & B.g1 or A.g1 & B.g0)
+  /// and not (A.g2 & B.g2 and A.g3 == B.g3). The default collides with everything.
+  std::array<uint32_t, 4> collision_groups = {1u, 0xFFFFFFFFu, 0u, 0u};
 };
 
 /// Texture and surface parameters for rendering.
@@ -88,6 +94,9 @@ struct Inertial {
 struct BodyDesc {
   std::string name;
   std::string semantic_label;  ///< part label (e.g. "drawer", "handle"), "" if none
+  /// Name of the part in the PartNet hierarchy (mobility_v2.json's "name", e.g. "cabinet_door"),
+  /// "" if none.
+  std::string partnet_name;
   std::vector<CollisionShape> collisions;
   std::vector<VisualShape> visuals;
   std::optional<Inertial> inertial;
@@ -143,8 +152,9 @@ struct LinkDesc : BodyDesc {
   JointDesc joint;
 };
 
-/// A coupled joint (URDF mimic): q[joint] = multiplier * q[source] + offset. The coupled joint is
-/// not a degree of freedom of its own.
+/// A coupled joint (URDF mimic): q[joint] = multiplier * q[source] + offset. The coupled joint
+/// stays a degree of freedom of its own (its own qpos entry and drive), as in SAPIEN; the engine
+/// holds the relation with an equality constraint. A source may not itself be coupled.
 struct JointCoupling {
   std::string joint;
   std::string source;
@@ -160,6 +170,9 @@ struct ArticulationDesc {
   bool kinematic = false;       ///< link poses follow qpos by forward kinematics
   Pose root_pose;               ///< X_WR at creation
   std::vector<JointCoupling> couplings;
+  /// Pairs of link names that never collide with each other (an SRDF's <disable_collisions>,
+  /// Articulation::DisableCollision). Links joined by a joint never collide in any case.
+  std::vector<std::pair<std::string, std::string>> disabled_collisions;
 };
 
 /// Checks a description; throws partsim::Error naming the element at fault. `where` prefixes

@@ -4,7 +4,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +21,7 @@ struct mjData_;
 namespace partsim {
 
 class Scene;
+class Shape;
 class Camera;
 class RenderBackend;
 struct RenderWorld;
@@ -65,6 +69,8 @@ class Actor {
   void AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point);
   /// Adds a world-frame force (N) at the centre of mass and a torque (N m) for the next step.
   void AddForceTorque(const Eigen::Vector3d& force, const Eigen::Vector3d& torque);
+  /// One handle per collision shape, in the order of GetDesc().collisions.
+  std::vector<Shape> GetCollisionShapes() const;
   const ActorDesc& GetDesc() const;
   Scene* GetScene() const { return scene_; }
   bool operator==(const Actor& o) const { return scene_ == o.scene_ && id_ == o.id_; }
@@ -96,12 +102,47 @@ class Link {
   double GetMass() const;                      ///< kg
   Eigen::Vector3d GetInertia() const;          ///< principal moments (kg m^2)
   void AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point);
+  /// One handle per collision shape, in the order of GetDesc().collisions.
+  std::vector<Shape> GetCollisionShapes() const;
   const LinkDesc& GetDesc() const;
   Scene* GetScene() const { return scene_; }
 
  private:
   Scene* scene_ = nullptr;
   int articulation_id_ = -1;
+  int index_ = -1;
+};
+
+/// Handle to one collision shape of an actor or a link (SAPIEN's CollisionShape); its
+/// description is GetDesc().
+class Shape {
+ public:
+  Shape() = default;
+  /// Shape `index` of an actor (articulation_id < 0) or of link `link_index` of an articulation.
+  Shape(Scene* scene, int actor_id, int articulation_id, int link_index, int index)
+      : scene_(scene),
+        actor_id_(actor_id),
+        articulation_id_(articulation_id),
+        link_index_(link_index),
+        index_(index) {}
+
+  /// Index in the body's collisions.
+  int GetIndex() const { return index_; }
+  /// The actor or link the shape belongs to (the other one is an empty handle).
+  Actor GetActor() const;
+  Link GetLink() const;
+  const CollisionShape& GetDesc() const;
+  /// SAPIEN's collision groups g0..g3 (see CollisionShape::collision_groups).
+  std::array<uint32_t, 4> GetCollisionGroups() const;
+  /// Changes the groups; the state of the scene is kept.
+  void SetCollisionGroups(const std::array<uint32_t, 4>& groups);
+
+ private:
+  CollisionShape& Desc() const;
+  Scene* scene_ = nullptr;
+  int actor_id_ = -1;
+  int articulation_id_ = -1;
+  int link_index_ = -1;
   int index_ = -1;
 };
 
@@ -115,7 +156,8 @@ class Joint {
   const std::string& GetName() const;
   JointType GetType() const;
   int GetIndex() const { return index_; }
-  /// Degrees of freedom of this joint (0 or 1; a joint coupled to another has 0).
+  /// Degrees of freedom of this joint: 0 when fixed, else 1 (a coupled joint, URDF mimic,
+  /// included).
   int GetDof() const;
   /// Index of this joint's dof in the articulation's qpos, -1 if it has none.
   int GetDofIndex() const;
@@ -182,8 +224,14 @@ class Articulation {
   Joint FindJointByName(const std::string& name) const;
 
   Eigen::VectorXd GetQpos() const;
+  /// Sets joint positions (dof). A coupled joint (JointCoupling, URDF mimic) is a dof of its own
+  /// that an equality constraint holds to its source: its entry is replaced by multiplier *
+  /// qpos[source] + offset, so the coupling holds from the start whatever the entry was, and
+  /// GetQpos returns the replaced value.
   void SetQpos(const Eigen::VectorXd& qpos);
   Eigen::VectorXd GetQvel() const;
+  /// Sets joint velocities (dof); a coupled joint's entry is replaced by multiplier *
+  /// qvel[source], as in SetQpos.
   void SetQvel(const Eigen::VectorXd& qvel);
   /// Joint accelerations of the last step (m/s^2 or rad/s^2).
   Eigen::VectorXd GetQacc() const;
@@ -226,6 +274,10 @@ class Articulation {
   Eigen::MatrixXd ComputeLinkJacobian(int index) const;
   /// Stacked link Jacobians, 6 nlinks x dof.
   Eigen::MatrixXd ComputeWorldCartesianJacobian() const;
+
+  /// Two links of this articulation never collide with each other from now on (links joined by
+  /// a joint never do in any case); the state of the scene is kept.
+  void DisableCollision(const Link& a, const Link& b);
 
   const ArticulationDesc& GetDesc() const;
   Scene* GetScene() const { return scene_; }
@@ -389,7 +441,9 @@ class BodyBuilder {
   Derived& AddCylinderCollision(const Pose& pose, double radius, double half_length,
                                 const std::optional<PhysicalMaterial>& material = {},
                                 double density = 1000.0);
-  /// Convex hull of a mesh file's vertices (scaled).
+  /// Convex hull of a mesh file's vertices (scaled). Pieces MuJoCo cannot collide with (flat,
+  /// line-like, under 0.1 mm: CheckConvexPiece) get a thin hull or are dropped, and a non-convex
+  /// file is warned about once (partsim::LogWarning); the same holds for the adders below.
   Derived& AddConvexCollisionFromFile(const std::string& filename, const Pose& pose = Pose(),
                                       const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
                                       const std::optional<PhysicalMaterial>& material = {},
@@ -423,10 +477,18 @@ class BodyBuilder {
   /// Explicit mass (kg), centre-of-mass pose in the body and principal inertia (kg m^2).
   Derived& SetMassAndInertia(double mass, const Pose& cmass_local_pose,
                              const Eigen::Vector3d& inertia);
+  /// SAPIEN's collision groups g0..g3 (see CollisionShape::collision_groups) for every collision
+  /// shape of the body, those added before and after this call.
+  Derived& SetCollisionGroups(const std::array<uint32_t, 4>& groups);
+
+ protected:
+  /// Gives the shapes of `body` the groups of SetCollisionGroups, if it was called.
+  void ApplyCollisionGroups(BodyDesc& body) const;
 
  private:
   BodyDesc& body() { return static_cast<Derived*>(this)->Body(); }
   Derived& self() { return *static_cast<Derived*>(this); }
+  std::optional<std::array<uint32_t, 4>> collision_groups_;
 };
 
 /// Builds an actor piece by piece (SAPIEN's ActorBuilder).
@@ -461,6 +523,7 @@ class LinkBuilder : public BodyBuilder<LinkBuilder> {
   BodyDesc& Body();
 
  private:
+  friend class ArticulationBuilder;
   LinkDesc& link();
   ArticulationBuilder* owner_;
   int index_;
@@ -487,6 +550,8 @@ class ArticulationBuilder {
 
  private:
   friend class LinkBuilder;
+  /// The description Build adds: links and joints named, link builders' groups applied.
+  ArticulationDesc Finished() const;
   Scene* scene_;
   ArticulationDesc desc_;
   std::vector<std::unique_ptr<LinkBuilder>> link_builders_;

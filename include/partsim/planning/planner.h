@@ -17,7 +17,9 @@ namespace partsim {
 
 /// Settings of one planning request.
 struct PlannerOptions {
-  double time_limit = 2.0;   ///< s of planning (OMPL solve); simplification gets up to 1 s more
+  /// s of planning (OMPL solve); simplification gets up to 1 s more. A path whose timed
+  /// trajectory leaves the free space is planned again, within this limit (twice at least).
+  double time_limit = 2.0;
   double resolution = 0.01;  ///< rad or m: largest joint step between two checked states
   double clearance = 0.005;  ///< m: the arm keeps at least this far from the rest of the scene
   unsigned seed = 0;         ///< seed of the IK restarts of PlanToPose

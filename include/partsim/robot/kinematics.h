@@ -15,7 +15,10 @@
 namespace partsim {
 
 /// Forward kinematics and Jacobians of a fixed- or free-rooted articulation (the free root is
-/// held at `root_pose`). Coupled joints (JointCoupling) follow their source joint.
+/// held at `root_pose`). A coupled joint (JointCoupling) has its dof, as in Articulation, but
+/// moves as its source dictates (multiplier * q[source] + offset), as Articulation::SetQpos
+/// places it: its own entry of q is ignored, its Jacobian column is zero, and its motion adds to
+/// its source's column.
 class KinematicModel {
  public:
   explicit KinematicModel(const ArticulationDesc& articulation);

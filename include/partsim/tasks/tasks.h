@@ -1,5 +1,6 @@
 // The SAPIEN paper's two interaction tasks, drawer pulling and door opening, on generated
-// StorageFurniture cabinets with the flying gripper; and the heuristic solvers of the paper.
+// StorageFurniture cabinets or on PartNet-Mobility folders (real or generated) with the flying
+// gripper; and the heuristic solvers of the paper.
 //
 // World layout: the cabinet stands with its base on z = 0 and its front facing +x, centred on
 // the origin; the gripper starts in front of it (x > 0); three cameras look at the cabinet from
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "partsim/assets/partnet_mobility.h"
 #include "partsim/core/pose.h"
 #include "partsim/physics/scene.h"
 #include "partsim/render/camera.h"
@@ -24,11 +26,17 @@ const char* TaskTypeName(TaskType t);  ///< "drawer" or "door"
 /// "drawer" or "door"; throws partsim::Error naming anything else.
 TaskType ParseTaskType(const std::string& name);
 
+/// The semantics.txt label of the task's target parts: "drawer" or "rotation_door".
+const char* TaskTargetLabel(TaskType t);
+
 /// Settings of a task.
 struct TaskOptions {
   TaskType type = TaskType::kPullDrawer;
   int object_index = 0;            ///< index of the StorageFurniture object in the generator
   std::uint64_t dataset_seed = 0;  ///< generator seed
+  /// A PartNet-Mobility folder (real or generated) to use instead of the generator's object;
+  /// "" uses object_index and dataset_seed.
+  std::string object_folder;
   int target = -1;  ///< which drawer (door) of the object, in link order; -1: drawn by Reset's seed
   std::string asset_dir;  ///< where the object's folder is written; "" = <tmp>/partsim-assets
   bool cameras = true;    ///< add the left, right and front cameras
@@ -45,6 +53,11 @@ struct TaskOptions {
 /// Candidate objects: the first `count` StorageFurniture indices (from 0) whose object has at
 /// least one drawer (door) with a handle.
 std::vector<int> FindTaskObjects(TaskType type, int count, std::uint64_t dataset_seed = 0);
+
+/// The task's targets in a PartNet-Mobility object: ids N of the links link_N whose semantics
+/// label is TaskTargetLabel(type), that move along a joint with a finite range and that carry a
+/// handle (a part or visual named "handle"), in id order. TaskOptions::target indexes this list.
+std::vector<int> FindTaskTargets(const PartNetMobilityObject& object, TaskType type);
 
 /// A door-opening or drawer-pulling episode: scene, cabinet, flying gripper, cameras.
 ///

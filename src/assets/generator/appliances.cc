@@ -716,7 +716,7 @@ void BuildDispenser(ObjectBuilder& b, Rng& rng) {
   }
   // the pump head rests locked down and lifts (and turns) to unlock
   double travel = 0.012;
-  int pump = b.ScrewSlider(parent, "lid", V3(0, y0 + kGap, 0), V3::UnitY(), 0, travel);
+  int pump = b.ScrewSlider(parent, "pump", V3(0, y0 + kGap, 0), V3::UnitY(), 0, travel);
   int pp = b.Part(pump, "pump_head");
   double py = y0 + kGap;
   b.Add(pp, Cylinder(FrameZ(V3(0, py, 0), V3::UnitY()), 0.006, 0.0, 0.03, 12), dark);

@@ -62,4 +62,11 @@ void BuildPliers(ObjectBuilder& b, Rng& rng);
 void BuildScissors(ObjectBuilder& b, Rng& rng);
 void BuildStapler(ObjectBuilder& b, Rng& rng);
 
+// labels.cc
+/// Turns each link's builder key (GeneratedLink::name as the builders set it: "door", "lid",
+/// "knob", ...) into its semantics.txt label and its mobility_v2.json PartNet name, from the
+/// category's tables; the body (the link joined to base) gets the category's body label. Throws
+/// partsim::Error naming a (category, key) that has no entry.
+void ApplyLabels(GeneratedObject* object);
+
 }  // namespace partsim::internal::gen

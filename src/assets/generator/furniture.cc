@@ -697,7 +697,7 @@ void BuildSafe(ObjectBuilder& b, Rng& rng) {
   if (!keypad) Knob(b, door, V3(cx, h * 0.62, zf), V3::UnitZ(), 0.035, 0.025, 0, steel, "knob");
   // handle: a turning lever
   V3 hc(cx, h * 0.3, zf);
-  int handle = b.Hinge(door, "knob", hc, V3::UnitZ(), 0, 90);
+  int handle = b.Hinge(door, "handle", hc, V3::UnitZ(), 0, 90);
   int hp = b.Part(handle, "handle");
   b.Add(hp, Cylinder(FrameZ(hc, V3::UnitZ()), 0.015, 0.002, 0.045, 20), steel);
   b.Add(hp, Rod(hc + V3(-0.06, 0, 0.045), hc + V3(0.06, 0, 0.045), 0.008), steel);

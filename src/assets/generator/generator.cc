@@ -103,6 +103,49 @@ std::uint64_t ObjectSeed(std::uint64_t seed, const std::string& category, int in
   return x ^ (x >> 29);
 }
 
+/// A 32-digit hexadecimal model id from the object's seed, like the dataset's ShapeNet ids.
+std::string ModelId(std::uint64_t object_seed) {
+  std::uint64_t a = object_seed * 0xd1b54a32d192ed03ULL + 0x8bb84b93962eacc9ULL;
+  a = (a ^ (a >> 32)) * 0x9e3779b97f4a7c15ULL;
+  std::uint64_t b = (a ^ (a >> 29)) * 0xbf58476d1ce4e5b9ULL;
+  char buf[33];
+  std::snprintf(buf, sizeof(buf), "%016llx%016llx", static_cast<unsigned long long>(a ^ (a >> 31)),
+                static_cast<unsigned long long>(b ^ (b >> 31)));
+  return buf;
+}
+
+/// Moves the object so that its bounding box at rest is centred on the origin of frame F, as the
+/// dataset's objects are (the shift rounded to 0.1 mm, like the generator's other positions).
+void CentreOnBoundingBox(GeneratedObject* o) {
+  V3 lo = V3::Constant(1e30), hi = V3::Constant(-1e30);
+  for (const GeneratedLink& l : o->links)
+    for (const GeneratedPart& part : l.parts)
+      for (const GeneratedPiece& piece : part.pieces)
+        for (const V3& v : piece.vertices) {
+          lo = lo.cwiseMin(v);
+          hi = hi.cwiseMax(v);
+        }
+  if (lo.x() > hi.x()) return;
+  const V3 c = Q(V3(0.5 * (lo + hi)));
+  for (GeneratedLink& l : o->links) {
+    l.axis_origin -= c;
+    for (GeneratedPart& part : l.parts)
+      for (GeneratedPiece& piece : part.pieces)
+        for (V3& v : piece.vertices) v -= c;
+  }
+}
+
+/// Numbers the parts as the leaves of result.json's hierarchy, in pre-order: the object is
+/// node 0; a link with several parts is a node whose children are its parts, a link with one
+/// part contributes that part alone.
+void NumberPartNodes(GeneratedObject* o) {
+  int next = 1;
+  for (GeneratedLink& l : o->links) {
+    if (l.parts.size() > 1) ++next;  // the link's node
+    for (GeneratedPart& part : l.parts) part.id = next++;
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> GeneratorCategories() {
@@ -123,14 +166,17 @@ GeneratedObject GenerateObject(const std::string& category, int index, std::uint
   out.category = info.name;
   out.index = index;
   out.seed = seed;
-  // ids: 1CCIIII with CC the category's place in the table and IIII the index
-  int id = 1000000 + CategoryIndex(category) * 10000 + index;
-  out.model_id = std::to_string(id);
-  out.anno_id = std::to_string(id);
-  Rng rng(ObjectSeed(seed, category, index));
+  // anno_id: 1CCIIII with CC the category's place in the table and IIII the index
+  const std::uint64_t object_seed = ObjectSeed(seed, category, index);
+  out.anno_id = std::to_string(1000000 + CategoryIndex(category) * 10000 + index);
+  out.model_id = ModelId(object_seed);
+  Rng rng(object_seed);
   ObjectBuilder b(&out);
   info.build(b, rng);
   b.Finalize();
+  ApplyLabels(&out);
+  CentreOnBoundingBox(&out);
+  NumberPartNodes(&out);
   return out;
 }
 
@@ -159,7 +205,9 @@ int GenerateDataset(const GeneratorOptions& options, const GeneratorProgress& pr
       }
       try {
         GeneratedObject o = GenerateObject(work[i].first, work[i].second, options.seed);
-        WriteObject(o, (std::filesystem::path(options.out_dir) / o.category / o.model_id).string());
+        std::filesystem::path dir(options.out_dir);
+        if (options.by_category) dir /= o.category;
+        WriteObject(o, (dir / o.anno_id).string());
         std::lock_guard<std::mutex> lock(mutex);
         ++done;
         if (progress) progress(done, total, o);

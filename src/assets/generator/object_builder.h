@@ -65,7 +65,9 @@ Material Paint(Rng& rng);         ///< painted metal sheet colours, 7800 kg/m^3
 /// Clearance between a moving part and anything else (m).
 constexpr double kGap = 0.003;
 
-/// Builds a GeneratedObject: links with their joints, parts and convex pieces.
+/// Builds a GeneratedObject: links with their joints, parts and convex pieces. Links are named
+/// with a key ("door", "lid", "knob", ...: the `label` arguments below), which ApplyLabels
+/// (labels.cc) turns into the link's semantics label and PartNet name once the object is built.
 class ObjectBuilder {
  public:
   explicit ObjectBuilder(GeneratedObject* out) : out_(out) {}

@@ -45,9 +45,10 @@ void BuildBottle(ObjectBuilder& b, Rng& rng) {
         glassy);
   b.Add(bp, Cylinder(fy, nr, h - 0.021, h, 32), glassy);
   if (rng.P(0.75)) {
-    // screw cap: lifts and turns
+    // screw cap that lifts and turns, or a push-on cap that only lifts
     double ch = rng.U(0.015, 0.03);
-    int lid = b.ScrewSlider(body, "translation_lid", V3(0, h + kGap, 0), V3::UnitY(), 0, 0.03);
+    int lid = rng.P(0.7) ? b.ScrewSlider(body, "lid", V3(0, h + kGap, 0), V3::UnitY(), 0, 0.03)
+                         : b.Slider(body, "lid", V3(0, h + kGap, 0), V3::UnitY(), 0, 0.03);
     b.AddPart(lid, "lid",
               Loft(Circle(1.0, 32),
                    {Ring{0.0, nr + 0.002}, Ring{ch - 0.003, nr + 0.002}, Ring{ch, nr - 0.001}},
@@ -58,7 +59,7 @@ void BuildBottle(ObjectBuilder& b, Rng& rng) {
     // flip-top lid hinged at the back of the neck
     double ch = 0.015;
     V3 o(0, h + kGap, -(nr + 0.002));
-    int lid = b.Hinge(body, "rotation_lid", o, -V3::UnitX(), 0, 150);
+    int lid = b.Hinge(body, "lid", o, -V3::UnitX(), 0, 150);
     b.AddPart(
         lid, "lid",
         Loft(Circle(1.0, 32), {Ring{0.0, nr + 0.002}, Ring{ch - 0.003, nr + 0.002}, Ring{ch, nr}},

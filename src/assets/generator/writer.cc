@@ -1,5 +1,6 @@
-// Writes a GeneratedObject as a PartNet-Mobility folder (docs/partnet_mobility_format.md).
-// Numbers have fixed formats so that the same object always gives the same bytes.
+// Writes a GeneratedObject as a PartNet-Mobility folder with the real dataset's structure
+// (docs/partnet_mobility_format.md). Numbers have fixed formats so that the same object always
+// gives the same bytes.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -61,12 +62,15 @@ void WriteFile(const std::filesystem::path& path, const std::string& text) {
 }
 
 /// Frame origin of each link in the file frame: the joint axis origin for moving links, the
-/// parent's origin for fixed ones.
+/// parent's origin for fixed ones; rounded to the micrometre the files print, so that joint
+/// offsets (differences of origins) and visual offsets add up exactly down a chain.
 std::vector<V3> LinkOrigins(const GeneratedObject& o) {
   std::vector<V3> origin(o.links.size(), V3::Zero());
   for (const GeneratedLink& l : o.links) {
     bool moving = l.joint == "hinge" || l.joint == "slider";
-    origin[l.id] = moving ? l.axis_origin : (l.parent >= 0 ? origin[l.parent] : V3::Zero());
+    V3 p = moving ? l.axis_origin : (l.parent >= 0 ? origin[l.parent] : V3::Zero());
+    for (int k = 0; k < 3; ++k) p[k] = std::round(p[k] * 1e6) / 1e6;
+    origin[l.id] = p;
   }
   return origin;
 }
@@ -158,60 +162,93 @@ std::string DynamicsXml(double damping, double friction) {
   return "    <dynamics damping=\"" + G9(damping) + "\" friction=\"" + G9(friction) + "\"/>\n";
 }
 
+// The rotation of the joint from "base" to the body, as the dataset writes it: it turns the raw
+// mesh frame F (y up, front +z) z-up, with the front facing -x.
+constexpr char kRootRpy[] = "1.570796326794897 0 -1.570796326794897";
+
+/// R_BF of kRootRpy: URDF rpy is R = Rz(yaw) Ry(pitch) Rx(roll).
+M3 RootRotation() {
+  const double h = kPi / 2;
+  M3 rx, rz;
+  rx << 1, 0, 0, 0, std::cos(h), -std::sin(h), 0, std::sin(h), std::cos(h);
+  rz << std::cos(-h), -std::sin(-h), 0, std::sin(-h), std::cos(-h), 0, 0, 0, 1;
+  return rz * rx;
+}
+
+bool Moving(const GeneratedLink& l) { return l.joint == "hinge" || l.joint == "slider"; }
+
+std::string LinkName(int id) { return "link_" + std::to_string(id); }
+
+/// Joint element: name, type, origin (xyz in the parent link's frame; rpy only at the root),
+/// parent, child and the rest (axis, limit, dynamics), already formatted.
+std::string JointXml(const std::string& name, const std::string& type, const V3& xyz,
+                     const char* rpy, const std::string& parent, const std::string& child,
+                     const std::string& rest) {
+  std::string s = "  <joint name=\"" + name + "\" type=\"" + type + "\">\n";
+  s += std::string("    <origin xyz=\"") + Vec6(xyz) + "\"" +
+       (rpy ? std::string(" rpy=\"") + rpy + "\"" : std::string()) + "/>\n";
+  s += "    <parent link=\"" + parent + "\"/>\n    <child link=\"" + child + "\"/>\n";
+  return s + rest + "  </joint>\n";
+}
+
+/// mobility.urdf as the dataset writes it: "base" (empty) joined to the body by a fixed joint
+/// that turns F z-up; below it everything in F, each moving link's frame at its axis origin
+/// (joint origins relative to the parent link's frame, visuals and collisions offset back); a
+/// slider that also turns hangs from link_N_helper. Joint joint_N has child link_N; the helpers'
+/// prismatic joints are numbered after the last link. partsim adds <inertial> and <dynamics>,
+/// which the dataset's files lack.
 std::string UrdfText(const GeneratedObject& o, const std::vector<std::vector<int>>& files) {
   std::vector<V3> origin = LinkOrigins(o);
-  std::string s = "<?xml version=\"1.0\"?>\n<robot name=\"" + o.model_id + "\">\n";
+  std::string s = "<?xml version=\"1.0\"?>\n<robot name=\"partnet_" + o.model_id + "\">\n";
   s += "  <link name=\"base\"/>\n";
   for (const GeneratedLink& l : o.links) {
-    const std::string name = "link_" + std::to_string(l.id);
-    // a rotating slider gets a helper link for its translation
-    if (l.rotates) {
-      s += "  <link name=\"" + name + "_helper\">\n" + InertialXml(GeneratedLink(), origin[l.id]) +
-           "  </link>\n";
-    }
-    s += "  <link name=\"" + name + "\">\n";
-    s += InertialXml(l, origin[l.id]);
+    // visuals: one per piece, named after its part; then the same files as collisions
+    std::string org = "      <origin xyz=\"" + Vec6(-origin[l.id]) + "\"/>\n";
+    std::string visuals, collisions;
     size_t k = 0;
     for (const GeneratedPart& part : l.parts) {
       for (size_t i = 0; i < part.pieces.size(); ++i, ++k) {
-        std::string file = "textured_objs/original-" + std::to_string(files[l.id][k]) + ".obj";
-        std::string org = "      <origin xyz=\"" + Vec6(-origin[l.id]) + "\" rpy=\"0 0 0\"/>\n";
-        std::string geo =
-            "      <geometry>\n        <mesh filename=\"" + file + "\"/>\n      </geometry>\n";
-        s += "    <visual name=\"" + part.name + "-" + std::to_string(part.id) + "\">\n" + org +
-             geo + "    </visual>\n";
-        s += "    <collision>\n" + org + geo + "    </collision>\n";
+        std::string geo = "      <geometry>\n        <mesh filename=\"textured_objs/original-" +
+                          std::to_string(files[l.id][k]) + ".obj\"/>\n      </geometry>\n";
+        visuals += "    <visual name=\"" + part.name + "-" + std::to_string(part.id) + "\">\n" +
+                   org + geo + "    </visual>\n";
+        collisions += "    <collision>\n" + org + geo + "    </collision>\n";
       }
     }
-    s += "  </link>\n";
-  }
-  for (const GeneratedLink& l : o.links) {
-    const std::string name = "link_" + std::to_string(l.id);
-    const std::string parent = l.parent < 0 ? "base" : "link_" + std::to_string(l.parent);
-    V3 parent_origin = l.parent < 0 ? V3::Zero() : origin[l.parent];
-    V3 xyz = origin[l.id] - parent_origin;
-    const std::string axis = "    <axis xyz=\"" + Vec6(l.axis_direction) + "\"/>\n";
-    s +=
-        "  <joint name=\"joint_" + std::to_string(l.id) + "\" type=\"" + JointTypeUrdf(l) + "\">\n";
-    s += "    <origin xyz=\"" + Vec6(xyz) + "\" rpy=\"0 0 0\"/>\n";
-    s += "    <parent link=\"" + parent + "\"/>\n";
-    s += "    <child link=\"" + name + (l.rotates ? "_helper" : "") + "\"/>\n";
-    if (l.joint == "hinge" || l.joint == "slider") {
-      s += axis;
-      if (!l.no_limit) s += LimitXml(l, false);
-      s += DynamicsXml(l.damping, l.friction);
-    }
-    s += "  </joint>\n";
+    s += "  <link name=\"" + LinkName(l.id) + "\">\n" + InertialXml(l, origin[l.id]) + visuals +
+         collisions + "  </link>\n";
     if (l.rotates) {
-      s += "  <joint name=\"joint_" + std::to_string(l.id) + "_rot\" type=\"" +
-           std::string(l.no_rotation_limit ? "continuous" : "revolute") + "\">\n";
-      s += "    <origin xyz=\"0.000000 0.000000 0.000000\" rpy=\"0 0 0\"/>\n";
-      s += "    <parent link=\"" + name + "_helper\"/>\n    <child link=\"" + name + "\"/>\n";
-      s += axis;
-      if (!l.no_rotation_limit) s += LimitXml(l, true);
-      s += DynamicsXml(l.rotation_damping, l.rotation_friction);
-      s += "  </joint>\n";
+      s += "  <link name=\"" + LinkName(l.id) + "_helper\">\n" +
+           InertialXml(GeneratedLink(), origin[l.id]) + "  </link>\n";
     }
+  }
+  const M3 R_BF = RootRotation();
+  int helper_joint = static_cast<int>(o.links.size());
+  for (const GeneratedLink& l : o.links) {
+    const std::string name = LinkName(l.id);
+    const std::string parent = l.parent < 0 ? "base" : LinkName(l.parent);
+    // the joint frame in the parent link: at the root, turned z-up
+    const V3 xyz = l.parent < 0 ? V3(R_BF * origin[l.id]) : V3(origin[l.id] - origin[l.parent]);
+    const char* rpy = l.parent < 0 ? kRootRpy : nullptr;
+    const std::string joint = "joint_" + std::to_string(l.id);
+    if (!Moving(l)) {
+      s += JointXml(joint, "fixed", xyz, rpy, parent, name, "");
+      continue;
+    }
+    const std::string axis = "    <axis xyz=\"" + Vec6(l.axis_direction) + "\"/>\n";
+    std::string motion =
+        axis + (l.no_limit ? "" : LimitXml(l, false)) + DynamicsXml(l.damping, l.friction);
+    if (!l.rotates) {
+      s += JointXml(joint, JointTypeUrdf(l), xyz, rpy, parent, name, motion);
+      continue;
+    }
+    // a slider that also turns: the slide to the helper, then the turn about the same axis
+    s += JointXml(joint, l.no_rotation_limit ? "continuous" : "revolute", V3::Zero(), nullptr,
+                  name + "_helper", name,
+                  axis + (l.no_rotation_limit ? "" : LimitXml(l, true)) +
+                      DynamicsXml(l.rotation_damping, l.rotation_friction));
+    s += JointXml("joint_" + std::to_string(helper_joint++), "prismatic", xyz, rpy, parent,
+                  name + "_helper", motion);
   }
   s += "</robot>\n";
   return s;
@@ -225,7 +262,7 @@ std::string MobilityText(const GeneratedObject& o) {
     const GeneratedLink& l = o.links[i];
     s += "  {\n    \"id\": " + std::to_string(l.id) +
          ",\n    \"parent\": " + std::to_string(l.parent) + ",\n    \"joint\": \"" + l.joint +
-         "\",\n    \"name\": \"" + l.name + "\",\n    \"parts\": [";
+         "\",\n    \"name\": \"" + l.partnet_name + "\",\n    \"parts\": [";
     for (size_t p = 0; p < l.parts.size(); ++p) {
       s += (p ? ", " : "") + std::string("{\"id\": ") + std::to_string(l.parts[p].id) +
            ", \"name\": \"" + l.parts[p].name + "\", \"children\": []}";
@@ -249,6 +286,121 @@ std::string MobilityText(const GeneratedObject& o) {
   }
   s += "]\n";
   return s;
+}
+
+/// "StorageFurniture" -> "storage_furniture" (PartNet's object names); "USB" -> "usb".
+std::string SnakeCase(const std::string& category) {
+  std::string out;
+  for (size_t i = 0; i < category.size(); ++i) {
+    char c = category[i];
+    bool upper = c >= 'A' && c <= 'Z';
+    bool after_lower = i > 0 && category[i - 1] >= 'a' && category[i - 1] <= 'z';
+    if (upper && after_lower) out += '_';
+    out += upper ? static_cast<char>(c - 'A' + 'a') : c;
+  }
+  return out;
+}
+
+/// "drawer_front" -> "Drawer Front", "storage_furniture" -> "Storage Furniture" (PartNet's
+/// display texts).
+std::string TitleText(const std::string& name) {
+  std::string out;
+  bool start = true;
+  for (char c : name) {
+    if (c == '_') {
+      out += ' ';
+      start = true;
+      continue;
+    }
+    out += start && c >= 'a' && c <= 'z' ? static_cast<char>(c - 'a' + 'A') : c;
+    start = false;
+  }
+  return out;
+}
+
+std::string Quoted(const std::string& s) { return "\"" + s + "\""; }
+
+std::string ObjList(const std::vector<int>& files) {
+  std::string s = "[";
+  for (size_t i = 0; i < files.size(); ++i)
+    s += (i ? ", " : "") + Quoted("original-" + std::to_string(files[i]));
+  return s + "]";
+}
+
+/// One node of the part hierarchy: the object, a link with several parts, or a part.
+struct Node {
+  int id = 0;
+  std::string name;
+  std::vector<int> files;  ///< OBJ numbers of the node and all below it
+  std::vector<Node> children;
+};
+
+/// The PartNet part hierarchy of the object (ids as NumberPartNodes gave them).
+Node PartTree(const GeneratedObject& o, const std::vector<std::vector<int>>& files) {
+  Node root;
+  root.name = SnakeCase(o.category);
+  for (const GeneratedLink& l : o.links) {
+    if (l.parts.empty()) continue;
+    std::vector<Node> leaves;
+    size_t k = 0;
+    for (const GeneratedPart& part : l.parts) {
+      Node leaf;
+      leaf.id = part.id;
+      leaf.name = part.name;
+      for (size_t i = 0; i < part.pieces.size(); ++i) leaf.files.push_back(files[l.id][k++]);
+      leaves.push_back(leaf);
+    }
+    if (leaves.size() == 1) {
+      root.children.push_back(leaves[0]);
+      continue;
+    }
+    Node group;
+    group.id = leaves[0].id - 1;
+    group.name = l.partnet_name;
+    group.files = files[l.id];
+    group.children = leaves;
+    root.children.push_back(group);
+  }
+  for (const Node& c : root.children)
+    root.files.insert(root.files.end(), c.files.begin(), c.files.end());
+  return root;
+}
+
+/// result.json's node: internal nodes {text, children, id, name}, leaves {text, objs, id, name}.
+std::string ResultJson(const Node& n, const std::string& text) {
+  std::string s = "{\"text\": " + Quoted(text) + ", ";
+  if (n.children.empty()) {
+    s += "\"objs\": " + ObjList(n.files) + ", ";
+  } else {
+    s += "\"children\": [";
+    for (size_t i = 0; i < n.children.size(); ++i)
+      s += (i ? ", " : "") + ResultJson(n.children[i], TitleText(n.children[i].name));
+    s += "], ";
+  }
+  return s + "\"id\": " + std::to_string(n.id) + ", \"name\": " + Quoted(n.name) + "}";
+}
+
+/// result_after_merging.json's node: every node lists the OBJ files below it, "ori_id" is its id
+/// in result.json and "id" its pre-order index here.
+std::string MergedJson(const Node& n, int* next) {
+  const int id = (*next)++;
+  std::string s = "{\"objs\": " + ObjList(n.files) + ", ";
+  if (n.children.empty()) {
+    s += "\"ori_id\": " + std::to_string(n.id) + ", \"text\": " + Quoted(n.name) +
+         ", \"name\": " + Quoted(n.name);
+  } else {
+    s += "\"name\": " + Quoted(n.name) + ", \"ori_id\": " + std::to_string(n.id) +
+         ", \"text\": " + Quoted(n.name) + ", \"children\": [";
+    for (size_t i = 0; i < n.children.size(); ++i)
+      s += (i ? ", " : "") + MergedJson(n.children[i], next);
+    s += "]";
+  }
+  return s + ", \"id\": " + std::to_string(id) + "}";
+}
+
+/// The semantics.txt joint kind: the JSON motion, "slider+" for a slider that also turns.
+std::string SemanticsKind(const GeneratedLink& l) {
+  return l.joint == "slider" && l.rotates ? "slider+" : l.joint;
 }
 
 }  // namespace
@@ -285,17 +437,23 @@ void WriteObject(const GeneratedObject& object, const std::string& dir) {
   WriteFile(root / "mobility_v2.json", MobilityText(object));
   std::string sem;
   for (const GeneratedLink& l : object.links) {
-    sem += "link_" + std::to_string(l.id) + " " + l.joint + " " + l.name + "\n";
+    sem += "link_" + std::to_string(l.id) + " " + SemanticsKind(l) + " " + l.name + "\n";
   }
   WriteFile(root / "semantics.txt", sem);
-  WriteFile(root / "meta.json",
-            "{\n  \"model_cat\": \"" + object.category + "\",\n  \"model_id\": \"" +
-                object.model_id + "\",\n  \"anno_id\": \"" + object.anno_id +
-                "\",\n  \"generator\": \"partsim assets generate\",\n  \"seed\": " +
-                std::to_string(object.seed) + ",\n  \"index\": " + std::to_string(object.index) +
-                "\n}\n");
+  // the dataset's keys (string values), then partsim's provenance
+  WriteFile(
+      root / "meta.json",
+      "{\"model_id\": " + Quoted(object.model_id) + ", \"anno_id\": " + Quoted(object.anno_id) +
+          ", \"user_id\": \"partsim\", \"time_in_sec\": \"0\", \"version\": \"3\", "
+          "\"model_cat\": " +
+          Quoted(object.category) + ", \"generator\": \"partsim assets generate\", \"seed\": " +
+          std::to_string(object.seed) + ", \"index\": " + std::to_string(object.index) + "}\n");
   WriteFile(root / "bounding_box.json",
             "{\"min\": " + Json3(lo) + ", \"max\": " + Json3(hi) + "}\n");
+  const Node tree = PartTree(object, files);
+  WriteFile(root / "result.json", "[" + ResultJson(tree, object.category) + "]\n");
+  int next = 0;
+  WriteFile(root / "result_after_merging.json", "[" + MergedJson(tree, &next) + "]\n");
 }
 
 }  // namespace partsim
