@@ -8,6 +8,8 @@ PACKAGES=(
   build-essential cmake git pkg-config
   libmujoco-dev libqhull-dev libeigen3-dev libassimp-dev libtinyxml2-dev nlohmann-json3-dev
   pybind11-dev python3-dev python3-numpy python3-pytest
+  # the SAPIEN-style examples save pictures and build rotations as SAPIEN's tutorials do
+  python3-pil python3-transforms3d
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev clang-format
   libegl-dev libegl-mesa0 libgl1-mesa-dri libopengl-dev libembree-dev libpng-dev

@@ -1,10 +1,22 @@
 """partsim: simulation of robots interacting with articulated objects, on MuJoCo 2.2.2.
 
 The compiled extension `partsim._partsim` holds the bindings; everything public in it is
-re-exported here, so `import partsim; partsim.Scene()` works.
+re-exported here, so `import partsim; partsim.Scene()` works. SAPIEN's names are added beside
+partsim's own (see partsim._sapien and docs/sapien_compatibility.md), so that SAPIEN 2.2 and 3.x
+scripts run with `import partsim as sapien` (or `import partsim.core as sapien` for SAPIEN 2's
+`import sapien.core as sapien`).
 """
+
+import sys as _sys
 
 from ._partsim import *  # noqa: F401,F403
 from ._partsim import PartsimError, PartsimIndexError  # noqa: F401  (explicit for readers)
+from ._sapien import (  # noqa: F401
+    Engine, KuafuRenderer, RenderBodyComponent, RenderMaterial, SapienContact, SapienRenderer,
+    SceneConfig, Viewer, VulkanRenderer, physx, render, set_log_level, utils)
 
 __version__ = "0.1.0"
+
+# SAPIEN 2 scripts say `import sapien.core as sapien`: partsim.core is partsim itself
+core = _sys.modules[__name__]
+_sys.modules[__name__ + ".core"] = core

@@ -19,6 +19,9 @@ class Actor:
     def add_force_torque(self, force: numpy.ndarray, torque: numpy.ndarray) -> None:
         """Adds a world-frame force (N) at the centre of mass and a torque (N m) for the next step."""
         ...
+    def get_angular_damping(self) -> float:
+        """Angular velocity damping (1/s)."""
+        ...
     def get_angular_velocity(self) -> numpy.ndarray:
         """World-frame angular velocity (3,), rad/s."""
         ...
@@ -28,7 +31,12 @@ class Actor:
     def get_desc(self) -> ActorDesc:
         """A copy of the actor's description."""
         ...
-    def get_id(self) -> int: ...
+    def get_id(self) -> int:
+        """Scene-wide id (unique among actors, articulations and links): also the actor's entity id in segmentation pictures."""
+        ...
+    def get_linear_damping(self) -> float:
+        """Linear velocity damping (1/s)."""
+        ...
     def get_mass(self) -> float:
         """Mass (kg) as compiled."""
         ...
@@ -42,6 +50,10 @@ class Actor:
     @property
     def name(self) -> str: ...
     def set_angular_velocity(self, w: numpy.ndarray) -> None: ...
+    def set_damping(self, linear: float, angular: float) -> None:
+        """Velocity damping (1/s, >= 0) of a dynamic actor, as PhysX's: dv/dt = -linear v, dw/dt = -angular w; integrated implicitly."""
+        ...
+    def set_name(self, name: str) -> None: ...
     def set_pose(self, pose: Pose) -> None:
         """Teleports a dynamic or kinematic actor."""
         ...
@@ -98,6 +110,9 @@ class ActorBuilder:
     def get_desc(self) -> ActorDesc:
         """A copy of the description built so far."""
         ...
+    def get_visual_count(self) -> int:
+        """Number of visuals added so far."""
+        ...
     @typing.overload
     def set_collision_groups(self, groups: typing.List[int]) -> ActorBuilder:
         """SAPIEN's collision groups [g0, g1, g2, g3] (uint32) for every collision shape of the body, added before or after. Returns self."""
@@ -111,11 +126,26 @@ class ActorBuilder:
         """Explicit mass (kg), centre-of-mass pose in the body and principal inertia (3,) (kg m^2). Returns self."""
         ...
     def set_name(self, name: str) -> ActorBuilder: ...
+    def set_visual_material(self, index: int, material: RenderMaterial) -> ActorBuilder:
+        """Replaces the RenderMaterial of visual `index` (in the order added). Returns self."""
+        ...
 
 
 class ActorDesc(BodyDesc):
     """Description of a free rigid body."""
     def __init__(self) -> None: ...
+    @property
+    def angular_damping(self) -> float:
+        """Angular velocity damping (1/s, >= 0): dw/dt = -angular_damping w."""
+        ...
+    @angular_damping.setter
+    def angular_damping(self, value: float) -> None: ...
+    @property
+    def linear_damping(self) -> float:
+        """Velocity damping (1/s, >= 0): dv/dt = -linear_damping v."""
+        ...
+    @linear_damping.setter
+    def linear_damping(self, value: float) -> None: ...
     @property
     def pose(self) -> Pose:
         """X_WA at creation."""
@@ -177,8 +207,8 @@ class Articulation:
     def compute_manipulator_inertia_matrix(self) -> numpy.ndarray:
         """Mass matrix (dof, dof)."""
         ...
-    def compute_passive_force(self, gravity: bool = ..., coriolis_and_centrifugal: bool = ...) -> numpy.ndarray:
-        """Generalized force (dof,) that cancels gravity and/or Coriolis and centrifugal forces at the current state."""
+    def compute_passive_force(self, gravity: bool = ..., coriolis_and_centrifugal: bool = ..., external: bool = ...) -> numpy.ndarray:
+        """Generalized force (dof,) that cancels gravity, Coriolis and centrifugal forces and the external forces added to the links for the next step, each when asked, at the current state: set_qf(it) holds the articulation still."""
         ...
     def compute_world_cartesian_jacobian(self) -> numpy.ndarray:
         """Stacked link Jacobians (6 nlinks, dof)."""
@@ -240,6 +270,7 @@ class Articulation:
     def set_drive_velocity_target(self, velocity: numpy.ndarray) -> None:
         """Drive velocity targets (dof,)."""
         ...
+    def set_name(self, name: str) -> None: ...
     def set_qacc(self, qacc: numpy.ndarray) -> None:
         """Sets accelerations; they only seed the solver's warm start."""
         ...
@@ -471,6 +502,9 @@ class Camera:
     def set_near_far(self, near: float, far: float) -> None:
         """Clipping distances (m), 0 < near < far."""
         ...
+    def set_parent(self, parent: object, keep_pose: bool) -> None:
+        """Mounts the camera on an actor or a link (None: the world). keep_pose=True keeps its world pose; False keeps its local pose, now in the new parent's frame."""
+        ...
     def set_pose(self, pose: Pose) -> None:
         """Same as set_local_pose: the world pose of a free camera, the pose in the mount's frame of a mounted one."""
         ...
@@ -610,15 +644,15 @@ class ContactPoint:
     """One contact point between two bodies."""
     @property
     def force(self) -> numpy.ndarray:
-        """World force (3,) on body1, N."""
+        """World force (3,) on body0, N."""
         ...
     @property
     def impulse(self) -> numpy.ndarray:
-        """World impulse (3,) on body1 over the last step, N s."""
+        """World impulse (3,) on body0 (SAPIEN's actor0) over the last step, N s."""
         ...
     @property
     def normal(self) -> numpy.ndarray:
-        """World normal (3,), from body0 to body1."""
+        """World normal (3,), from body1 into body0 (as SAPIEN's)."""
         ...
     @property
     def position(self) -> numpy.ndarray:
@@ -1450,6 +1484,9 @@ class Link:
     def get_desc(self) -> LinkDesc:
         """A copy of the link's description."""
         ...
+    def get_id(self) -> int:
+        """Scene-wide id (unique among actors, articulations and links): the link's entity id in segmentation pictures."""
+        ...
     def get_index(self) -> int:
         """Index in the articulation (0 is the root)."""
         ...
@@ -1512,6 +1549,9 @@ class LinkBuilder:
         """Adds every sub-mesh of a mesh file as visuals, multiplied by `scale`. Returns self."""
         ...
     def get_index(self) -> int: ...
+    def get_visual_count(self) -> int:
+        """Number of visuals added so far."""
+        ...
     @typing.overload
     def set_collision_groups(self, groups: typing.List[int]) -> LinkBuilder:
         """SAPIEN's collision groups [g0, g1, g2, g3] (uint32) for every collision shape of the body, added before or after. Returns self."""
@@ -1532,6 +1572,9 @@ class LinkBuilder:
     def set_name(self, name: str) -> LinkBuilder: ...
     def set_screw_pitch(self, pitch: float) -> LinkBuilder:
         """Metres per radian. Returns self."""
+        ...
+    def set_visual_material(self, index: int, material: RenderMaterial) -> LinkBuilder:
+        """Replaces the RenderMaterial of visual `index` (in the order added). Returns self."""
         ...
 
 
@@ -2136,8 +2179,8 @@ class Scene:
     def add_directional_light(self, direction: numpy.ndarray, color: numpy.ndarray, shadow: bool = ...) -> None:
         """Light travelling along `direction` (3,) (world); color (3,) linear RGB."""
         ...
-    def add_ground(self, altitude: float = ..., material: typing.Optional[PhysicalMaterial] = ..., name: str = ...) -> Actor:
-        """Adds a static ground plane at z = altitude (m)."""
+    def add_ground(self, altitude: float = ..., material: typing.Optional[PhysicalMaterial] = ..., name: str = ..., render: bool = ..., render_half_size: numpy.ndarray = ..., render_material: typing.Optional[RenderMaterial] = ...) -> Actor:
+        """Adds a static ground plane at z = altitude (m). Cameras see a square of render_half_size (2,) m around the origin in render_material (light grey by default), or nothing when render is False."""
         ...
     @typing.overload
     def add_mounted_camera(self, name: str, mount: Actor, pose: Pose, width: int, height: int, fovy: float, near: float, far: float) -> Camera:
@@ -2211,6 +2254,9 @@ class Scene:
     def remove_camera(self, camera: Camera) -> None: ...
     def set_ambient_light(self, color: numpy.ndarray) -> None:
         """Ambient light (3,), linear RGB."""
+        ...
+    def set_default_material(self, material: PhysicalMaterial) -> None:
+        """Material of the collision shapes that name none, those already built included."""
         ...
     def set_gravity(self, g: numpy.ndarray) -> None: ...
     def set_render_backend(self, name: str) -> None:

@@ -212,6 +212,19 @@ D& BodyBuilder<D>::AddVisualFromFile(const std::string& filename, const Pose& po
   return self();
 }
 template <typename D>
+int BodyBuilder<D>::GetVisualCount() {
+  return static_cast<int>(body().visuals.size());
+}
+template <typename D>
+D& BodyBuilder<D>::SetVisualMaterial(int index, const RenderMaterial& material) {
+  std::vector<VisualShape>& v = body().visuals;
+  if (index < 0 || index >= static_cast<int>(v.size()))
+    throw Error("set_visual_material: visual index " + std::to_string(index) + " out of range (" +
+                std::to_string(v.size()) + " visuals)");
+  v[index].material = material;
+  return self();
+}
+template <typename D>
 D& BodyBuilder<D>::SetMassAndInertia(double mass, const Pose& cmass_local_pose,
                                      const Eigen::Vector3d& inertia) {
   body().inertial = MakeInertial(mass, cmass_local_pose, inertia);

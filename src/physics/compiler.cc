@@ -284,6 +284,12 @@ class MjcfWriter {
     return -1;  // Validate() has already rejected unknown names
   }
 
+  // The step over which drives are backward Euler (DriveVelocityGain): the implicit integrator's;
+  // 0, plain gains, for the explicit ones.
+  double DriveStep() const {
+    return scene_.config.integrator == Integrator::kImplicit ? scene_.config.timestep : 0.0;
+  }
+
   // Couplings must hold tightly even against stiff, implicitly damped drives: the shortest time
   // constant MuJoCo accepts and the highest impedance.
   std::string EqualitySolver() const {
@@ -319,8 +325,10 @@ class MjcfWriter {
   void WriteJoint(int id, int index, const JointDesc& j, int depth) {
     Eigen::Vector3d axis = j.pose_in_child.q * Eigen::Vector3d::UnitX();
     std::string where = " pos=\"" + Vec(j.pose_in_child.p) + "\" axis=\"" + Vec(axis) + "\"";
+    // the implicit integrator steps drives by backward Euler: their inertia joins the armature
+    const double drive_dt = DriveStep();
     std::string dyn = " damping=\"" + Num(j.damping) + "\" frictionloss=\"" + Num(j.friction) +
-                      "\" armature=\"" + Num(j.armature) + "\"";
+                      "\" armature=\"" + Num(j.armature + DriveArmature(j.drive, drive_dt)) + "\"";
     bool limited =
         std::isfinite(j.lower) && std::isfinite(j.upper) && j.type != JointType::kContinuous;
     // limits hold hard: the shortest time constant MuJoCo accepts, high impedance
@@ -344,11 +352,13 @@ class MjcfWriter {
                 << EqualitySolver() << "/>\n";
       ++num_equalities_;
     }
-    // every joint with a dof gets a PD drive actuator; gains are set at run time
+    // every joint with a dof gets a PD drive actuator; gains are set at run time (SyncDrive).
+    // Backward-Euler drives take their velocity gain in ctrl (SceneImpl::ApplyDrives): a velocity
+    // gain here would be integrated implicitly a second time.
     actuators_ << "    <general name=\"" << ActuatorMjName(id, index) << "\" joint=\""
                << JointMjName(id, index) << "\" gaintype=\"fixed\" gainprm=\"1\" "
                << "biastype=\"affine\" biasprm=\"0 " << Num(-j.drive.stiffness) << " "
-               << Num(-j.drive.damping) << "\" ctrllimited=\"false\"";
+               << Num(drive_dt > 0 ? 0.0 : -j.drive.damping) << "\" ctrllimited=\"false\"";
     if (std::isfinite(j.drive.force_limit))
       actuators_ << " forcelimited=\"true\" forcerange=\"" << Num(-j.drive.force_limit) << " "
                  << Num(j.drive.force_limit) << "\"";
@@ -493,6 +503,25 @@ std::string DescribeMjNames(const SceneImpl& scene, const std::string& text) {
   return out;
 }
 
+void SyncActorDamping(SceneImpl& s, const ActorDesc& desc, const CompiledActor& c) {
+  if (c.dofadr < 0) return;
+  mjModel* m = s.m;
+  const int b = c.body;
+  // the free joint's translational dofs move the body in the world, its rotational dofs turn it
+  // about its own axes: damping b = rate x (mass, or the inertia about that body axis) gives
+  // dv/dt = -rate v, and MuJoCo integrates joint damping implicitly
+  const Eigen::Quaterniond q(m->body_iquat[4 * b], m->body_iquat[4 * b + 1],
+                             m->body_iquat[4 * b + 2], m->body_iquat[4 * b + 3]);
+  const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+  const Eigen::Vector3d principal(m->body_inertia[3 * b], m->body_inertia[3 * b + 1],
+                                  m->body_inertia[3 * b + 2]);
+  const Eigen::Matrix3d inertia = R * principal.asDiagonal() * R.transpose();
+  for (int k = 0; k < 3; ++k) {
+    m->dof_damping[c.dofadr + k] = desc.linear_damping * m->body_mass[b];
+    m->dof_damping[c.dofadr + 3 + k] = desc.angular_damping * inertia(k, k);
+  }
+}
+
 void BuildTables(SceneImpl& s) {
   const mjModel* m = s.m;
   s.compiled_actors.clear();
@@ -518,6 +547,7 @@ void BuildTables(SceneImpl& s) {
       c.dofadr = m->jnt_dofadr[j];
     }
     s.compiled_actors[a.id] = c;
+    SyncActorDamping(s, a.desc, c);
     GeomOwner owner;
     owner.actor_id = a.id;
     own_geoms(name, a.desc.collisions.size(), owner);

@@ -54,6 +54,14 @@ const char* JointTypeName(JointType t) {
   return "?";
 }
 
+double DriveVelocityGain(const DriveDesc& drive, double dt) {
+  return drive.damping + drive.stiffness * dt;
+}
+
+double DriveArmature(const DriveDesc& drive, double dt) {
+  return dt * DriveVelocityGain(drive, dt);
+}
+
 namespace {
 
 std::string Prefix(const std::string& where) { return where.empty() ? "" : where + ": "; }
@@ -142,6 +150,11 @@ void Validate(const ActorDesc& a, const std::string& where) {
   std::string what = "actor '" + a.name + "'";
   CheckPose(a.pose, where, what + " pose");
   CheckBody(a, where, what);
+  Require(std::isfinite(a.linear_damping) && a.linear_damping >= 0 &&
+              std::isfinite(a.angular_damping) && a.angular_damping >= 0,
+          where,
+          what + " damping must be finite and >= 0, got linear " +
+              std::to_string(a.linear_damping) + ", angular " + std::to_string(a.angular_damping));
 }
 
 void Validate(const ArticulationDesc& art, const std::string& where) {

@@ -70,6 +70,7 @@ void AddBodyForce(SceneImpl& s, int body, const Eigen::Vector3d& f, const Eigen:
 // Actor
 
 const std::string& Actor::GetName() const { return S(scene_).GetActor(id_).desc.name; }
+void Actor::SetName(const std::string& name) { S(scene_).GetActor(id_).desc.name = name; }
 ActorType Actor::GetType() const { return S(scene_).GetActor(id_).desc.type; }
 const ActorDesc& Actor::GetDesc() const { return S(scene_).GetActor(id_).desc; }
 
@@ -98,7 +99,10 @@ void Actor::SetPose(const Pose& pose) {
     for (int k = 0; k < 3; ++k) s.d->mocap_pos[3 * c.mocap + k] = pose.p[k];
     dst = s.d->mocap_quat + 4 * c.mocap;
   } else {
-    throw Error("actor '" + a.desc.name + "' is static and cannot be moved");
+    // a static actor is welded to the world: move the weld in the model (contacts with what
+    // rests on it are not carried along)
+    for (int k = 0; k < 3; ++k) s.m->body_pos[3 * c.body + k] = pose.p[k];
+    dst = s.m->body_quat + 4 * c.body;
   }
   dst[0] = q.w();
   dst[1] = q.x();
@@ -149,6 +153,24 @@ double Actor::GetMass() const {
   return s.m->body_mass[s.Compiled(s.GetActor(id_)).body];
 }
 
+void Actor::SetDamping(double linear, double angular) {
+  SceneImpl& s = S(scene_);
+  auto& a = s.GetActor(id_);
+  const auto& c = s.Compiled(a);
+  if (c.dofadr < 0)
+    throw Error("actor '" + a.desc.name + "' is " + ActorTypeName(a.desc.type) +
+                ": only dynamic actors have velocity damping");
+  if (!std::isfinite(linear) || linear < 0 || !std::isfinite(angular) || angular < 0)
+    throw Error("actor '" + a.desc.name + "': damping must be finite and >= 0, got linear " +
+                std::to_string(linear) + ", angular " + std::to_string(angular));
+  a.desc.linear_damping = linear;
+  a.desc.angular_damping = angular;
+  SyncActorDamping(s, a.desc, c);
+}
+
+double Actor::GetLinearDamping() const { return S(scene_).GetActor(id_).desc.linear_damping; }
+double Actor::GetAngularDamping() const { return S(scene_).GetActor(id_).desc.angular_damping; }
+
 void Actor::AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point) {
   SceneImpl& s = S(scene_);
   AddBodyForce(s, s.Compiled(s.GetActor(id_)).body, force, point);
@@ -195,6 +217,10 @@ int LinkBody(SceneImpl& s, int art, int index) {
 
 const std::string& Link::GetName() const {
   return LinkAt(S(scene_), articulation_id_, index_).name;
+}
+int Link::GetId() const {
+  LinkAt(S(scene_), articulation_id_, index_);  // throws when gone
+  return static_cast<int>(S(scene_).GetArticulation(articulation_id_).render_id_base) + index_;
 }
 int Link::GetParentIndex() const { return LinkAt(S(scene_), articulation_id_, index_).parent; }
 const LinkDesc& Link::GetDesc() const { return LinkAt(S(scene_), articulation_id_, index_); }
@@ -325,13 +351,33 @@ void CheckDriveParam(double v, const char* what) {
   if (!std::isfinite(v) || v < 0) throw Error(std::string(what) + " must be finite and >= 0");
 }
 
-// Writes a drive's gains into the compiled model.
+// The step over which drives are backward Euler (DriveVelocityGain), as the compiler takes it.
+double DriveStep(const SceneImpl& s) {
+  return s.config.integrator == Integrator::kImplicit ? s.config.timestep : 0.0;
+}
+
+// Sets a dof's armature in the compiled model, and the constants MuJoCo derives from it when it
+// compiles (the mass matrix of simple dofs, dof_M0, used as is; the constraint weights; the mean
+// inertia), as a compile would: mj_setConst works at qpos0, and changes no state but qpos.
+void SetDofArmature(SceneImpl& s, int dofadr, double armature) {
+  if (s.m->dof_armature[dofadr] == armature) return;
+  s.m->dof_armature[dofadr] = armature;
+  std::vector<double> qpos(s.d->qpos, s.d->qpos + s.m->nq);
+  mj_setConst(s.m, s.d);
+  std::copy(qpos.begin(), qpos.end(), s.d->qpos);
+  s.Invalidate();
+}
+
+// Writes a drive's gains into the compiled model, as the compiler writes them: a backward-Euler
+// drive's velocity gain goes to ctrl (SceneImpl::ApplyDrives) and its inertia to the armature.
 void SyncDrive(SceneImpl& s, const JointRef& j) {
   if (j.compiled->actuator < 0) return;
   int a = j.compiled->actuator;
   const DriveDesc& dr = j.desc->drive;
+  const double dt = DriveStep(s);
   s.m->actuator_biasprm[a * mjNBIAS + 1] = -dr.stiffness;
-  s.m->actuator_biasprm[a * mjNBIAS + 2] = -dr.damping;
+  s.m->actuator_biasprm[a * mjNBIAS + 2] = dt > 0 ? 0.0 : -dr.damping;
+  SetDofArmature(s, j.compiled->dofadr, j.desc->armature + DriveArmature(dr, dt));
   bool limited = std::isfinite(dr.force_limit);
   s.m->actuator_forcelimited[a] = limited;
   s.m->actuator_forcerange[2 * a] = limited ? -dr.force_limit : 0;
@@ -422,7 +468,9 @@ void Joint::SetArmature(double v) {
   CheckDriveParam(v, "armature");
   JointRef j = GetJointRef(scene_, articulation_id_, index_);
   j.desc->armature = v;
-  if (j.compiled->dofadr >= 0) S(scene_).m->dof_armature[j.compiled->dofadr] = v;
+  if (j.compiled->dofadr >= 0)
+    SetDofArmature(S(scene_), j.compiled->dofadr,
+                   v + DriveArmature(j.desc->drive, DriveStep(S(scene_))));
   S(scene_).Invalidate();
 }
 
@@ -532,11 +580,16 @@ Eigen::VectorXd WithCouplings(const ArtRef& r, Eigen::VectorXd x, bool positions
   return x;
 }
 
-// Mass matrix over the articulation's MuJoCo dofs.
+// Mass matrix over the articulation's MuJoCo dofs, without the inertia of backward-Euler drives.
 Eigen::MatrixXd MjMassMatrix(const ArtRef& r) {
   int nv = r.s.m->nv;
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> full(nv, nv);
   mj_fullM(r.s.m, full.data(), r.s.d->qM);
+  const double dt = DriveStep(r.s);
+  for (int li : r.c.dof_links) {
+    const int v = r.c.joints[li].dofadr;
+    full(v, v) -= DriveArmature(r.a.desc.links[li].joint.drive, dt);
+  }
   int n = static_cast<int>(r.c.mj_dofs.size());
   Eigen::MatrixXd out(n, n);
   for (int i = 0; i < n; ++i)
@@ -548,6 +601,9 @@ Eigen::MatrixXd MjMassMatrix(const ArtRef& r) {
 
 const std::string& Articulation::GetName() const {
   return S(scene_).GetArticulation(id_).desc.name;
+}
+void Articulation::SetName(const std::string& name) {
+  S(scene_).GetArticulation(id_).desc.name = name;
 }
 bool Articulation::IsKinematic() const { return S(scene_).GetArticulation(id_).desc.kinematic; }
 bool Articulation::HasFixedRoot() const { return S(scene_).GetArticulation(id_).desc.fix_root; }
@@ -801,7 +857,8 @@ void Articulation::SetDriveProperty(double stiffness, double damping, double for
   for (Joint& j : GetActiveJoints()) j.SetDriveProperty(stiffness, damping, force_limit);
 }
 
-Eigen::VectorXd Articulation::ComputePassiveForce(bool gravity, bool coriolis) const {
+Eigen::VectorXd Articulation::ComputePassiveForce(bool gravity, bool coriolis,
+                                                  bool external) const {
   ArtRef r = DynamicArt(scene_, id_, "compute_passive_force");
   r.s.EnsureForward();
   const mjModel* m = r.s.m;
@@ -821,6 +878,18 @@ Eigen::VectorXd Articulation::ComputePassiveForce(bool gravity, bool coriolis) c
   Eigen::VectorXd f = Eigen::VectorXd::Zero(bias.size());
   if (gravity) f += grav;
   if (coriolis) f += bias - grav;
+  if (external && r.s.xfrc_dirty) {
+    // the wrenches waiting in xfrc_applied (at the links' centres of mass), in joint space
+    std::vector<double> qfrc(m->nv, 0.0);
+    std::vector<int> bodies = r.c.link_body;
+    std::sort(bodies.begin(), bodies.end());
+    bodies.erase(std::unique(bodies.begin(), bodies.end()), bodies.end());
+    for (int b : bodies) {
+      const double* w = d->xfrc_applied + 6 * b;
+      mj_applyFT(m, d, w, w + 3, d->xipos + 3 * b, b, qfrc.data());
+    }
+    f -= MjDofs(r, qfrc.data());
+  }
   return r.c.G.transpose() * f;
 }
 

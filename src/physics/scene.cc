@@ -183,13 +183,18 @@ void SceneImpl::EnsureKinematics() {
 }
 
 void SceneImpl::ApplyDrives() {
+  // with the implicit integrator drives are backward Euler: the velocity gain acts here, on the
+  // velocity at the step's start, and the armature the compiler added makes up the rest
+  const double dt = config.integrator == Integrator::kImplicit ? config.timestep : 0.0;
   for (const auto& a : articulations) {
     if (a.desc.kinematic) continue;
     const CompiledArticulation& c = compiled_articulations.at(a.id);
     for (int li : c.dof_links) {
       const CompiledJoint& j = c.joints[li];
       const DriveDesc& dr = a.desc.links[li].joint.drive;
-      d->ctrl[j.actuator] = dr.stiffness * dr.target + dr.damping * dr.velocity_target;
+      double u = dr.stiffness * dr.target + dr.damping * dr.velocity_target;
+      if (dt > 0) u -= DriveVelocityGain(dr, dt) * d->qvel[j.dofadr];
+      d->ctrl[j.actuator] = u;
     }
   }
 }
@@ -292,7 +297,6 @@ std::unique_ptr<Scene> Scene::Clone() const {
   c.actors = impl_->actors;
   c.articulations = impl_->articulations;
   c.next_id = impl_->next_id;
-  c.next_render_id = impl_->next_render_id;
   c.next_visual_id = impl_->next_visual_id;
   c.lights = impl_->lights;
   c.ambient = impl_->ambient;
@@ -340,9 +344,30 @@ double Scene::GetTime() const {
   return impl_->d->time;
 }
 
+void Scene::SetDefaultMaterial(const PhysicalMaterial& material) {
+  const PhysicalMaterial& m = material;
+  if (!(m.static_friction >= 0) || !std::isfinite(m.static_friction) ||
+      !(m.dynamic_friction >= 0) || !std::isfinite(m.dynamic_friction) ||
+      !(m.restitution >= 0 && m.restitution <= 1))
+    throw Error(
+        "default material: frictions must be finite and >= 0 and restitution in [0, 1], "
+        "got static_friction " +
+        std::to_string(m.static_friction) + ", dynamic_friction " +
+        std::to_string(m.dynamic_friction) + ", restitution " + std::to_string(m.restitution));
+  impl_->config.default_material = material;
+  impl_->dirty = true;
+  impl_->EnsureCompiled();
+}
+
 Actor Scene::AddGround(double altitude, const std::optional<PhysicalMaterial>& material,
-                       const std::string& name) {
+                       const std::string& name, bool render,
+                       const Eigen::Vector2d& render_half_size,
+                       const std::optional<RenderMaterial>& render_material) {
   if (!std::isfinite(altitude)) throw Error("add_ground: altitude must be finite");
+  if (!(render_half_size.minCoeff() > 0) || !render_half_size.allFinite())
+    throw Error("add_ground: render_half_size must be finite and > 0, got (" +
+                std::to_string(render_half_size[0]) + ", " + std::to_string(render_half_size[1]) +
+                ")");
   ActorDesc desc;
   desc.name = name;
   desc.type = ActorType::kStatic;
@@ -353,9 +378,10 @@ Actor Scene::AddGround(double altitude, const std::optional<PhysicalMaterial>& m
   desc.collisions.push_back(plane);
   VisualShape visual;
   visual.type = ShapeType::kPlane;
-  visual.half_size = Eigen::Vector3d(10, 10, 0);
+  visual.half_size = Eigen::Vector3d(render_half_size[0], render_half_size[1], 0);
   visual.material.base_color = Eigen::Vector4f(0.9f, 0.9f, 0.9f, 1.0f);
-  desc.visuals.push_back(visual);
+  if (render_material) visual.material = *render_material;
+  if (render) desc.visuals.push_back(visual);
   return AddActor(desc);
 }
 
@@ -382,11 +408,11 @@ Actor Scene::AddActor(const ActorDesc& desc) {
   Validate(desc);
   Impl& s = *impl_;
   s.EnsureCompiled();
+  // an actor's id is its entity id in segmentation pictures too (as SAPIEN's)
   int id = s.next_id;
-  s.actors.push_back({id, desc, s.next_render_id, s.next_visual_id});
+  s.actors.push_back({id, desc, static_cast<uint32_t>(id), s.next_visual_id});
   CompileOrUndo(s, [&] { s.actors.pop_back(); });
   ++s.next_id;
-  ++s.next_render_id;
   s.next_visual_id += static_cast<uint32_t>(desc.visuals.size());
   return Actor(this, id);
 }
@@ -395,8 +421,9 @@ Articulation Scene::AddArticulation(const ArticulationDesc& desc) {
   Validate(desc);
   Impl& s = *impl_;
   s.EnsureCompiled();
+  // its links take the ids (segmentation entity ids) after the articulation's own
   int id = s.next_id;
-  internal::SceneImpl::ArticulationEntry entry{id, desc, {}, {}, s.next_render_id, {}};
+  internal::SceneImpl::ArticulationEntry entry{id, desc, {}, {}, static_cast<uint32_t>(id + 1), {}};
   uint32_t visual_id = s.next_visual_id;
   for (const LinkDesc& l : desc.links) {
     entry.visual_id_base.push_back(visual_id);
@@ -404,8 +431,7 @@ Articulation Scene::AddArticulation(const ArticulationDesc& desc) {
   }
   s.articulations.push_back(std::move(entry));
   CompileOrUndo(s, [&] { s.articulations.pop_back(); });
-  ++s.next_id;
-  s.next_render_id += static_cast<uint32_t>(desc.links.size());
+  s.next_id += 1 + static_cast<int>(desc.links.size());
   s.next_visual_id = visual_id;
   // a new articulation starts at q = 0 clamped into its limits
   Articulation art(this, id);
@@ -504,17 +530,24 @@ std::vector<Contact> Scene::GetContacts() const {
     }
     return b;
   };
+  // a static actor (the ground, a wall) is body 1 when the other body can move
+  auto is_static = [&](int geom) {
+    const internal::GeomOwner& o = s.geom_owner[geom];
+    return o.actor_id >= 0 && s.GetActor(o.actor_id).desc.type == ActorType::kStatic;
+  };
   std::map<std::pair<int, int>, size_t> index;
   std::vector<Contact> out;
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& c = d->contact[i];
     if (c.exclude != 0) continue;
-    auto key = std::make_pair(c.geom1, c.geom2);
+    const bool swap = is_static(c.geom1) && !is_static(c.geom2);
+    const int g0 = swap ? c.geom2 : c.geom1, g1 = swap ? c.geom1 : c.geom2;
+    auto key = std::make_pair(g0, g1);
     auto it = index.find(key);
     if (it == index.end()) {
       Contact contact;
-      contact.body0 = body(c.geom1);
-      contact.body1 = body(c.geom2);
+      contact.body0 = body(g0);
+      contact.body1 = body(g1);
       it = index.emplace(key, out.size()).first;
       out.push_back(contact);
     }
@@ -523,9 +556,11 @@ std::vector<Contact> Scene::GetContacts() const {
     Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> frame(c.frame);
     ContactPoint p;
     p.position = Eigen::Vector3d(c.pos[0], c.pos[1], c.pos[2]);
-    p.normal = frame.row(0).transpose();
-    // the contact force acts on geom2 along the normal that points from geom1 to geom2
-    p.force = frame.transpose() * Eigen::Vector3d(f[0], f[1], f[2]);
+    // MuJoCo's normal points from geom1 to geom2 and its force acts on geom2; partsim's normal
+    // points into body 0 and its force acts on body 0
+    const double sign = swap ? 1.0 : -1.0;
+    p.normal = sign * frame.row(0).transpose();
+    p.force = sign * (frame.transpose() * Eigen::Vector3d(f[0], f[1], f[2]));
     p.impulse = p.force * m->opt.timestep;
     p.separation = c.dist;
     out[it->second].points.push_back(p);

@@ -104,8 +104,9 @@ struct SceneImpl {
   };
   std::vector<ActorEntry> actors;
   std::vector<ArticulationEntry> articulations;
-  int next_id = 0;
-  uint32_t next_render_id = 1;
+  /// ids of actors, articulations, links and cameras, scene-wide; 0 is no entity (background
+  /// in segmentation pictures)
+  int next_id = 1;
   uint32_t next_visual_id = 1;
 
   // rendering
@@ -176,6 +177,8 @@ std::string GenerateMjcf(const SceneImpl& scene);
 std::string DescribeMjNames(const SceneImpl& scene, const std::string& text);
 /// Fills compiled tables from a loaded model.
 void BuildTables(SceneImpl& scene);
+/// Writes a dynamic actor's velocity damping into its free joint's dofs (compiled model).
+void SyncActorDamping(SceneImpl& scene, const ActorDesc& desc, const CompiledActor& compiled);
 
 /// Name of MuJoCo elements generated for partsim entities.
 std::string ActorBodyName(int actor_id);

@@ -99,6 +99,10 @@ void BindShapeAdders(PyClass& c) {
            py::arg("pose") = Pose(), py::arg("scale") = Eigen::Vector3d::Ones().eval(),
            py::arg("name") = "", ri,
            "Adds every sub-mesh of a mesh file as visuals, multiplied by `scale`. Returns self.")
+      .def("get_visual_count", &Builder::GetVisualCount, "Number of visuals added so far.")
+      .def("set_visual_material", &Builder::SetVisualMaterial, py::arg("index"),
+           py::arg("material"), ri,
+           "Replaces the RenderMaterial of visual `index` (in the order added). Returns self.")
       .def("set_mass_and_inertia", &Builder::SetMassAndInertia, py::arg("mass"),
            py::arg("cmass_local_pose"), py::arg("inertia"), ri,
            "Explicit mass (kg), centre-of-mass pose in the body and principal inertia (3,) "
@@ -238,7 +242,11 @@ void BindDescription(py::module_& m) {
   py::class_<ActorDesc, BodyDesc>(m, "ActorDesc", "Description of a free rigid body.")
       .def(py::init<>())
       .def_readwrite("type", &ActorDesc::type)
-      .def_readwrite("pose", &ActorDesc::pose, "X_WA at creation.");
+      .def_readwrite("pose", &ActorDesc::pose, "X_WA at creation.")
+      .def_readwrite("linear_damping", &ActorDesc::linear_damping,
+                     "Velocity damping (1/s, >= 0): dv/dt = -linear_damping v.")
+      .def_readwrite("angular_damping", &ActorDesc::angular_damping,
+                     "Angular velocity damping (1/s, >= 0): dw/dt = -angular_damping w.");
 
   py::enum_<JointType>(m, "JointType",
                        "Joint types; revolute, continuous and screw joints rotate about the joint "
@@ -333,8 +341,11 @@ void BindHandles(py::module_& m) {
            [](const Shape& self) { return "<Shape " + std::to_string(self.GetIndex()) + ">"; });
 
   py::class_<Actor>(m, "Actor", "Handle to an actor; valid until the actor is removed.")
-      .def("get_id", &Actor::GetId)
+      .def("get_id", &Actor::GetId,
+           "Scene-wide id (unique among actors, articulations and links): also the actor's "
+           "entity id in segmentation pictures.")
       .def("get_name", &Actor::GetName)
+      .def("set_name", &Actor::SetName, py::arg("name"))
       .def_property_readonly("name", &Actor::GetName)
       .def_property_readonly("type", &Actor::GetType, "ActorType.")
       .def("get_pose", &Actor::GetPose, "X_WA: the actor's frame in the world.")
@@ -346,6 +357,11 @@ void BindHandles(py::module_& m) {
            "World-frame angular velocity (3,), rad/s.")
       .def("set_angular_velocity", &Actor::SetAngularVelocity, py::arg("w"))
       .def("get_mass", &Actor::GetMass, "Mass (kg) as compiled.")
+      .def("set_damping", &Actor::SetDamping, py::arg("linear"), py::arg("angular"),
+           "Velocity damping (1/s, >= 0) of a dynamic actor, as PhysX's: dv/dt = -linear v, "
+           "dw/dt = -angular w; integrated implicitly.")
+      .def("get_linear_damping", &Actor::GetLinearDamping, "Linear velocity damping (1/s).")
+      .def("get_angular_damping", &Actor::GetAngularDamping, "Angular velocity damping (1/s).")
       .def("add_force_at_point", &Actor::AddForceAtPoint, py::arg("force"), py::arg("point"),
            "Adds a world-frame force (N) at a world point (m) for the next step.")
       .def("add_force_torque", &Actor::AddForceTorque, py::arg("force"), py::arg("torque"),
@@ -370,6 +386,9 @@ void BindHandles(py::module_& m) {
       .def("get_name", &Link::GetName)
       .def_property_readonly("name", &Link::GetName)
       .def("get_index", &Link::GetIndex, "Index in the articulation (0 is the root).")
+      .def("get_id", &Link::GetId,
+           "Scene-wide id (unique among actors, articulations and links): the link's entity id "
+           "in segmentation pictures.")
       .def("get_articulation_id", &Link::GetArticulationId)
       .def("get_parent_index", &Link::GetParentIndex, "Parent link index; -1 for the root.")
       .def("get_pose", &Link::GetPose, "X_WL: the link frame in the world.")
@@ -444,6 +463,7 @@ void BindHandles(py::module_& m) {
                            "included.")
       .def("get_id", &Articulation::GetId)
       .def("get_name", &Articulation::GetName)
+      .def("set_name", &Articulation::SetName, py::arg("name"))
       .def_property_readonly("name", &Articulation::GetName)
       .def("is_kinematic", &Articulation::IsKinematic)
       .def("has_fixed_root", &Articulation::HasFixedRoot)
@@ -497,9 +517,10 @@ void BindHandles(py::module_& m) {
            py::arg("damping"), py::arg("force_limit") = kInf,
            "Same drive parameters on every active joint.")
       .def("compute_passive_force", &Articulation::ComputePassiveForce, py::arg("gravity") = true,
-           py::arg("coriolis_and_centrifugal") = true,
-           "Generalized force (dof,) that cancels gravity and/or Coriolis and centrifugal "
-           "forces at the current state.")
+           py::arg("coriolis_and_centrifugal") = true, py::arg("external") = true,
+           "Generalized force (dof,) that cancels gravity, Coriolis and centrifugal forces and "
+           "the external forces added to the links for the next step, each when asked, at the "
+           "current state: set_qf(it) holds the articulation still.")
       .def("compute_forward_dynamics", &Articulation::ComputeForwardDynamics, py::arg("qf"),
            "Accelerations (dof,) from generalized forces qf, without contacts, limits or "
            "drives.")
@@ -531,10 +552,11 @@ void BindHandles(py::module_& m) {
 void BindContacts(py::module_& m) {
   py::class_<ContactPoint>(m, "ContactPoint", "One contact point between two bodies.")
       .def_readonly("position", &ContactPoint::position, "World position (3,), m.")
-      .def_readonly("normal", &ContactPoint::normal, "World normal (3,), from body0 to body1.")
+      .def_readonly("normal", &ContactPoint::normal,
+                    "World normal (3,), from body1 into body0 (as SAPIEN's).")
       .def_readonly("impulse", &ContactPoint::impulse,
-                    "World impulse (3,) on body1 over the last step, N s.")
-      .def_readonly("force", &ContactPoint::force, "World force (3,) on body1, N.")
+                    "World impulse (3,) on body0 (SAPIEN's actor0) over the last step, N s.")
+      .def_readonly("force", &ContactPoint::force, "World force (3,) on body0, N.")
       .def_readonly("separation", &ContactPoint::separation,
                     "Signed distance (m), negative when penetrating.");
 
@@ -688,8 +710,14 @@ void BindScene(py::module_& m) {
           py::arg("static_friction"), py::arg("dynamic_friction"), py::arg("restitution"),
           "Same as PhysicalMaterial(static_friction, dynamic_friction, restitution).")
       .def("add_ground", &Scene::AddGround, py::arg("altitude") = 0.0,
-           py::arg("material") = py::none(), py::arg("name") = "ground", ka,
-           "Adds a static ground plane at z = altitude (m).")
+           py::arg("material") = py::none(), py::arg("name") = "ground", py::arg("render") = true,
+           py::arg("render_half_size") = Eigen::Vector2d(10, 10),
+           py::arg("render_material") = py::none(), ka,
+           "Adds a static ground plane at z = altitude (m). Cameras see a square of "
+           "render_half_size (2,) m around the origin in render_material (light grey by "
+           "default), or nothing when render is False.")
+      .def("set_default_material", &Scene::SetDefaultMaterial, py::arg("material"),
+           "Material of the collision shapes that name none, those already built included.")
       .def("add_actor", &Scene::AddActor, py::arg("desc"), ka)
       .def("add_articulation", &Scene::AddArticulation, py::arg("desc"), ka)
       .def("remove_actor", &Scene::RemoveActor, py::arg("actor"))

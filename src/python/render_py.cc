@@ -171,6 +171,23 @@ void BindCamera(py::module_& m) {
            "Same as set_local_pose: the world pose of a free camera, the pose in the mount's "
            "frame of a mounted one.")
       .def("get_local_pose", &Camera::GetLocalPose)
+      .def(
+          "set_parent",
+          [](Camera& self, const py::object& parent, bool keep_pose) {
+            if (parent.is_none())
+              self.ClearParent(keep_pose);
+            else if (py::isinstance<Actor>(parent))
+              self.SetParent(parent.cast<const Actor&>(), keep_pose);
+            else if (py::isinstance<Link>(parent))
+              self.SetParent(parent.cast<const Link&>(), keep_pose);
+            else
+              throw Error("camera '" + self.GetName() +
+                          "': set_parent expects an Actor, a Link or None, got " +
+                          py::str(py::type::of(parent)).cast<std::string>());
+          },
+          py::arg("parent"), py::arg("keep_pose"),
+          "Mounts the camera on an actor or a link (None: the world). keep_pose=True keeps its "
+          "world pose; False keeps its local pose, now in the new parent's frame.")
       .def("set_local_pose", &Camera::SetLocalPose, py::arg("pose"),
            "World pose of a free camera, or pose in the mount's frame of a mounted one.")
       .def(

@@ -181,6 +181,44 @@ void Camera::SetLocalPose(const Pose& pose) {
 
 Pose Camera::GetLocalPose() const { return Entry(scene_, id_).local_pose; }
 
+namespace {
+
+// remounts camera `c` on a parent now at X_WP (identity for the world)
+void Remount(SceneImpl::CameraEntry& c, const Pose& X_WP, bool keep_pose) {
+  if (keep_pose) {
+    c.local_pose = X_WP.Inverse() * c.X_WC;
+  } else {
+    c.X_WC = X_WP * c.local_pose;
+  }
+  c.mount_actor = c.mount_articulation = c.mount_link = -1;
+}
+
+}  // namespace
+
+void Camera::SetParent(const Actor& parent, bool keep_pose) {
+  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  if (parent.GetScene() != scene_)
+    throw Error("camera '" + c.name + "': set_parent: the actor belongs to another scene");
+  scene_->impl().GetActor(parent.GetId());  // throws when removed
+  Remount(c, parent.GetPose(), keep_pose);
+  c.mount_actor = parent.GetId();
+}
+
+void Camera::SetParent(const Link& parent, bool keep_pose) {
+  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  if (parent.GetScene() != scene_)
+    throw Error("camera '" + c.name + "': set_parent: the link belongs to another scene");
+  const auto& art = scene_->impl().GetArticulation(parent.GetArticulationId());
+  if (parent.GetIndex() < 0 || parent.GetIndex() >= static_cast<int>(art.desc.links.size()))
+    throw Error("camera '" + c.name + "': set_parent: link index " +
+                std::to_string(parent.GetIndex()) + " out of range");
+  Remount(c, parent.GetPose(), keep_pose);
+  c.mount_articulation = parent.GetArticulationId();
+  c.mount_link = parent.GetIndex();
+}
+
+void Camera::ClearParent(bool keep_pose) { Remount(Entry(scene_, id_), Pose(), keep_pose); }
+
 void Camera::TakePicture(unsigned outputs) {
   SceneImpl::CameraEntry& c = Entry(scene_, id_);
   if (outputs == 0 || (outputs & ~unsigned{kAllOutputs}) != 0)

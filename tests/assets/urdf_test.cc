@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <string>
 
 #include "partsim/assets/generator.h"
@@ -1074,7 +1075,7 @@ TEST(UrdfSceneTest, MuJoCoErrorsNameTheUrdfsJoints) {
   } catch (const Error& e) {
     const std::string msg = e.what();
     EXPECT_NE(msg.find("joint 'stuck'"), std::string::npos) << msg;
-    EXPECT_EQ(msg.find("r1_"), std::string::npos) << msg;
+    EXPECT_FALSE(std::regex_search(msg, std::regex("\\br[0-9]+_[a-z]"))) << msg;
     EXPECT_EQ(msg.find("line ="), std::string::npos) << msg;
   }
   // an inertia that breaks A + B >= C given directly, past the URDF loader's repair
@@ -1090,7 +1091,7 @@ TEST(UrdfSceneTest, MuJoCoErrorsNameTheUrdfsJoints) {
     const std::string msg = e.what();
     EXPECT_NE(msg.find("A + B >= C"), std::string::npos) << msg;
     EXPECT_NE(msg.find("link 'lid'"), std::string::npos) << msg;
-    EXPECT_EQ(msg.find("r1_"), std::string::npos) << msg;
+    EXPECT_FALSE(std::regex_search(msg, std::regex("\\br[0-9]+_[a-z]"))) << msg;
   }
   EXPECT_EQ(scene.GetArticulations().size(), 1u);
 }

@@ -4,7 +4,9 @@
 #include <mujoco/mujoco.h>
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
 #include <cstring>
+#include <memory>
 
 #include "physics/test_worlds.h"
 
@@ -20,10 +22,10 @@ double TotalNormalForceZ(const Scene& scene, int actor_id) {
   double fz = 0;
   for (const Contact& c : scene.GetContacts()) {
     for (const ContactPoint& p : c.points) {
-      // force is on body1; flip it when the actor is body0
-      if (c.body1.actor_id == actor_id)
+      // force is on body0; flip it when the actor is body1
+      if (c.body0.actor_id == actor_id)
         fz += p.force.z();
-      else if (c.body0.actor_id == actor_id)
+      else if (c.body1.actor_id == actor_id)
         fz -= p.force.z();
     }
   }
@@ -49,14 +51,87 @@ TEST(SceneTest, ContactForceOfBoxAtRestEqualsWeight) {
   double weight = box.GetMass() * kG;
   EXPECT_NEAR(box.GetMass(), 8.0, 1e-9);  // (0.2 m)^3 * 1000 kg/m^3
   EXPECT_NEAR(TotalNormalForceZ(scene, box.GetId()), weight, 0.01 * weight);
-  // the contact names its bodies and points up from the ground
+  // the contact names its bodies (the static ground second) and points up into the box
   auto contacts = scene.GetContacts();
   ASSERT_FALSE(contacts.empty());
-  EXPECT_EQ(contacts[0].body0.name, "ground");
-  EXPECT_EQ(contacts[0].body1.name, "box");
+  EXPECT_EQ(contacts[0].body0.name, "box");
+  EXPECT_EQ(contacts[0].body1.name, "ground");
   EXPECT_GT(contacts[0].points[0].normal.z(), 0.99);
+  EXPECT_GT(contacts[0].points[0].impulse.z(), 0.0);
   EXPECT_NEAR(contacts[0].points[0].impulse.z(),
               contacts[0].points[0].force.z() * scene.GetTimestep(), 1e-12);
+}
+
+// Velocity damping (1/s), as PhysX's: dv/dt = -c v, integrated implicitly (backward Euler gives
+// v_n = v_0 / (1 + c dt)^n), about each body axis of a box whose inertia frame is turned.
+TEST(SceneTest, ActorDampingDecaysVelocitiesAtItsRate) {
+  Scene scene;
+  scene.SetGravity(Eigen::Vector3d::Zero());
+  const double dt = scene.GetTimestep();
+  Actor box = scene.CreateActorBuilder()
+                  .SetName("slab")
+                  .AddBoxCollision(Pose(), Eigen::Vector3d(0.3, 0.1, 0.05))
+                  .SetInitialPose(Pose(Eigen::Vector3d(0, 0, 1)))
+                  .Build();
+  box.SetDamping(2.0, 5.0);
+  EXPECT_EQ(box.GetLinearDamping(), 2.0);
+  EXPECT_EQ(box.GetAngularDamping(), 5.0);
+  // a second actor recompiles the model: the damping stays
+  Actor other = AddBox(scene, 0.05, 3.0, "other");
+  other.SetVelocity(Eigen::Vector3d(1, 0, 0));
+  box.SetVelocity(Eigen::Vector3d(1, -2, 0.5));
+  box.SetAngularVelocity(Eigen::Vector3d(0, 0, 3));  // about the slab's z: no precession
+  const int n = 100;
+  scene.Step(n);
+  const double lin = std::pow(1 + 2.0 * dt, -n), ang = std::pow(1 + 5.0 * dt, -n);
+  EXPECT_NEAR(box.GetVelocity().x(), lin, 1e-3);
+  EXPECT_NEAR(box.GetVelocity().y(), -2 * lin, 2e-3);
+  EXPECT_NEAR(box.GetAngularVelocity().z(), 3 * ang, 3e-3);
+  EXPECT_NEAR(other.GetVelocity().x(), 1.0, 1e-9);  // undamped
+  // clones carry it
+  std::unique_ptr<Scene> copy = scene.Clone();
+  Actor copied = copy->GetActors().front();
+  EXPECT_EQ(copied.GetLinearDamping(), 2.0);
+  const double v0 = copied.GetVelocity().x();
+  copy->Step(n);
+  EXPECT_NEAR(copied.GetVelocity().x(), v0 * lin, 1e-3);
+}
+
+// Backward Euler stays stable where an explicit decay (1 - c dt) would flip the sign and grow.
+TEST(SceneTest, StiffActorDampingIsStableAtLargeSteps) {
+  Scene scene;
+  scene.SetGravity(Eigen::Vector3d::Zero());
+  scene.SetTimestep(0.01);
+  Actor box = AddBox(scene, 0.1, 1.0);
+  box.SetDamping(1000.0, 1000.0);  // c dt = 10
+  box.SetVelocity(Eigen::Vector3d(5, 0, 0));
+  box.SetAngularVelocity(Eigen::Vector3d(0, 4, 0));
+  for (int i = 0; i < 10; ++i) {
+    scene.Step();
+    EXPECT_GE(box.GetVelocity().x(), 0.0);
+    EXPECT_LT(box.GetVelocity().norm(), 5.0 / std::pow(11.0, i + 1) + 1e-9);
+    EXPECT_LT(box.GetAngularVelocity().norm(), 4.0 / std::pow(11.0, i + 1) + 1e-9);
+  }
+}
+
+TEST(SceneTest, ActorDampingRefusesBadInput) {
+  Scene scene;
+  Actor ground = scene.AddGround(0.0);
+  Actor box = AddBox(scene, 0.1, 1.0);
+  EXPECT_THROW(ground.SetDamping(1, 1), Error);
+  EXPECT_THROW(box.SetDamping(-1, 0), Error);
+  EXPECT_THROW(box.SetDamping(0, std::nan("")), Error);
+  EXPECT_EQ(box.GetLinearDamping(), 0.0);  // unchanged by the refused calls
+  ActorDesc desc = box.GetDesc();
+  desc.name = "bad";
+  desc.linear_damping = -2;
+  try {
+    scene.AddActor(desc);
+    FAIL() << "negative damping accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("actor 'bad' damping"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(scene.GetActors().size(), 2u);
 }
 
 TEST(SceneTest, RestitutionSetsTheReboundSpeed) {
@@ -167,7 +242,8 @@ TEST(SceneTest, ForceLimitCapsDriveForce) {
   scene.Step(10);
   const mjData* d = scene.GetMjData();
   const mjModel* m = scene.GetMjModel();
-  int act = mj_name2id(m, mjOBJ_ACTUATOR, "r0_d1");
+  const std::string name = "r" + std::to_string(arm.GetId()) + "_d1";
+  int act = mj_name2id(m, mjOBJ_ACTUATOR, name.c_str());
   ASSERT_GE(act, 0);
   EXPECT_NEAR(std::abs(d->actuator_force[act]), 2.0, 1e-9);
   EXPECT_LT(arm.GetQpos()[0], 0.5);  // a 2 N m motor turns the arm slowly

@@ -50,12 +50,16 @@ class Actor {
   Actor() = default;
   Actor(Scene* scene, int id) : scene_(scene), id_(id) {}
 
+  /// Scene-wide id, unique among actors, articulations and links; also the actor's entity id in
+  /// segmentation pictures.
   int GetId() const { return id_; }
   const std::string& GetName() const;
+  void SetName(const std::string& name);
   ActorType GetType() const;
   /// X_WA: the actor's frame in the world.
   Pose GetPose() const;
-  /// Teleports the actor (dynamic or kinematic); static actors refuse.
+  /// Teleports the actor. A static actor is moved in the model: meant for placing it before
+  /// simulating (what rests on it is not carried along).
   void SetPose(const Pose& pose);
   /// World-frame linear velocity of the actor's origin (m/s).
   Eigen::Vector3d GetVelocity() const;
@@ -65,6 +69,12 @@ class Actor {
   void SetAngularVelocity(const Eigen::Vector3d& w);
   /// Mass (kg) as compiled.
   double GetMass() const;
+  /// Velocity damping (1/s, >= 0) of a dynamic actor, as PhysX's: the linear velocity decays as
+  /// dv/dt = -linear v, the angular as dw/dt = -angular w (about each body axis, with the body's
+  /// inertia about that axis). Integrated implicitly. Static and kinematic actors refuse.
+  void SetDamping(double linear, double angular);
+  double GetLinearDamping() const;
+  double GetAngularDamping() const;
   /// Adds a world-frame force (N) at a world point (m) for the next step.
   void AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point);
   /// Adds a world-frame force (N) at the centre of mass and a torque (N m) for the next step.
@@ -91,6 +101,9 @@ class Link {
   /// Index of the link in its articulation (0 is the root).
   int GetIndex() const { return index_; }
   int GetArticulationId() const { return articulation_id_; }
+  /// Scene-wide id of the link, unique among actors, articulations and links: its entity id in
+  /// segmentation pictures (an actor's is Actor::GetId()).
+  int GetId() const;
   /// Index of the parent link, -1 for the root.
   int GetParentIndex() const;
   /// X_WL: the link frame in the world.
@@ -211,6 +224,7 @@ class Articulation {
 
   int GetId() const { return id_; }
   const std::string& GetName() const;
+  void SetName(const std::string& name);
   bool IsKinematic() const;
   bool HasFixedRoot() const;
   int Dof() const;
@@ -259,10 +273,11 @@ class Articulation {
   /// Same drive parameters on every active joint.
   void SetDriveProperty(double stiffness, double damping, double force_limit = kInf);
 
-  /// Generalized force that cancels gravity and/or Coriolis and centrifugal forces at the
-  /// current state (apply it with SetQf to hold a pose).
-  Eigen::VectorXd ComputePassiveForce(bool gravity = true,
-                                      bool coriolis_and_centrifugal = true) const;
+  /// Generalized force that cancels gravity, Coriolis and centrifugal forces, and the external
+  /// forces added to the links for the next step (AddForceAtPoint, AddForceTorque), each when
+  /// asked, at the current state (apply it with SetQf to hold a pose).
+  Eigen::VectorXd ComputePassiveForce(bool gravity = true, bool coriolis_and_centrifugal = true,
+                                      bool external = true) const;
   /// Accelerations produced by generalized forces qf at the current state, without contacts,
   /// limits or drives: M^-1 (qf - bias).
   Eigen::VectorXd ComputeForwardDynamics(const Eigen::VectorXd& qf) const;
@@ -291,9 +306,9 @@ class Articulation {
 /// One contact point between two bodies.
 struct ContactPoint {
   Eigen::Vector3d position;  ///< world (m)
-  Eigen::Vector3d normal;    ///< world, pointing from body 0 to body 1
-  Eigen::Vector3d impulse;   ///< world, impulse on body 1 over the last step (N s)
-  Eigen::Vector3d force;     ///< world, force on body 1 (N)
+  Eigen::Vector3d normal;    ///< world, pointing from body 1 into body 0
+  Eigen::Vector3d impulse;   ///< world, impulse on body 0 over the last step (N s)
+  Eigen::Vector3d force;     ///< world, force on body 0 (N)
   double separation = 0.0;   ///< signed distance (m), negative when penetrating
 };
 
@@ -308,7 +323,9 @@ struct ContactBody {
   std::string name;          ///< actor or link name
 };
 
-/// The contact between two shapes, with its points.
+/// The contact between two shapes, with its points. When one of the two is a static actor (the
+/// ground, a wall) and the other is not, the static one is body 1: a box resting on the ground
+/// reads an upward normal and impulse.
 struct Contact {
   ContactBody body0;
   ContactBody body1;
@@ -344,9 +361,15 @@ class Scene {
   ArticulationBuilder CreateArticulationBuilder();
   UrdfLoader CreateUrdfLoader();
 
-  /// Adds a static ground plane at z = altitude.
+  /// Adds a static ground plane at z = altitude. Cameras see a square of `render_half_size`
+  /// (m) around the origin with `render_material`, or nothing when `render` is false.
   Actor AddGround(double altitude = 0.0, const std::optional<PhysicalMaterial>& material = {},
-                  const std::string& name = "ground");
+                  const std::string& name = "ground", bool render = true,
+                  const Eigen::Vector2d& render_half_size = Eigen::Vector2d(10, 10),
+                  const std::optional<RenderMaterial>& render_material = {});
+  /// The material of collision shapes that name none: SceneConfig::default_material, which
+  /// this replaces for the shapes already in the scene too (the model is recompiled).
+  void SetDefaultMaterial(const PhysicalMaterial& material);
   /// Adds an actor or articulation (validated first); the state of everything else is kept.
   Actor AddActor(const ActorDesc& desc);
   Articulation AddArticulation(const ArticulationDesc& desc);
@@ -474,6 +497,11 @@ class BodyBuilder {
   Derived& AddVisualFromFile(const std::string& filename, const Pose& pose = Pose(),
                              const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
                              const std::string& name = "");
+  /// Number of visuals added so far.
+  int GetVisualCount();
+  /// Replaces the material of visual `index` (in the order added); throws naming the index
+  /// when out of range.
+  Derived& SetVisualMaterial(int index, const RenderMaterial& material);
   /// Explicit mass (kg), centre-of-mass pose in the body and principal inertia (kg m^2).
   Derived& SetMassAndInertia(double mass, const Pose& cmass_local_pose,
                              const Eigen::Vector3d& inertia);

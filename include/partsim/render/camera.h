@@ -57,6 +57,12 @@ class Camera {
   /// For a free camera, its world pose; for a mounted one, its pose in the mount's frame.
   void SetLocalPose(const Pose& pose);
   Pose GetLocalPose() const;
+  /// Mounts the camera on an actor or a link of its scene, or frees it (ClearParent). With
+  /// `keep_pose` the camera stays where it is in the world (its local pose is recomputed);
+  /// otherwise its local pose is kept and now counts in the new parent's frame.
+  void SetParent(const Actor& parent, bool keep_pose);
+  void SetParent(const Link& parent, bool keep_pose);
+  void ClearParent(bool keep_pose);
 
   /// Renders the scene as of the last Scene::UpdateRender() with the scene's backend.
   /// `outputs` (PictureOutput bits, at least one) names the outputs to render; the others stay
