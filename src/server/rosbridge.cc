@@ -152,8 +152,8 @@ struct RosbridgeServer::Impl {
   };
   struct Outgoing {
     std::string data;
-    size_t bound;  // queue bound of its subscription
     bool binary;
+    std::string topic;  // the subscription it was published for; "" for replies and statuses
   };
   /// An incoming message arriving in fragments.
   struct Partial {
@@ -207,12 +207,30 @@ struct RosbridgeServer::Impl {
 
   // ---- outgoing ----
   /// Queues a message for a client from any thread; drops the oldest beyond the bound.
-  void Enqueue(const ClientPtr& c, const std::string& msg, size_t bound, bool binary = false) {
+  /// Queues a message for a client. A message published for `topic` keeps at most `bound` (the
+  /// subscription's queue_length; 0: max_client_queue) of that topic's messages waiting, the
+  /// oldest dropped first; replies and statuses (no topic) are only dropped when the whole queue
+  /// exceeds max_client_queue, so that a busy subscription never evicts a service response.
+  void Enqueue(const ClientPtr& c, const std::string& msg, size_t bound, bool binary = false,
+               const std::string& topic = "") {
     if (bound == 0 || bound > options.max_client_queue) bound = options.max_client_queue;
     {
       std::lock_guard<std::mutex> lock(c->out_mutex);
-      c->out.push_back({msg, bound, binary});
-      while (c->out.size() > bound) {
+      c->out.push_back({msg, binary, topic});
+      if (!topic.empty()) {
+        size_t same = 0;
+        for (const Outgoing& o : c->out) same += o.topic == topic;
+        for (auto it = c->out.begin(); same > bound && it != c->out.end();) {
+          if (it->topic == topic) {
+            it = c->out.erase(it);
+            --same;
+            ++dropped;
+          } else {
+            ++it;
+          }
+        }
+      }
+      while (c->out.size() > options.max_client_queue) {
         c->out.pop_front();
         ++dropped;
       }
@@ -366,14 +384,14 @@ struct RosbridgeServer::Impl {
           std::vector<uint8_t> bytes = json::to_cbor(msg);
           cbor.assign(bytes.begin(), bytes.end());
         }
-        Enqueue(c, cbor, s.queue_length, true);
+        Enqueue(c, cbor, s.queue_length, true, topic);
         continue;
       }
       if (text.empty()) text = Dump(TextForm(msg));
       if (s.fragment_size > 0 && text.size() > s.fragment_size)
-        EnqueueFragments(c, text, s);
+        EnqueueFragments(c, text, s, topic);
       else
-        Enqueue(c, text, s.queue_length);
+        Enqueue(c, text, s.queue_length, false, topic);
     }
   }
   /// The message for JSON clients: binary fields become base64 strings.
@@ -384,7 +402,8 @@ struct RosbridgeServer::Impl {
     return j;
   }
   /// rosbridge fragments: pieces of at most fragment_size characters of the JSON text.
-  void EnqueueFragments(const ClientPtr& c, const std::string& text, const Subscription& s) {
+  void EnqueueFragments(const ClientPtr& c, const std::string& text, const Subscription& s,
+                        const std::string& topic) {
     const size_t n = (text.size() + s.fragment_size - 1) / s.fragment_size;
     const std::string id = "partsim_fragment_" + std::to_string(next_fragment++);
     // the bound counts whole messages: all pieces of one message fit together
@@ -396,7 +415,7 @@ struct RosbridgeServer::Impl {
                         {"data", text.substr(i * s.fragment_size, s.fragment_size)},
                         {"num", i},
                         {"total", n}}),
-              bound);
+              bound, false, topic);
   }
   static json Header(double t, const std::string& frame) {
     return {{"seq", 0}, {"stamp", Stamp(t)}, {"frame_id", frame}};
@@ -892,7 +911,7 @@ struct RosbridgeServer::Impl {
       std::lock_guard<std::mutex> lock(clients_mutex);
       for (auto& [h, other] : clients) {
         auto it = other->subs.find(topic);
-        if (it != other->subs.end()) Enqueue(other, text, it->second.queue_length);
+        if (it != other->subs.end()) Enqueue(other, text, it->second.queue_length, false, topic);
       }
     } else if (op == "call_service") {
       std::string service = Name(j, "service", op);
