@@ -29,6 +29,12 @@ namespace partsim {
 namespace ob = ompl::base;
 namespace og = ompl::geometric;
 
+namespace {
+
+bool Cancelled(const PlannerOptions& opt) { return opt.cancel && opt.cancel->load(); }
+
+}  // namespace
+
 struct MotionPlanner::Impl {
   Articulation arm;
   std::vector<std::string> names;
@@ -374,7 +380,13 @@ PlanResult MotionPlanner::Impl::Plan(const Eigen::VectorXd& goal_in, const Plann
       if (round > 2 && left <= 0) break;
       ss.clear();
     }
-    ob::PlannerStatus status = ss.solve(std::max(left, round == 0 ? opt.time_limit : 0.25));
+    // the time left, or sooner when the caller cancels
+    const double budget = std::max(left, round == 0 ? opt.time_limit : 0.25);
+    const std::atomic<bool>* cancel = opt.cancel;
+    ob::PlannerStatus status = ss.solve(ob::plannerOrTerminationCondition(
+        ob::timedPlannerTerminationCondition(budget),
+        ob::PlannerTerminationCondition([cancel] { return cancel && cancel->load(); })));
+    if (Cancelled(opt)) return fail("cancelled");
     if (!status || !ss.haveExactSolutionPath()) {
       if (round > 0) break;
       return fail("no collision-free path found in " + std::to_string(opt.time_limit) + " s (" +
@@ -439,6 +451,10 @@ PlanResult MotionPlanner::PlanToPose(const std::string& link, const Pose& tcp_of
   Eigen::VectorXd best;
   std::string last = "IK found no solution";
   for (int a = 0; a < std::max(1, options.ik_attempts); ++a) {
+    if (Cancelled(options)) {
+      last = "cancelled";
+      break;
+    }
     Eigen::VectorXd init = p.base_q;
     if (a > 0)
       for (int i = 0; i < n; ++i)

@@ -32,6 +32,10 @@ using WallClock = std::chrono::steady_clock;
 // serialisation would recurse that deep.
 constexpr int kMaxJsonDepth = 64;
 
+// Most pieces of fragmented messages held for one client at a time (each costs a map node
+// beside its bytes): a 16 MB message arrives in pieces of 256 bytes or more.
+constexpr size_t kMaxFragmentsHeld = 65536;
+
 // Text of a JSON value; bytes that are not UTF-8 (a client's string quoted back in an error)
 // become U+FFFD instead of throwing.
 std::string Dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
@@ -91,12 +95,25 @@ json Stamp(double t) {
           {"nsecs", static_cast<long long>(std::llround((t - secs) * 1e9)) % 1000000000}};
 }
 
-/// Reads a ROS duration {secs, nsecs} (or a number of seconds).
-double Duration(const json& d) {
-  if (d.is_number()) return d.get<double>();
-  if (!d.is_object()) throw Error("time_from_start is not a duration");
-  double s = d.value("secs", 0.0) + d.value("nsecs", 0.0) * 1e-9;
-  if (d.contains("sec")) s = d.value("sec", 0.0) + d.value("nanosec", 0.0) * 1e-9;
+/// Reads a ROS duration {secs, nsecs} ({sec, nanosec} in ROS 2, or a number of seconds) of
+/// `what`; it must be finite and within [0, kMaxTrajectorySeconds].
+double Duration(const json& d, const std::string& what) {
+  auto field = [&](const char* k) {
+    if (!d.contains(k)) return 0.0;
+    if (!d[k].is_number()) throw Error(what + "." + k + " is not a number");
+    return d[k].get<double>();
+  };
+  double s = 0.0;
+  if (d.is_number())
+    s = d.get<double>();
+  else if (!d.is_object())
+    throw Error(what + " is not a duration");
+  else if (d.contains("sec"))
+    s = field("sec") + field("nanosec") * 1e-9;
+  else
+    s = field("secs") + field("nsecs") * 1e-9;
+  if (!std::isfinite(s) || s < 0 || s > kMaxTrajectorySeconds)
+    throw Error(what + " must be from 0 to 86400 s, got " + Dump(s));
   return s;
 }
 
@@ -156,10 +173,12 @@ struct RosbridgeServer::Impl {
     std::string topic;  // the subscription it was published for; "" for replies and statuses
   };
   /// An incoming message arriving in fragments.
+  /// Only the pieces received are held: memory follows the bytes a client sent, never the
+  /// `total` it announced.
   struct Partial {
-    std::vector<std::string> pieces;
-    std::vector<char> got;
-    size_t received = 0, bytes = 0;
+    size_t total = 0;
+    std::map<size_t, std::string> pieces;  // num -> data
+    size_t bytes = 0;
   };
   struct Client {
     Hdl hdl;
@@ -579,7 +598,9 @@ struct RosbridgeServer::Impl {
       cmd.positions.push_back(Numbers(p["positions"], where + ".positions"));
       if (p.contains("velocities") && p["velocities"].is_array() && !p["velocities"].empty())
         cmd.velocities.push_back(Numbers(p["velocities"], where + ".velocities"));
-      cmd.times.push_back(p.contains("time_from_start") ? Duration(p["time_from_start"]) : 0.0);
+      cmd.times.push_back(p.contains("time_from_start")
+                              ? Duration(p["time_from_start"], where + ".time_from_start")
+                              : 0.0);
     }
     if (!cmd.velocities.empty() && cmd.velocities.size() != cmd.positions.size())
       cmd.velocities.clear();  // velocities on some points only: interpolate positions alone
@@ -624,11 +645,18 @@ struct RosbridgeServer::Impl {
       sim->Reset();
       values = json::object();
     } else if (service == "/partsim/step") {
-      int n = 1;
+      long long n = 1;
       if (args.is_object() && args.contains("n")) {
-        if (!args["n"].is_number_integer() || args["n"].get<int>() < 1)
-          throw Error("/partsim/step: n must be a positive integer");
-        n = args["n"].get<int>();
+        // the whole range is checked: no integer is truncated into a valid one
+        const json& a = args["n"];
+        const bool in_range =
+            a.is_number_unsigned()
+                ? a.get<uint64_t>() <= static_cast<uint64_t>(SimServer::kMaxStepRequest)
+                : a.is_number_integer();
+        if (!in_range || a.get<long long>() < 1)
+          throw Error("/partsim/step: n must be an integer from 1 to " +
+                      std::to_string(SimServer::kMaxStepRequest) + ", got " + Dump(a));
+        n = a.get<long long>();
       }
       sim->StepN(n);
       values = json::object();
@@ -789,31 +817,46 @@ struct RosbridgeServer::Impl {
       throw Error("fragment needs integers 0 <= num < total");
     const std::string key = j["id"].is_string() ? j["id"].get<std::string>() : Dump(j["id"]);
     const size_t total = j["total"].get<size_t>(), num = j["num"].get<size_t>();
-    if (total > options.max_message_bytes) throw Error("fragment: total is too large");
+    if (total > kMaxFragmentsHeld)
+      throw Error("fragment: total " + std::to_string(total) + " is more than " +
+                  std::to_string(kMaxFragmentsHeld) + " pieces");
     auto it = c->partial.find(key);
     if (it == c->partial.end()) {
       if (c->partial.size() >= 16) throw Error("fragment: too many messages in pieces at once");
       it = c->partial.emplace(key, Partial()).first;
-      it->second.pieces.resize(total);
-      it->second.got.assign(total, 0);
+      it->second.total = total;
     }
     Partial& p = it->second;
-    if (p.pieces.size() != total) {
+    if (p.total != total) {
       c->partial.erase(it);
       throw Error("fragment '" + key + "': total changed between pieces");
     }
-    if (!p.got[num]) ++p.received;
-    p.got[num] = 1;
-    p.bytes = p.bytes - p.pieces[num].size() + j["data"].get_ref<const std::string&>().size();
-    p.pieces[num] = j["data"].get<std::string>();
-    if (p.bytes > options.max_message_bytes) {
+    const std::string& data = j["data"].get_ref<const std::string&>();
+    // the bytes held for this client, all its messages in pieces together, stay within one
+    // message's bound
+    size_t held = 0, held_pieces = 0;
+    for (const auto& [k, other] : c->partial) {
+      held += other.bytes;
+      held_pieces += other.pieces.size();
+    }
+    if (held_pieces >= kMaxFragmentsHeld && !p.pieces.count(num)) {
       c->partial.erase(it);
-      throw Error("fragment '" + key + "': the message exceeds " +
+      throw Error("fragment '" + key + "': more than " + std::to_string(kMaxFragmentsHeld) +
+                  " pieces held for this client");
+    }
+    auto old_piece = p.pieces.find(num);
+    const size_t replaced = old_piece == p.pieces.end() ? 0 : old_piece->second.size();
+    if (held - replaced + data.size() > options.max_message_bytes) {
+      c->partial.erase(it);
+      throw Error("fragment '" + key + "': the pieces held for this client exceed " +
                   std::to_string(options.max_message_bytes) + " bytes");
     }
-    if (p.received < total) return false;
+    p.bytes = p.bytes - replaced + data.size();
+    p.pieces[num] = data;
+    if (p.pieces.size() < total) return false;
     whole->clear();
-    for (const std::string& piece : p.pieces) *whole += piece;
+    whole->reserve(p.bytes);
+    for (const auto& [k, piece] : p.pieces) *whole += piece;
     c->partial.erase(it);
     return true;
   }

@@ -76,6 +76,7 @@ struct ServedRobot::Impl {
   std::condition_variable jobs_cv;
   std::deque<std::function<void()>> jobs;
   bool stopping = false;
+  std::atomic<bool> cancel_planning{false};
 
   /// Runs `apply` on the simulation thread between steps, counting the latency.
   void Post(std::function<void()> apply, ErrorSink on_error) {
@@ -240,13 +241,18 @@ struct ServedRobot::Impl {
     auto done = std::make_shared<std::promise<void>>();
     std::future<void> fut = done->get_future();
     sim->Post([f, done] {
-      f();
-      done->set_value();
+      try {
+        f();
+        done->set_value();
+      } catch (...) {  // to the waiting thread, not the simulation thread's
+        done->set_exception(std::current_exception());
+      }
     });
     while (fut.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
       std::lock_guard<std::mutex> lock(jobs_mutex);
       if (stopping) return false;
     }
+    fut.get();  // rethrows what f threw
     return true;
   }
 };
@@ -301,6 +307,7 @@ void ServedRobot::Close() {
     std::lock_guard<std::mutex> lock(impl_->jobs_mutex);
     impl_->stopping = true;
   }
+  impl_->cancel_planning = true;  // a plan under way stops within milliseconds
   impl_->jobs_cv.notify_all();
   if (impl_->worker.joinable()) impl_->worker.join();
 }
@@ -334,8 +341,10 @@ void ServedRobot::CheckTrajectory(const TrajectoryCommand& c, const std::string&
                 std::to_string(c.times.size()) + " points");
   for (size_t k = 0; k < c.times.size(); ++k) {
     const std::string p = what + " point " + std::to_string(k);
-    if (!std::isfinite(c.times[k]) || c.times[k] < 0)
-      throw Error(p + ": time_from_start must be finite and >= 0");
+    if (!std::isfinite(c.times[k]) || c.times[k] < 0 || c.times[k] > kMaxTrajectorySeconds)
+      throw Error(p + ": time_from_start must be from 0 to " +
+                  std::to_string(static_cast<int>(kMaxTrajectorySeconds)) + " s, got " +
+                  std::to_string(c.times[k]));
     if (k > 0 && !(c.times[k] > c.times[k - 1]))
       throw Error(p + ": time_from_start does not come after the previous point's");
     CheckValues(c.positions[k], index.size(), p + " positions");
@@ -425,11 +434,17 @@ void ServedRobot::Plan(const PlanRequest& request, PlanCallback on_result, DoneC
     throw Error("plan: pose_goal must be finite with a unit quaternion");
   PlannerOptions opt = request.options;
   opt.use_last_snapshot = true;
+  opt.cancel = &m->cancel_planning;
   try {  // now, so that a bad request fails on the caller's thread
     CheckPlannerOptions(opt);
   } catch (const Error& e) {
     throw Error(std::string("plan: ") + e.what());
   }
+  // one worker plans for every client: a long request would hold up the others
+  if (opt.time_limit > kMaxPlanSeconds)
+    throw Error("plan: time_limit must be at most " +
+                std::to_string(static_cast<int>(kMaxPlanSeconds)) + " s, got " +
+                std::to_string(opt.time_limit));
   {
     std::lock_guard<std::mutex> lock(m->jobs_mutex);
     if (m->stopping) throw Error("plan: the server is shutting down");

@@ -1,6 +1,9 @@
 #include "partsim/server/sim_server.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <string>
 
 #include "partsim/core/error.h"
 
@@ -37,6 +40,7 @@ void SimServer::Stop() {
 
 void SimServer::Pause() {
   paused_ = true;
+  pending_steps_ = 0;  // a pause stops a StepN burst too
   cv_.notify_all();
 }
 
@@ -49,14 +53,47 @@ void SimServer::Resume() {
   cv_.notify_all();
 }
 
-void SimServer::StepN(int n) {
-  if (n <= 0) return;
-  pending_steps_ += n;
+void SimServer::StepN(long long n) {
+  if (n < 1 || n > kMaxStepRequest)
+    throw Error("step: n must be an integer from 1 to " + std::to_string(kMaxStepRequest) +
+                ", got " + std::to_string(n));
+  long long pending = pending_steps_.load();
+  while (!pending_steps_.compare_exchange_weak(pending, std::min(pending + n, kMaxStepRequest))) {
+  }
   cv_.notify_all();
 }
 
 void SimServer::Reset() {
+  pending_steps_ = 0;
   Post([this] { scene_->Unpack(initial_state_); });
+}
+
+std::string SimServer::GetLastError() const {
+  std::lock_guard<std::mutex> lock(error_mutex_);
+  return last_error_;
+}
+
+void SimServer::RecordError(const std::string& message) {
+  const long long n = ++errors_;
+  {
+    std::lock_guard<std::mutex> lock(error_mutex_);
+    last_error_ = message;
+  }
+  if (n <= 20 || n % 1000 == 0)
+    std::fprintf(stderr, "partsim: simulation thread: %s (error %lld; the simulation goes on)\n",
+                 message.c_str(), n);
+}
+
+template <class F>
+void SimServer::Guarded(const char* what, F&& f) {
+  // nothing that runs on the simulation thread may end it (or the process)
+  try {
+    f();
+  } catch (const std::exception& e) {
+    RecordError(std::string(what) + ": " + e.what());
+  } catch (...) {
+    RecordError(std::string(what) + ": unknown exception");
+  }
 }
 
 void SimServer::Post(Command command) {
@@ -81,7 +118,7 @@ void SimServer::RunCommands(std::unique_lock<std::mutex>& lock) {
   pending.swap(queue_);
   lock.unlock();
   for (Command& c : pending) {
-    c();
+    Guarded("command", c);
     ++commands_run_;
   }
   lock.lock();
@@ -124,12 +161,15 @@ void SimServer::Loop() {
       resync_ = true;
     }
     lock.unlock();
-    if (loop_)
-      loop_->Step(1);
-    else
-      scene_->Step(1);
+    Guarded("step", [this] {
+      if (loop_)
+        loop_->Step(1);
+      else
+        scene_->Step(1);
+    });
     const long long now_steps = ++clock_steps_;
-    for (const StepCallback& callback : callbacks_) callback(now_steps);
+    for (const StepCallback& callback : callbacks_)
+      Guarded("step callback", [&] { callback(now_steps); });
     lock.lock();
   }
 }

@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <thread>
 
 #include "partsim/core/error.h"
 #include "partsim/robot/controllers.h"
@@ -179,6 +182,33 @@ TEST(MotionPlanner, GoalInsideTheObstacleFailsCleanly) {
   EXPECT_FALSE(r.success);
   EXPECT_FALSE(r.message.empty());
   EXPECT_EQ(w.scene.Pack(), before);
+}
+
+// RRT* improves its path until the time limit: a cancel from another thread ends it at once
+// (a server shutting down must not wait for a 20 s plan).
+TEST(MotionPlanner, CancelStopsPlanningWithinTheTimeLimit) {
+  PandaWorld w;
+  MotionPlanner planner(w.arm, w.robot.arm_joints, w.VelocityLimits(), VectorXd::Constant(7, 2.0));
+  std::atomic<bool> cancel{false};
+  PlannerOptions opt;
+  opt.algorithm = "RRTstar";
+  opt.time_limit = 20.0;
+  opt.cancel = &cancel;
+  std::thread canceller([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    cancel = true;
+  });
+  PlanResult r = planner.PlanToJoints(w.goal, opt);
+  canceller.join();
+  EXPECT_FALSE(r.success);
+  EXPECT_EQ(r.message, "cancelled");
+  EXPECT_LT(r.planning_time, 10.0);
+  // cancelled before it starts: a pose goal gives up too
+  KinematicModel km = KinematicModel::FromArticulation(w.arm);
+  Pose reachable = km.LinkPose(w.Full(w.goal), km.LinkIndex(w.robot.ee_link), w.robot.tcp_in_ee);
+  r = planner.PlanToPose(w.robot.ee_link, w.robot.tcp_in_ee, reachable, opt);
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.message.find("cancelled"), std::string::npos) << r.message;
 }
 
 TEST(MotionPlanner, BadRequests) {

@@ -568,6 +568,105 @@ TEST_F(RosbridgeTest, FragmentedCommandIsReassembledAndBadFragmentsAreRefused) {
   EXPECT_EQ(bridge_->GetStats().commands, 1);
 }
 
+// Fragments announcing 16,777,216 pieces once reserved ~0.5 GB each; now what is held follows
+// the bytes received, and an absurd total is refused.
+TEST_F(RosbridgeTest, FragmentsAnnouncingHugeTotalsAreRefusedAndHoldNoMemory) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  for (int k = 0; k < 4; ++k)
+    c.Send(json{{"op", "fragment"},
+                {"id", "huge" + std::to_string(k)},
+                {"data", std::string(100, 'x')},
+                {"num", 0},
+                {"total", 16777216}});
+  for (int k = 0; k < 4; ++k) {
+    const std::string id = "huge" + std::to_string(k);
+    json e = c.WaitMessage([&](const json& m) { return m.value("id", "") == id; });
+    ASSERT_TRUE(IsError(e)) << id << ": " << e.dump();
+    EXPECT_NE(e["msg"].get<std::string>().find("more than 65536 pieces"), std::string::npos)
+        << e["msg"];
+  }
+  // allowed totals hold only what came: 16 messages of 65536 announced pieces, one piece each
+  for (int k = 0; k < 16; ++k)
+    c.Send(json{{"op", "fragment"},
+                {"id", "many" + std::to_string(k)},
+                {"data", "y"},
+                {"num", 0},
+                {"total", 65536}});
+  // a 17th message in pieces at once is refused
+  c.Send(json{{"op", "fragment"}, {"id", "many16"}, {"data", "y"}, {"num", 0}, {"total", 2}});
+  json e = c.WaitMessage([](const json& m) { return m.value("id", "") == "many16"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("too many messages"), std::string::npos) << e["msg"];
+  c.Send(json{{"op", "subscribe"}, {"topic", "/clock"}});
+  EXPECT_TRUE(ClockAdvances(c, 0.05));
+}
+
+// /partsim/step's n was read as an int: 2^32 + 1 ran 1 step, 2^32 + 2^31 - 1 queued 2^31 - 1
+// steps that pause and reset did not cancel.
+TEST_F(RosbridgeTest, StepServiceChecksTheWholeRangeOfN) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "call_service"}, {"service", "/partsim/pause"}, {"id", "p"}});
+  ASSERT_FALSE(c.WaitMessage([](const json& m) { return m.value("id", "") == "p"; }).is_null());
+  const std::vector<json> bad = {json(4294967297LL), json(6442450943LL), json(-3),     json(0),
+                                 json(2.5),          json("7"),          json(1000001)};
+  for (size_t k = 0; k < bad.size(); ++k) {
+    const std::string id = "s" + std::to_string(k);
+    c.Send(json{{"op", "call_service"},
+                {"service", "/partsim/step"},
+                {"args", {{"n", bad[k]}}},
+                {"id", id}});
+    json e = c.WaitMessage([&](const json& m) { return m.value("id", "") == id; });
+    ASSERT_TRUE(IsError(e) || e.value("result", true) == false) << bad[k] << ": " << e.dump();
+    EXPECT_NE(e.dump().find("from 1 to 1000000"), std::string::npos) << e.dump();
+  }
+  EXPECT_EQ(sim_->GetPendingSteps(), 0);
+  // the largest request is taken, and a pause cancels what is left of it
+  c.Send(json{{"op", "call_service"},
+              {"service", "/partsim/step"},
+              {"args", {{"n", 1000000}}},
+              {"id", "big"}});
+  ASSERT_FALSE(c.WaitMessage([](const json& m) { return m.value("id", "") == "big"; }).is_null());
+  ASSERT_TRUE(WaitFor([&] { return sim_->GetClockSteps() > 10; }));
+  c.Send(json{{"op", "call_service"}, {"service", "/partsim/pause"}, {"id", "p2"}});
+  ASSERT_FALSE(c.WaitMessage([](const json& m) { return m.value("id", "") == "p2"; }).is_null());
+  EXPECT_EQ(sim_->GetPendingSteps(), 0);
+}
+
+// A trajectory point 1e200 s away made the drive targets not finite on the simulation thread,
+// which ended the process: now the command is refused naming the field, and the clock goes on.
+TEST_F(RosbridgeTest, TrajectoryWithAFarTimeIsRefusedAndTheSimulationGoesOn) {
+  auto c = ClockWatcher();
+  const std::string topic = "/" + robot_.GetName() + "/joint_trajectory_controller/command";
+  c->Send(json{{"op", "advertise"}, {"topic", topic}, {"type", "trajectory_msgs/JointTrajectory"}});
+  std::vector<std::string> names;
+  for (const Joint& j : robot_.GetActiveJoints()) names.push_back(j.GetName());
+  json point = {{"positions", std::vector<double>(names.size(), 0.1)},
+                {"time_from_start", {{"secs", 1e200}, {"nsecs", 0}}}};
+  c->Send(json{{"op", "publish"},
+               {"topic", topic},
+               {"msg", {{"joint_names", names}, {"points", {point}}}},
+               {"id", "far"}});
+  json e = c->WaitMessage([](const json& m) { return m.value("id", "") == "far"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("points[0].time_from_start must be from 0 to 86400"),
+            std::string::npos)
+      << e["msg"];
+  point["time_from_start"] = {{"secs", "soon"}};
+  c->Send(json{{"op", "publish"},
+               {"topic", topic},
+               {"msg", {{"joint_names", names}, {"points", {point}}}},
+               {"id", "word"}});
+  e = c->WaitMessage([](const json& m) { return m.value("id", "") == "word"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("time_from_start.secs is not a number"),
+            std::string::npos)
+      << e["msg"];
+  EXPECT_TRUE(ClockAdvances(*c, 0.05));
+  EXPECT_EQ(sim_->GetErrorCount(), 0);
+}
+
 TEST_F(RosbridgeTest, SubscriptionWithFragmentSizeGetsPiecesThatRebuildTheMessage) {
   TestClient c(port_);
   ASSERT_TRUE(c.WaitOpen());

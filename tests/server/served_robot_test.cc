@@ -16,6 +16,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "partsim/core/error.h"
@@ -317,6 +318,9 @@ TEST(ServedRobotTest, MalformedCommandsThrowNamingTheProblemAndTheRobotKeepsWork
   ExpectError([&] { send(c); }, "time_from_start");
   c = MoveX(0.1, -1.0);
   ExpectError([&] { send(c); }, "time_from_start");
+  // finite but far off: a spline over 1e200 s has no finite targets
+  c = MoveX(0.1, 1e200);
+  ExpectError([&] { send(c); }, "time_from_start must be from 0 to 86400 s");
   c = MoveX(0.1, 1.0);
   c.times = {0.5, 0.5};
   c.positions = {{0.1}, {0.2}};
@@ -557,6 +561,12 @@ TEST(ServedRobotTest, MalformedPlanRequestsThrowAndAnUnreachablePoseFails) {
   req.options.time_limit = 1.0;
   req.options.algorithm = "Nope";
   ExpectError([&] { plan(req); }, "algorithm");
+  // one worker plans for every client: no request may hold it for long
+  req.options.algorithm = "RRTConnect";
+  for (double t : {1e6, 1e308}) {
+    req.options.time_limit = t;
+    ExpectError([&] { plan(req); }, "time_limit must be at most 30 s");
+  }
 
   // a pose far out of reach: an answer with success = false and a reason, nothing executed
   const VectorXd start = w.Qpos();
@@ -577,6 +587,30 @@ TEST(ServedRobotTest, MalformedPlanRequestsThrowAndAnUnreachablePoseFails) {
   ASSERT_TRUE(WaitFor([&] { return w.sim->GetClockSteps() > clock + 200; }));
   EXPECT_FALSE(done.Done());
   EXPECT_LT((w.Qpos() - start).cwiseAbs().maxCoeff(), 1e-2);
+}
+
+// Close (a server shutting down on SIGTERM) cancels a plan under way instead of waiting out its
+// time limit: RRT* would use all of its 25 s.
+TEST(ServedRobotTest, CloseCancelsAPlanUnderWay) {
+  World w({/*panda=*/true, /*camera=*/false, /*paused=*/false});
+  PlanRequest req;
+  const VectorXd q = w.Qpos();
+  req.joint_goal = std::vector<double>(q.data(), q.data() + q.size());
+  req.joint_goal[w.Index("panda_joint1")] += 0.5;
+  req.options.algorithm = "RRTstar";
+  req.options.time_limit = 25.0;
+  PlanRecorder result;
+  w.served->Plan(req, result.Callback(w.sim.get()));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // planning by now
+  const auto t0 = std::chrono::steady_clock::now();
+  w.served->Close();
+  const double closing =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LT(closing, 5.0);
+  ASSERT_TRUE(result.Got());
+  std::lock_guard<std::mutex> lock(result.mutex);
+  EXPECT_FALSE(result.result.success);
+  EXPECT_EQ(result.result.message, "cancelled");
 }
 
 // ---- readings ----

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <string>
 #include <thread>
 
+#include "partsim/core/error.h"
 #include "partsim/robot/robots.h"
 #include "server/wait_for.h"
 
@@ -116,6 +119,66 @@ TEST_F(SimServerTest, RejectsBadOptions) {
   o.realtime_factor = 0;
   EXPECT_THROW(SimServer(&scene_, nullptr, o), Error);
   EXPECT_THROW(SimServer(nullptr, nullptr), Error);
+}
+
+}  // namespace
+}  // namespace partsim
+
+namespace partsim {
+namespace {
+
+TEST_F(SimServerTest, StepRequestsAreRangeCheckedAndPauseOrResetCancelsThem) {
+  SimServer sim(&scene_, nullptr);
+  for (long long n : {0LL, -5LL, SimServer::kMaxStepRequest + 1, (1LL << 32) + 1}) {
+    try {
+      sim.StepN(n);
+      ADD_FAILURE() << "StepN(" << n << ") accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("from 1 to 1000000"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(sim.GetPendingSteps(), 0);
+  // requests add up to the bound, no further
+  sim.StepN(SimServer::kMaxStepRequest);
+  sim.StepN(SimServer::kMaxStepRequest);
+  EXPECT_EQ(sim.GetPendingSteps(), SimServer::kMaxStepRequest);
+  sim.Start(/*paused=*/true);
+  ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() > 10; }));
+  sim.Pause();  // cancels what is still waiting
+  EXPECT_EQ(sim.GetPendingSteps(), 0);
+  std::this_thread::sleep_for(30ms);
+  const long long n = sim.GetClockSteps();
+  std::this_thread::sleep_for(30ms);
+  EXPECT_EQ(sim.GetClockSteps(), n);
+  sim.StepN(SimServer::kMaxStepRequest);
+  ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() > n + 10; }));
+  sim.Reset();  // so does a reset
+  EXPECT_EQ(sim.GetPendingSteps(), 0);
+  std::this_thread::sleep_for(30ms);
+  const long long m = sim.GetClockSteps();
+  std::this_thread::sleep_for(30ms);
+  EXPECT_EQ(sim.GetClockSteps(), m);
+}
+
+TEST_F(SimServerTest, ThrowingCommandsStepsAndCallbacksDoNotEndTheThread) {
+  SimServerOptions o;
+  o.fast = true;
+  SimServer sim(&scene_, nullptr, o);
+  sim.AddStepCallback([](long long step) {
+    if (step == 5) throw Error("callback trouble at step 5");
+  });
+  // queued before the start: they run before the first step
+  sim.Post([] { throw Error("a bad command"); });
+  sim.Post([] { throw 42; });  // not even an exception
+  // a drive target that is not finite, the way a bad trajectory used to reach the scene
+  sim.Post([this] { robot_.SetDriveTarget(Eigen::VectorXd::Constant(robot_.Dof(), NAN)); });
+  sim.Start();
+  ASSERT_TRUE(WaitFor([&] { return sim.GetErrorCount() >= 4; }));
+  const long long n = sim.GetClockSteps();
+  EXPECT_TRUE(WaitFor([&] { return sim.GetClockSteps() > n + 100; }));  // still stepping
+  EXPECT_EQ(sim.GetErrorCount(), 4);
+  EXPECT_EQ(sim.GetLastError(), "step callback: callback trouble at step 5");
+  sim.Stop();
 }
 
 }  // namespace

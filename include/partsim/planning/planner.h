@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +32,9 @@ struct PlannerOptions {
   /// reads nothing of the live scene.
   bool use_last_snapshot = false;
   int ik_attempts = 8;  ///< PlanToPose: IK solutions tried (from the start, then random)
+  /// When set, planning stops as soon as *cancel turns true (checked by OMPL's termination
+  /// condition and between IK attempts) and fails with "cancelled". Must outlive the call.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 /// Throws partsim::Error naming the first bad field: time_limit and resolution must be finite

@@ -56,8 +56,15 @@ struct CameraSensor {
   std::string frame;  ///< <name>_optical_frame
 };
 
+/// Longest planning time_limit (s) a served robot accepts.
+constexpr double kMaxPlanSeconds = 30.0;
+
+/// Latest time_from_start (s) a trajectory point may have: a day.
+constexpr double kMaxTrajectorySeconds = 86400.0;
+
 /// A trajectory as ROS messages carry it: joints by name (a subset of the robot's, in any
-/// order; the others hold where they are), points with times from the start.
+/// order; the others hold where they are), points with times from the start (at most
+/// kMaxTrajectorySeconds).
 struct TrajectoryCommand {
   std::vector<std::string> joint_names;
   std::vector<double> times;

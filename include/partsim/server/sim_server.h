@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -49,8 +50,14 @@ class SimServer {
   void Pause();
   void Resume();
   bool IsPaused() const { return paused_; }
-  /// While paused: advances exactly n steps, then stays paused. Running: no effect.
-  void StepN(int n);
+  /// Most steps one StepN may ask for, and most steps waiting at once.
+  static constexpr long long kMaxStepRequest = 1000000;
+  /// While paused: advances exactly n steps, then stays paused. Running: no effect. Throws
+  /// partsim::Error unless 1 <= n <= kMaxStepRequest; steps already waiting count towards the
+  /// bound (the excess is dropped). Pause() and Reset() cancel the steps still waiting.
+  void StepN(long long n);
+  /// Steps asked for by StepN and not taken yet.
+  long long GetPendingSteps() const { return pending_steps_; }
   /// Restores the state from construction (queued like a command). The clock keeps counting.
   void Reset();
   /// Queues a command; it runs before the next step (or at once while paused).
@@ -65,10 +72,19 @@ class SimServer {
   double GetTimestep() const { return dt_; }
   /// Commands run so far.
   long long GetCommandsRun() const { return commands_run_; }
+  /// Errors on the simulation thread so far: a command, a step or a step callback that threw.
+  /// The thread goes on; each error is written to stderr (the first 20, then every 1000th).
+  long long GetErrorCount() const { return errors_; }
+  /// The last such error's message ("" if none).
+  std::string GetLastError() const;
 
  private:
   void Loop();
   void RunCommands(std::unique_lock<std::mutex>& lock);
+  /// Runs `f` on the simulation thread, recording what it throws as an error of `what`.
+  template <class F>
+  void Guarded(const char* what, F&& f);
+  void RecordError(const std::string& message);
   Scene* scene_;
   ControlLoop* loop_;
   SimServerOptions options_;
@@ -85,6 +101,9 @@ class SimServer {
   std::atomic<long long> pending_steps_{0};
   std::atomic<long long> clock_steps_{0};
   std::atomic<long long> commands_run_{0};
+  std::atomic<long long> errors_{0};
+  mutable std::mutex error_mutex_;
+  std::string last_error_;
 };
 
 }  // namespace partsim

@@ -433,7 +433,8 @@ void Ros1Bridge::Start() {
       nh.advertiseService<partsim_msgs::Step::Request, partsim_msgs::Step::Response>(
           "/partsim/step",
           [sim](partsim_msgs::Step::Request& req, partsim_msgs::Step::Response& res) {
-            if (req.steps < 1) return false;  // the caller sees the service fail
+            // out of range: the caller sees the service fail
+            if (req.steps < 1 || req.steps > SimServer::kMaxStepRequest) return false;
             sim->StepN(req.steps);
             res.clock_steps = sim->GetClockSteps();
             return true;
