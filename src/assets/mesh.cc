@@ -19,6 +19,7 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "core/file_read.h"
 #include "partsim/assets/convex_decomposition.h"
 #include "partsim/core/error.h"
 
@@ -318,10 +319,7 @@ ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh) {
 }
 
 std::vector<LoadedMesh> LoadMeshFile(const std::string& path, const Eigen::Vector3d& scale) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) {
-    throw Error("mesh file '" + path + "' does not exist or is not a regular file");
-  }
+  internal::CheckReadableFile(path, "mesh file", internal::kMaxDataFileBytes);
   if (!scale.allFinite()) throw Error("mesh file '" + path + "': scale is not finite");
 
   Assimp::Importer importer;

@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/file_read.h"
+#include "core/json_parse.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -34,10 +36,14 @@ fs::path Require(const fs::path& folder, const char* name) {
 }
 
 json ReadJson(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) Fail(file, "cannot be read");
+  std::string text;
   try {
-    return json::parse(in);
+    text = internal::ReadWholeFile(file.string(), "file");
+  } catch (const Error& e) {
+    Fail(file, e.what());
+  }
+  try {
+    return internal::ParseJsonBounded(text);
   } catch (const json::exception& e) {
     Fail(file, std::string("malformed JSON: ") + e.what());
   }
@@ -299,8 +305,12 @@ struct SemanticsLine {
 };
 
 std::vector<SemanticsLine> ReadSemantics(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) Fail(file, "cannot be read");
+  std::istringstream in;
+  try {
+    in.str(internal::ReadWholeFile(file.string(), "file"));
+  } catch (const Error& e) {
+    Fail(file, e.what());
+  }
   std::vector<SemanticsLine> out;
   std::string line;
   int n = 0;

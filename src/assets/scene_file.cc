@@ -10,6 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include "core/file_read.h"
+#include "core/json_parse.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/core/error.h"
@@ -217,16 +219,12 @@ SceneFileSpec ReadSceneFile(const std::string& path) {
   SceneFileSpec spec;
   spec.path = path;
   const std::string where = "scene file " + path;
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(where + ": file does not exist");
-  if (fs::is_directory(path, ec)) throw Error(where + ": is a folder, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(where + ": cannot be read");
+  const std::string text = internal::ReadWholeFile(path, "scene file");
 
   // the JSON
   json root;
   try {
-    root = json::parse(in);
+    root = internal::ParseJsonBounded(text);
   } catch (const json::exception& e) {
     throw Error(where + ": bad JSON: " + e.what());
   }
@@ -239,6 +237,7 @@ SceneFileSpec ReadSceneFile(const std::string& path) {
   if (objects.empty()) Fields(path, "objects").Fail("", "is empty (no object to load)");
 
   // the entries, with names unique within the file
+  std::error_code ec;
   const fs::path base_dir = fs::absolute(fs::path(path), ec).parent_path();
   std::set<std::string> names;
   for (size_t i = 0; i < objects.size(); ++i) {

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/file_read.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -45,13 +46,7 @@ SrdfDesc ParseSrdf(const std::string& text, const std::string& source, LoadRepor
 }
 
 SrdfDesc ReadSrdfFile(const std::string& path, LoadReport* report) {
-  std::ifstream in(path, std::ios::binary);
-  std::error_code ec;
-  if (!in || std::filesystem::is_directory(path, ec))
-    throw Error("SRDF " + path + ": cannot open file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseSrdf(text.str(), path, report);
+  return ParseSrdf(internal::ReadWholeFile(path, "SRDF"), path, report);
 }
 
 }  // namespace partsim

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/file_read.h"
 #include "partsim/assets/mesh.h"
 #include "partsim/assets/srdf.h"
 #include "partsim/core/error.h"
@@ -497,7 +498,7 @@ std::optional<Inertial> Parser::ReadInertial(const XMLElement* e, const std::str
   double mass = Number(mass_e, "value", std::nullopt, where);
   if (mass < 0) Fail(where + " has negative mass " + std::to_string(mass));
   // a massless link (common for frames in ROS files): mass follows from its shapes, if any
-  if (mass == 0) return std::nullopt;
+  if (mass == 0) return std::nullopt;  // ReadLink warns when shapes then give it a mass
 
   // inertia tensor about the centre of mass in the <origin> frame; scaling at constant
   // density multiplies mass by s^3 and inertia by s^5
@@ -521,6 +522,17 @@ std::optional<Inertial> Parser::ReadInertial(const XMLElement* e, const std::str
     Fail(where + " has an inertia tensor that is not positive semi-definite (principal moments " +
          std::to_string(moments[0]) + ", " + std::to_string(moments[1]) + ", " +
          std::to_string(moments[2]) + ")");
+  }
+  if (largest <= 1e-12 * mass) {
+    // no inertia at all (an <inertia> of zeros, or none): a link whose centre of mass lies on
+    // its joint's axis would turn without resistance (one such joint spun to -283,062 rad in
+    // 0.4 s). It gets the inertia of a solid sphere of its mass, 5 cm in radius (scaled).
+    const double r = 0.05 * s;
+    moments.setConstant(0.4 * mass * r * r);
+    axes.setIdentity();
+    Warn(where + " has no inertia tensor (all zero) for its mass of " + std::to_string(mass) +
+         " kg: set to that of a solid sphere 5 cm in radius, " + std::to_string(moments[0]) +
+         " kg m^2 about each axis");
   }
   const double floor = std::max(1e-9 * mass, 1e-6 * largest);
   moments = moments.cwiseMax(floor);
@@ -567,6 +579,10 @@ LinkDesc Parser::ReadLink(const XMLElement* link, const std::string& name) {
   }
   if (const XMLElement* in = link->FirstChildElement("inertial")) {
     out.inertial = ReadInertial(in, name);
+    if (!out.inertial && !out.collisions.empty())
+      Warn("link '" + name +
+           "' <inertial> has mass 0: the link's mass and inertia follow "
+           "from its collision shapes at the loader's density instead");
   }
   return out;
 }
@@ -625,7 +641,7 @@ JointDesc Parser::ReadJoint(const RawJoint& raw, ArticulationDesc* desc) {
     }
     double effort = Number(limit, "effort", 0.0, where);
     if (effort < 0) Fail(where + " <limit effort> is negative");
-    if (effort > 0) j.drive.force_limit = effort;
+    if (effort > 0) j.drive.force_limit = j.effort_limit = effort;
     Number(limit, "velocity", 0.0, where);  // checked, not used
   }
 
@@ -907,13 +923,10 @@ ArticulationDesc UrdfLoader::Parse(const std::string& text, const std::string& b
 
 ArticulationDesc UrdfLoader::ParseFile(const std::string& path) const {
   const std::string name = fs::path(path).filename().string();
-  std::ifstream in(path, std::ios::binary);
+  const std::string text = internal::ReadWholeFile(path, "URDF");
   std::error_code ec;
-  if (!in || fs::is_directory(path, ec)) throw Error("URDF " + path + ": cannot open file");
-  std::ostringstream text;
-  text << in.rdbuf();
   fs::path dir = fs::absolute(fs::path(path), ec).parent_path();
-  ArticulationDesc desc = Parse(text.str(), dir.string(), name);
+  ArticulationDesc desc = Parse(text, dir.string(), name);
   // without an SRDF named, the one beside the file (same stem) applies
   fs::path beside = fs::path(path).replace_extension(".srdf");
   if (srdf_file.empty() && fs::is_regular_file(beside, ec))

@@ -70,8 +70,14 @@ void Require(bool ok, const std::string& where, const std::string& what) {
   if (!ok) throw Error(Prefix(where) + what);
 }
 
+// Largest coordinate or size (m) a description may hold: past it MuJoCo's arithmetic overflows
+// (an origin of 1e308 or a box of 1e300 made every state NaN).
+constexpr double kMaxLength = 1e6;
+
 void CheckPose(const Pose& pose, const std::string& where, const std::string& what) {
   Require(pose.p.allFinite(), where, what + " has a non-finite position " + pose.ToString());
+  Require(pose.p.cwiseAbs().maxCoeff() <= kMaxLength, where,
+          what + " has a position beyond 1e6 m " + pose.ToString());
   Require(pose.q.coeffs().allFinite() && pose.q.norm() > 1e-6, where,
           what + " has an invalid rotation " + pose.ToString());
 }
@@ -84,6 +90,13 @@ void CheckNonNegative(double v, const std::string& where, const std::string& wha
 void CheckPositive(double v, const std::string& where, const std::string& what) {
   Require(std::isfinite(v) && v > 0.0, where,
           what + " must be finite and > 0, got " + std::to_string(v));
+}
+
+// A shape's size: > 0 (or >= 0) and at most kMaxLength.
+void CheckLength(double v, bool allow_zero, const std::string& where, const std::string& what) {
+  Require(std::isfinite(v) && (allow_zero ? v >= 0.0 : v > 0.0) && v <= kMaxLength, where,
+          what + " must be " + (allow_zero ? ">= 0" : "> 0") + " and at most 1e6 m, got " +
+              std::to_string(v));
 }
 
 void CheckMaterial(const PhysicalMaterial& m, const std::string& where, const std::string& what) {
@@ -103,18 +116,18 @@ void CheckBody(const BodyDesc& b, const std::string& where, const std::string& w
     if (s.material) CheckMaterial(*s.material, where, w + " material");
     switch (s.type) {
       case ShapeType::kBox:
-        for (int k = 0; k < 3; ++k) CheckPositive(s.half_size[k], where, w + " half_size");
+        for (int k = 0; k < 3; ++k) CheckLength(s.half_size[k], false, where, w + " half_size");
         break;
       case ShapeType::kSphere:
-        CheckPositive(s.radius, where, w + " radius");
+        CheckLength(s.radius, false, where, w + " radius");
         break;
       case ShapeType::kCapsule:
-        CheckPositive(s.radius, where, w + " radius");
-        CheckNonNegative(s.half_length, where, w + " half_length");
+        CheckLength(s.radius, false, where, w + " radius");
+        CheckLength(s.half_length, true, where, w + " half_length");
         break;
       case ShapeType::kCylinder:
-        CheckPositive(s.radius, where, w + " radius");
-        CheckPositive(s.half_length, where, w + " half_length");
+        CheckLength(s.radius, false, where, w + " radius");
+        CheckLength(s.half_length, false, where, w + " half_length");
         break;
       case ShapeType::kPlane:
         break;
@@ -126,7 +139,8 @@ void CheckBody(const BodyDesc& b, const std::string& where, const std::string& w
             w + src + " needs at least 4 vertices, has " + std::to_string(s.mesh->vertices.size()));
         Eigen::Vector3f lo = s.mesh->vertices[0], hi = lo;
         for (const auto& v : s.mesh->vertices) {
-          Require(v.allFinite(), where, w + src + " has a non-finite vertex");
+          Require(v.allFinite() && v.cwiseAbs().maxCoeff() <= static_cast<float>(kMaxLength), where,
+                  w + src + " has a vertex that is not finite or lies beyond 1e6 m");
           lo = lo.cwiseMin(v);
           hi = hi.cwiseMax(v);
         }
@@ -190,6 +204,8 @@ void Validate(const ArticulationDesc& art, const std::string& where) {
     CheckNonNegative(j.damping, where, jw + " damping");
     CheckNonNegative(j.armature, where, jw + " armature");
     Require(std::isfinite(j.pitch), where, jw + " pitch must be finite");
+    Require(j.effort_limit > 0, where,
+            jw + " effort_limit must be > 0 (inf for none), got " + std::to_string(j.effort_limit));
     CheckNonNegative(j.drive.stiffness, where, jw + " drive stiffness");
     CheckNonNegative(j.drive.damping, where, jw + " drive damping");
     Require(!std::isnan(j.drive.force_limit) && j.drive.force_limit > 0, where,

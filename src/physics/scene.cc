@@ -55,9 +55,28 @@ void OnMujocoWarning(const char* msg) {
     std::fprintf(stderr, "partsim: MuJoCo warning: %s\n", msg);
 }
 
+// MuJoCo's default error handler prints "Press Enter to exit" and ends the process; partsim's
+// throws, so that the caller gets partsim::Error and the process goes on (the step that hit it
+// is abandoned and MuJoCo's stack released, see SceneImpl::Step).
+void OnMujocoError(const char* msg) { throw Error(std::string("MuJoCo: ") + msg); }
+
 struct InstallWarningHook {
-  InstallWarningHook() { mju_user_warning = OnMujocoWarning; }
+  InstallWarningHook() {
+    mju_user_warning = OnMujocoWarning;
+    mju_user_error = OnMujocoError;
+  }
 } install_warning_hook;
+
+// Marks a scene as stepping on this thread (its warnings go to it) until destroyed; on the way
+// out of a failed step it releases what MuJoCo held on its stack.
+struct SteppingScope {
+  SceneImpl* scene;
+  explicit SteppingScope(SceneImpl* s) : scene(s) { stepping_scene = s; }
+  ~SteppingScope() {
+    stepping_scene = nullptr;
+    if (scene->d) scene->d->pstack = 0;
+  }
+};
 
 // State of named MuJoCo elements, used to carry a state across a recompile.
 struct NamedState {
@@ -247,7 +266,7 @@ void SceneImpl::UpdateKinematicArticulation(ArticulationEntry& a) {
 void SceneImpl::Step(int n) {
   if (n < 0) throw Error("step: n must be >= 0, got " + std::to_string(n));
   EnsureCompiled();
-  stepping_scene = this;
+  SteppingScope scope(this);
   for (int i = 0; i < n; ++i) {
     ApplyDrives();
     int bad_before = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
@@ -265,7 +284,6 @@ void SceneImpl::Step(int n) {
       xfrc_dirty = false;
     }
   }
-  stepping_scene = nullptr;
   Invalidate();
 }
 
@@ -292,15 +310,15 @@ Scene::Scene(const SceneConfig& config) : impl_(std::make_unique<Impl>()) {
 Scene::~Scene() = default;
 
 std::unique_ptr<Scene> Scene::Clone() const {
-  auto copy = std::make_unique<Scene>(impl_->config);
+  auto copy = std::make_unique<Scene>(impl().config);
   Impl& c = copy->impl();
-  c.actors = impl_->actors;
-  c.articulations = impl_->articulations;
-  c.next_id = impl_->next_id;
-  c.next_visual_id = impl_->next_visual_id;
-  c.lights = impl_->lights;
-  c.ambient = impl_->ambient;
-  for (const auto& cam : impl_->cameras) {
+  c.actors = impl().actors;
+  c.articulations = impl().articulations;
+  c.next_id = impl().next_id;
+  c.next_visual_id = impl().next_visual_id;
+  c.lights = impl().lights;
+  c.ambient = impl().ambient;
+  for (const auto& cam : impl().cameras) {
     internal::SceneImpl::CameraEntry copy_cam{cam.id,   cam.name, cam.width,     cam.height,
                                               cam.fx,   cam.fy,   cam.cx,        cam.cy,
                                               cam.near, cam.far,  cam.local_pose};
@@ -313,35 +331,35 @@ std::unique_ptr<Scene> Scene::Clone() const {
   c.dirty = true;
   c.EnsureCompiled();
   copy->Unpack(Pack());
-  c.warnings = impl_->warnings;
+  c.warnings = impl().warnings;
   return copy;
 }
 
-const SceneConfig& Scene::GetConfig() const { return impl_->config; }
-double Scene::GetTimestep() const { return impl_->config.timestep; }
+const SceneConfig& Scene::GetConfig() const { return impl().config; }
+double Scene::GetTimestep() const { return impl().config.timestep; }
 
 void Scene::SetTimestep(double dt) {
   if (!(dt > 0) || !std::isfinite(dt))
     throw Error("timestep must be finite and > 0, got " + std::to_string(dt));
-  impl_->config.timestep = dt;
+  impl().config.timestep = dt;
   // constraint time constants are derived from the timestep: recompile, keeping the state
-  impl_->dirty = true;
-  impl_->EnsureCompiled();
+  impl().dirty = true;
+  impl().EnsureCompiled();
 }
 
-Eigen::Vector3d Scene::GetGravity() const { return impl_->config.gravity; }
+Eigen::Vector3d Scene::GetGravity() const { return impl().config.gravity; }
 
 void Scene::SetGravity(const Eigen::Vector3d& g) {
   if (!g.allFinite()) throw Error("gravity must be finite");
-  impl_->config.gravity = g;
-  impl_->EnsureCompiled();
-  for (int k = 0; k < 3; ++k) impl_->m->opt.gravity[k] = g[k];
-  impl_->Invalidate();
+  impl().config.gravity = g;
+  impl().EnsureCompiled();
+  for (int k = 0; k < 3; ++k) impl().m->opt.gravity[k] = g[k];
+  impl().Invalidate();
 }
 
 double Scene::GetTime() const {
-  impl_->EnsureCompiled();
-  return impl_->d->time;
+  impl().EnsureCompiled();
+  return impl().d->time;
 }
 
 void Scene::SetDefaultMaterial(const PhysicalMaterial& material) {
@@ -354,9 +372,9 @@ void Scene::SetDefaultMaterial(const PhysicalMaterial& material) {
         "got static_friction " +
         std::to_string(m.static_friction) + ", dynamic_friction " +
         std::to_string(m.dynamic_friction) + ", restitution " + std::to_string(m.restitution));
-  impl_->config.default_material = material;
-  impl_->dirty = true;
-  impl_->EnsureCompiled();
+  impl().config.default_material = material;
+  impl().dirty = true;
+  impl().EnsureCompiled();
 }
 
 Actor Scene::AddGround(double altitude, const std::optional<PhysicalMaterial>& material,
@@ -406,7 +424,7 @@ void CompileOrUndo(internal::SceneImpl& s, Undo undo) {
 
 Actor Scene::AddActor(const ActorDesc& desc) {
   Validate(desc);
-  Impl& s = *impl_;
+  Impl& s = impl();
   s.EnsureCompiled();
   // an actor's id is its entity id in segmentation pictures too (as SAPIEN's)
   int id = s.next_id;
@@ -419,7 +437,7 @@ Actor Scene::AddActor(const ActorDesc& desc) {
 
 Articulation Scene::AddArticulation(const ArticulationDesc& desc) {
   Validate(desc);
-  Impl& s = *impl_;
+  Impl& s = impl();
   s.EnsureCompiled();
   // its links take the ids (segmentation entity ids) after the articulation's own
   int id = s.next_id;
@@ -443,7 +461,11 @@ Articulation Scene::AddArticulation(const ArticulationDesc& desc) {
 }
 
 void Scene::RemoveActor(const Actor& actor) {
-  Impl& s = *impl_;
+  Impl& s = impl();
+  // ids are per scene: another scene's handle would name one of ours
+  if (actor.GetScene() != this)
+    throw Error("remove_actor: actor " + std::to_string(actor.GetId()) +
+                " belongs to another scene");
   s.GetActor(actor.GetId());  // throws if absent
   s.actors.erase(std::remove_if(s.actors.begin(), s.actors.end(),
                                 [&](const auto& a) { return a.id == actor.GetId(); }),
@@ -453,7 +475,10 @@ void Scene::RemoveActor(const Actor& actor) {
 }
 
 void Scene::RemoveArticulation(const Articulation& articulation) {
-  Impl& s = *impl_;
+  Impl& s = impl();
+  if (articulation.GetScene() != this)
+    throw Error("remove_articulation: articulation " + std::to_string(articulation.GetId()) +
+                " belongs to another scene");
   s.GetArticulation(articulation.GetId());
   s.articulations.erase(std::remove_if(s.articulations.begin(), s.articulations.end(),
                                        [&](const auto& a) { return a.id == articulation.GetId(); }),
@@ -464,53 +489,94 @@ void Scene::RemoveArticulation(const Articulation& articulation) {
 
 std::vector<Actor> Scene::GetActors() const {
   std::vector<Actor> out;
-  for (const auto& a : impl_->actors) out.emplace_back(const_cast<Scene*>(this), a.id);
+  for (const auto& a : impl().actors) out.emplace_back(const_cast<Scene*>(this), a.id);
   return out;
 }
 
 std::vector<Articulation> Scene::GetArticulations() const {
   std::vector<Articulation> out;
-  for (const auto& a : impl_->articulations) out.emplace_back(const_cast<Scene*>(this), a.id);
+  for (const auto& a : impl().articulations) out.emplace_back(const_cast<Scene*>(this), a.id);
   return out;
 }
 
 Actor Scene::FindActorByName(const std::string& name) const {
-  for (const auto& a : impl_->actors)
+  for (const auto& a : impl().actors)
     if (a.desc.name == name) return Actor(const_cast<Scene*>(this), a.id);
   throw Error("no actor named '" + name + "'");
 }
 
 Articulation Scene::FindArticulationByName(const std::string& name) const {
-  for (const auto& a : impl_->articulations)
+  for (const auto& a : impl().articulations)
     if (a.desc.name == name) return Articulation(const_cast<Scene*>(this), a.id);
   throw Error("no articulation named '" + name + "'");
 }
 
-void Scene::Step(int n) { impl_->Step(n); }
+void Scene::Step(int n) {
+  Use use(*this);  // waits for another thread's step; keeps other threads out meanwhile
+  impl_->Step(n);
+}
 
-const std::vector<Warning>& Scene::GetWarnings() const { return impl_->warnings; }
-void Scene::ClearWarnings() { impl_->warnings.clear(); }
+Scene::Use::Use(const Scene& scene) : scene_(&scene), owns_(true) {
+  Impl& s = *scene.impl_;
+  s.use_mutex.lock();
+  if (s.use_depth++ == 0) s.user = std::this_thread::get_id();
+}
+
+Scene::Use::Use(const Scene& scene, std::try_to_lock_t) : scene_(&scene) {
+  Impl& s = *scene.impl_;
+  if (!s.use_mutex.try_lock()) return;
+  owns_ = true;
+  if (s.use_depth++ == 0) s.user = std::this_thread::get_id();
+}
+
+Scene::Use::~Use() {
+  if (!owns_) return;
+  Impl& s = *scene_->impl_;
+  if (--s.use_depth == 0) s.user = std::thread::id();
+  s.use_mutex.unlock();
+}
+
+Scene::Impl& Scene::impl() const {
+  impl_->CheckUser();
+  return *impl_;
+}
+
+namespace internal {
+
+void SceneImpl::CheckUser() const {
+  const std::thread::id holder = user.load();
+  if (holder != std::thread::id() && holder != std::this_thread::get_id())
+    throw Error(
+        "scene: another thread is stepping or rendering this scene; use a scene from one thread "
+        "at a time (Step calls from several threads take turns; hold Scene::Use across other "
+        "calls)");
+}
+
+}  // namespace internal
+
+const std::vector<Warning>& Scene::GetWarnings() const { return impl().warnings; }
+void Scene::ClearWarnings() { impl().warnings.clear(); }
 
 const mjModel_* Scene::GetMjModel() const {
-  impl_->EnsureCompiled();
-  return impl_->m;
+  impl().EnsureCompiled();
+  return impl().m;
 }
 
 mjData_* Scene::GetMjData() const {
-  impl_->EnsureCompiled();
-  return impl_->d;
+  impl().EnsureCompiled();
+  return impl().d;
 }
 
 std::string Scene::GetMjcf() const {
-  impl_->EnsureCompiled();
-  return impl_->mjcf;
+  impl().EnsureCompiled();
+  return impl().mjcf;
 }
 
 // ---------------------------------------------------------------------------------------------
 // contacts
 
 std::vector<Contact> Scene::GetContacts() const {
-  Impl& s = *impl_;
+  Impl& s = impl();
   s.EnsureCompiled();
   const mjModel* m = s.m;
   const mjData* d = s.d;
@@ -620,7 +686,7 @@ class Reader {
 }  // namespace
 
 std::vector<char> Scene::Pack() const {
-  Impl& s = *impl_;
+  Impl& s = impl();
   s.EnsureCompiled();
   const mjModel* m = s.m;
   const mjData* d = s.d;
@@ -651,7 +717,7 @@ std::vector<char> Scene::Pack() const {
 }
 
 void Scene::Unpack(const std::vector<char>& state) {
-  Impl& s = *impl_;
+  Impl& s = impl();
   s.EnsureCompiled();
   mjModel* m = s.m;
   mjData* d = s.d;

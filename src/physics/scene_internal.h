@@ -4,9 +4,11 @@
 
 #include <mujoco/mujoco.h>
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "partsim/physics/scene.h"
@@ -104,6 +106,13 @@ struct SceneImpl {
   };
   std::vector<ActorEntry> actors;
   std::vector<ArticulationEntry> articulations;
+
+  // the thread that holds the scene (Scene::Use), if any
+  std::recursive_mutex use_mutex;
+  std::atomic<std::thread::id> user{};
+  int use_depth = 0;  ///< nested Uses of the holding thread (guarded by use_mutex)
+  /// Throws partsim::Error when a thread other than the caller holds the scene.
+  void CheckUser() const;
   /// ids of actors, articulations, links and cameras, scene-wide; 0 is no entity (background
   /// in segmentation pictures)
   int next_id = 1;

@@ -4,7 +4,10 @@
 
 #include <pybind11/pybind11.h>
 
+#include <optional>
 #include <vector>
+
+#include "partsim/physics/scene.h"
 
 namespace partsim::python {
 
@@ -27,6 +30,22 @@ void BindControl(py::module_& m);
 void BindTasks(py::module_& m);
 /// Motion planning (planning_py.cc).
 void BindPlanning(py::module_& m);
+
+/// Runs `f` without the GIL while this thread holds `scene` (Scene::Use), so that other Python
+/// threads can run meanwhile but not touch that scene: their calls on it raise PartsimError, and
+/// their steps wait. Waiting for another thread's hold happens without the GIL too.
+template <typename F>
+auto WithoutGil(const Scene& scene, F&& f) {
+  std::optional<Scene::Use> use;
+  use.emplace(scene, std::try_to_lock);
+  if (!use->owns()) {
+    use.reset();
+    py::gil_scoped_release release;
+    use.emplace(scene);
+  }
+  py::gil_scoped_release release;
+  return f();
+}
 
 /// Casts handles to a Python list whose items each keep `owner` alive (py::keep_alive cannot
 /// attach to a list, which holds no weak references).

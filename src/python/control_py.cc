@@ -198,10 +198,16 @@ void BindControl(py::module_& m) {
       .def(py::init<Scene*>(), py::arg("scene"), py::keep_alive<1, 2>())
       .def("add", &ControlLoop::Add, py::arg("controller"), py::keep_alive<1, 2>())
       .def("remove", &ControlLoop::Remove, py::arg("controller"))
-      .def("step", &ControlLoop::Step, py::arg("n") = 1, py::call_guard<py::gil_scoped_release>())
-      .def("run_until_done", &ControlLoop::RunUntilDone, py::arg("max_seconds"),
-           py::call_guard<py::gil_scoped_release>(),
-           "Steps until every controller is reached, failed or idle; True if none failed.")
+      .def(
+          "step", [](ControlLoop& l, int n) { WithoutGil(*l.GetScene(), [&] { l.Step(n); }); },
+          py::arg("n") = 1, "Steps n times (the GIL released, the scene held: see Scene.step).")
+      .def(
+          "run_until_done",
+          [](ControlLoop& l, double max_seconds) {
+            return WithoutGil(*l.GetScene(), [&] { return l.RunUntilDone(max_seconds); });
+          },
+          py::arg("max_seconds"),
+          "Steps until every controller is reached, failed or idle; True if none failed.")
       .def("get_scene", &ControlLoop::GetScene, py::return_value_policy::reference);
 
   // ------------------------------------------------------------------ IMU

@@ -279,6 +279,9 @@ void BindDescription(py::module_& m) {
       .def_readwrite("damping", &JointDesc::damping, "N s/m or N m s/rad.")
       .def_readwrite("armature", &JointDesc::armature, "kg or kg m^2.")
       .def_readwrite("pitch", &JointDesc::pitch, "Screw joints: metres per radian.")
+      .def_readwrite("effort_limit", &JointDesc::effort_limit,
+                     "N or N m: the actuator's largest effort (URDF <limit effort>); effort "
+                     "controllers clamp to it. inf: none given.")
       .def_readwrite("drive", &JointDesc::drive);
 
   py::class_<LinkDesc, BodyDesc>(m, "LinkDesc", "A link: a body and the joint to its parent.")
@@ -730,9 +733,11 @@ void BindScene(py::module_& m) {
            })
       .def("find_actor_by_name", &Scene::FindActorByName, py::arg("name"), ka)
       .def("find_articulation_by_name", &Scene::FindArticulationByName, py::arg("name"), ka)
-      .def("step", &Scene::Step, py::arg("n") = 1, py::call_guard<py::gil_scoped_release>(),
-           "Advances by n timesteps. The GIL is released meanwhile: other Python threads run, "
-           "but must not use this scene until step returns.")
+      .def(
+          "step", [](Scene& s, int n) { WithoutGil(s, [&] { s.Step(n); }); }, py::arg("n") = 1,
+          "Advances by n timesteps. The GIL is released meanwhile: other Python threads run; "
+          "their steps of this scene wait their turn, and their other calls on it raise "
+          "PartsimError until step returns.")
       .def("get_contacts", &Scene::GetContacts, "Contacts of the last step.")
       .def("get_warnings", &Scene::GetWarnings, "Warnings recorded so far.")
       .def("clear_warnings", &Scene::ClearWarnings)

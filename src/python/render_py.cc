@@ -198,8 +198,7 @@ void BindCamera(py::module_& m) {
               mask = 0;
               for (const std::string& name : *outputs) mask |= PictureOutputFromName(name);
             }
-            py::gil_scoped_release release;
-            self.TakePicture(mask);
+            WithoutGil(*self.GetScene(), [&] { self.TakePicture(mask); });
           },
           py::arg("outputs") = py::none(),
           "Renders the scene as of the last update_render() (the first picture of a scene "

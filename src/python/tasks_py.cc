@@ -56,8 +56,12 @@ void BindTasks(py::module_& m) {
       "command in [-1, 1].")
       .def(py::init<const TaskOptions&>(), py::arg("options"),
            py::call_guard<py::gil_scoped_release>())
-      .def("reset", &ArticulationTask::Reset, py::arg("seed") = 0,
-           py::call_guard<py::gil_scoped_release>(), "Starts a new episode.")
+      .def(
+          "reset",
+          [](ArticulationTask& t, std::uint64_t seed) {
+            WithoutGil(t.GetScene(), [&] { t.Reset(seed); });
+          },
+          py::arg("seed") = 0, "Starts a new episode.")
       .def_property_readonly(
           "options", [](const ArticulationTask& t) { return t.GetOptions(); },
           "A copy of the task's options (they are fixed when the task is made).")
@@ -88,10 +92,11 @@ void BindTasks(py::module_& m) {
       .def("gripper_touches_target", &ArticulationTask::GripperTouchesTarget)
       .def("apply_action", &ArticulationTask::ApplyAction, py::arg("action"),
            "7 values: TCP twist (vx, vy, vz, wx, wy, wz; world) and gripper in [-1, 1].")
-      .def("step", &ArticulationTask::Step, py::call_guard<py::gil_scoped_release>(),
-           "Advances one control period.")
-      .def("take_pictures", &ArticulationTask::TakePictures,
-           py::call_guard<py::gil_scoped_release>())
+      .def(
+          "step", [](ArticulationTask& t) { WithoutGil(t.GetScene(), [&] { t.Step(); }); },
+          "Advances one control period.")
+      .def("take_pictures",
+           [](ArticulationTask& t) { WithoutGil(t.GetScene(), [&] { t.TakePictures(); }); })
       .def("get_cameras", &ArticulationTask::GetCameras, ka)
       .def("get_camera", &ArticulationTask::GetCamera, py::arg("name"), ka)
       .def("get_raw_observation", &ArticulationTask::GetRawObservation)
@@ -115,8 +120,12 @@ void BindTasks(py::module_& m) {
       .def_readwrite("frame_every", &SolverOptions::frame_every);
   auto solver = [&m](const char* name, SolverResult (*f)(ArticulationTask&, const SolverOptions&),
                      const char* doc) {
-    m.def(name, f, py::arg("task"), py::arg("options") = SolverOptions(),
-          py::call_guard<py::gil_scoped_release>(), doc);
+    m.def(
+        name,
+        [f](ArticulationTask& task, const SolverOptions& options) {
+          return WithoutGil(task.GetScene(), [&] { return f(task, options); });
+        },
+        py::arg("task"), py::arg("options") = SolverOptions(), doc);
   };
   solver("solve_pull_drawer", &SolvePullDrawer, "The paper's drawer heuristic.");
   solver("solve_open_door", &SolveOpenDoor, "The paper's door heuristic.");

@@ -22,13 +22,13 @@ void Scene::SetRenderBackend(const std::string& name) {
     throw Error("set_render_backend: unknown backend '" + name +
                 "' (expected rasterizer, pathtracer or null)");
   }
-  impl_->render_backend = std::move(backend);
+  impl().render_backend = std::move(backend);
 }
 
 RenderBackend& Scene::GetRenderBackend() {
   // the rasterizer is the default, created on first use
-  if (!impl_->render_backend) impl_->render_backend = MakeRasterBackend();
-  return *impl_->render_backend;
+  if (!impl().render_backend) impl().render_backend = MakeRasterBackend();
+  return *impl().render_backend;
 }
 
 }  // namespace partsim

@@ -4,6 +4,7 @@
 #include <jpeglib.h>
 #include <png.h>
 
+#include <algorithm>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
@@ -11,6 +12,7 @@
 #include <iterator>
 #include <mutex>
 
+#include "core/file_read.h"
 #include "partsim/core/error.h"
 
 namespace partsim::internal {
@@ -229,6 +231,13 @@ Image8 DecodePng(const std::string& path, const std::vector<uint8_t>& bytes) {
   if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size())) {
     throw Error("texture " + path + ": cannot decode PNG: " + image.message);
   }
+  // the header's size, checked before the pixels are allocated (a 74-byte file can claim 16000^2)
+  if (static_cast<long long>(image.width) * image.height > kMaxDecodedPixels) {
+    png_image_free(&image);
+    throw Error("texture " + path + ": PNG of " + std::to_string(image.width) + "x" +
+                std::to_string(image.height) + " pixels is larger than partsim decodes (" +
+                std::to_string(kMaxDecodedPixels >> 20) + " M pixels); scale it down");
+  }
   image.format = PNG_FORMAT_RGBA;
   Image8 out;
   out.width = static_cast<int>(image.width);
@@ -272,10 +281,31 @@ Image8 DecodeJpeg(const std::string& path, const std::vector<uint8_t>& bytes) {
   jpeg_mem_src(&cinfo, bytes.data(), static_cast<unsigned long>(bytes.size()));
   jpeg_read_header(&cinfo, TRUE);
   cinfo.out_color_space = JCS_RGB;
+  // decode big images scaled down (1/2, 1/4 or 1/8, done by the DCT), and refuse what would
+  // still be too big before any pixel memory is taken
+  const unsigned side = std::max(cinfo.image_width, cinfo.image_height);
+  cinfo.scale_num = 1;
+  cinfo.scale_denom = 1;
+  while (cinfo.scale_denom < 8 && side / cinfo.scale_denom > kMaxTextureSide)
+    cinfo.scale_denom *= 2;
+  jpeg_calc_output_dimensions(&cinfo);
+  if (static_cast<long long>(cinfo.output_width) * cinfo.output_height > kMaxDecodedPixels) {
+    const std::string size =
+        std::to_string(cinfo.image_width) + "x" + std::to_string(cinfo.image_height);
+    jpeg_destroy_decompress(&cinfo);
+    throw Error("texture " + path + ": JPEG of " + size +
+                " pixels is larger than partsim decodes (" +
+                std::to_string(kMaxDecodedPixels >> 20) + " M pixels at 1/8 scale); scale it down");
+  }
   jpeg_start_decompress(&cinfo);
   width = static_cast<int>(cinfo.output_width);
   height = static_cast<int>(cinfo.output_height);
   rgb = static_cast<uint8_t*>(std::malloc(static_cast<size_t>(width) * height * 3));
+  if (!rgb) {
+    jpeg_destroy_decompress(&cinfo);
+    throw Error("texture " + path + ": out of memory for " + std::to_string(width) + "x" +
+                std::to_string(height) + " pixels");
+  }
   while (cinfo.output_scanline < cinfo.output_height) {
     JSAMPROW row = rgb + static_cast<size_t>(cinfo.output_scanline) * width * 3;
     jpeg_read_scanlines(&cinfo, &row, 1);
@@ -299,18 +329,39 @@ Image8 DecodeJpeg(const std::string& path, const std::vector<uint8_t>& bytes) {
 }  // namespace
 
 Image8 LoadImageRgba8(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw Error("texture " + path + ": cannot open the file");
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)),
-                             std::istreambuf_iterator<char>());
+  const std::string text = ReadWholeFile(path, "texture", kMaxDataFileBytes);
+  const std::vector<uint8_t> bytes(text.begin(), text.end());
   static const uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (bytes.size() >= 8 && std::memcmp(bytes.data(), kPngSignature, 8) == 0) {
-    return DecodePng(path, bytes);
+    return DownscaleToFit(DecodePng(path, bytes), kMaxTextureSide);
   }
   if (bytes.size() >= 3 && bytes[0] == 0xff && bytes[1] == 0xd8 && bytes[2] == 0xff) {
-    return DecodeJpeg(path, bytes);
+    return DownscaleToFit(DecodeJpeg(path, bytes), kMaxTextureSide);
   }
   throw Error("texture " + path + ": not a PNG or JPEG image");
+}
+
+Image8 DownscaleToFit(const Image8& image, int max_side) {
+  int f = 1;
+  while ((image.width + f - 1) / f > max_side || (image.height + f - 1) / f > max_side) ++f;
+  if (f == 1) return image;
+  Image8 out;
+  out.width = (image.width + f - 1) / f;
+  out.height = (image.height + f - 1) / f;
+  out.rgba.assign(static_cast<size_t>(out.width) * out.height * 4, 0);
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x) {
+      unsigned sum[4] = {0, 0, 0, 0};
+      int n = 0;
+      for (int v = y * f; v < std::min(image.height, (y + 1) * f); ++v)
+        for (int u = x * f; u < std::min(image.width, (x + 1) * f); ++u, ++n)
+          for (int k = 0; k < 4; ++k)
+            sum[k] += image.rgba[(static_cast<size_t>(v) * image.width + u) * 4 + k];
+      for (int k = 0; k < 4; ++k)
+        out.rgba[(static_cast<size_t>(y) * out.width + x) * 4 + k] =
+            static_cast<uint8_t>((sum[k] + n / 2) / n);
+    }
+  return out;
 }
 
 }  // namespace partsim::internal

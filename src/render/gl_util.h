@@ -69,8 +69,20 @@ struct Image8 {
   std::vector<uint8_t> rgba;  ///< height x width x 4
 };
 
-/// Loads a PNG or JPEG file (by content, not by extension) as RGBA8. Throws partsim::Error
-/// naming the file when it is missing or cannot be decoded.
+/// Largest side of a texture as loaded: bigger images are scaled down (JPEG while decoding,
+/// PNG by averaging after it).
+constexpr int kMaxTextureSide = 4096;
+/// Largest image partsim decodes at all, in pixels (after JPEG's decode-time scaling): 32 M,
+/// 128 MB as RGBA (8192 x 4096).
+constexpr long long kMaxDecodedPixels = 32ll << 20;
+
+/// Loads a PNG or JPEG file (by content, not by extension) as RGBA8, at most kMaxTextureSide
+/// on a side. Throws partsim::Error naming the file when it is missing, not a regular file,
+/// cannot be decoded, or claims more than kMaxDecodedPixels (checked from its header, before
+/// anything is allocated for the pixels).
 Image8 LoadImageRgba8(const std::string& path);
+/// `image` scaled down by the smallest whole factor that brings both sides to at most
+/// `max_side` (each pixel the mean of a factor x factor block); unchanged when it fits.
+Image8 DownscaleToFit(const Image8& image, int max_side);
 
 }  // namespace partsim::internal

@@ -138,7 +138,7 @@ bool IsMounted(const SceneImpl::CameraEntry& c) {
 Camera Scene::AddCamera(const std::string& name, int width, int height, double fovy, double near,
                         double far) {
   CheckCameraArgs("add_camera '" + name + "'", width, height, fovy, near, far);
-  Impl& s = *impl_;
+  Impl& s = impl();
   int id = s.next_id++;
   s.cameras.push_back(MakeEntry(id, name, width, height, fovy, near, far));
   return Camera(this, id);
@@ -150,7 +150,7 @@ Camera Scene::AddMountedCamera(const std::string& name, const Actor& mount, cons
   CheckCameraArgs(what, width, height, fovy, near, far);
   CheckPose(what + ": local_pose", local_pose);
   if (mount.GetScene() != this) throw Error(what + ": the mount actor belongs to another scene");
-  Impl& s = *impl_;
+  Impl& s = impl();
   s.GetActor(mount.GetId());  // throws when removed
   // the pose is known at once, before the first UpdateRender
   Pose X_WC = mount.GetPose() * local_pose;
@@ -169,7 +169,7 @@ Camera Scene::AddMountedCamera(const std::string& name, const Link& mount, const
   CheckCameraArgs(what, width, height, fovy, near, far);
   CheckPose(what + ": local_pose", local_pose);
   if (mount.GetScene() != this) throw Error(what + ": the mount link belongs to another scene");
-  Impl& s = *impl_;
+  Impl& s = impl();
   const auto& art = s.GetArticulation(mount.GetArticulationId());
   if (mount.GetIndex() < 0 || mount.GetIndex() >= static_cast<int>(art.desc.links.size()))
     throw Error(what + ": link index " + std::to_string(mount.GetIndex()) + " out of range");
@@ -185,7 +185,7 @@ Camera Scene::AddMountedCamera(const std::string& name, const Link& mount, const
 }
 
 void Scene::RemoveCamera(const Camera& camera) {
-  Impl& s = *impl_;
+  Impl& s = impl();
   for (auto it = s.cameras.begin(); it != s.cameras.end(); ++it)
     if (it->id == camera.GetId() && camera.GetScene() == this) {
       s.cameras.erase(it);
@@ -197,7 +197,7 @@ void Scene::RemoveCamera(const Camera& camera) {
 
 std::vector<Camera> Scene::GetCameras() const {
   std::vector<Camera> out;
-  for (const auto& c : impl_->cameras) out.emplace_back(const_cast<Scene*>(this), c.id);
+  for (const auto& c : impl().cameras) out.emplace_back(const_cast<Scene*>(this), c.id);
   return out;
 }
 
@@ -212,8 +212,8 @@ void Scene::AddDirectionalLight(const Eigen::Vector3d& direction, const Eigen::V
   CheckColor("add_directional_light", color);
   l.color = color;
   l.shadow = shadow;
-  l.name = "directional_" + std::to_string(impl_->lights.size());
-  impl_->lights.push_back(l);
+  l.name = "directional_" + std::to_string(impl().lights.size());
+  impl().lights.push_back(l);
 }
 
 void Scene::AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f& color) {
@@ -224,8 +224,8 @@ void Scene::AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f
   l.type = LightType::kPoint;
   l.position = position;
   l.color = color;
-  l.name = "point_" + std::to_string(impl_->lights.size());
-  impl_->lights.push_back(l);
+  l.name = "point_" + std::to_string(impl().lights.size());
+  impl().lights.push_back(l);
 }
 
 void Scene::AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d& direction,
@@ -248,30 +248,30 @@ void Scene::AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d&
   l.outer_angle = outer_angle;
   l.color = color;
   l.shadow = shadow;
-  l.name = "spot_" + std::to_string(impl_->lights.size());
-  impl_->lights.push_back(l);
+  l.name = "spot_" + std::to_string(impl().lights.size());
+  impl().lights.push_back(l);
 }
 
 void Scene::SetAmbientLight(const Eigen::Vector3f& color) {
   CheckColor("set_ambient_light", color);
-  impl_->ambient = color;
+  impl().ambient = color;
 }
 
-const std::vector<LightDesc>& Scene::GetLights() const { return impl_->lights; }
+const std::vector<LightDesc>& Scene::GetLights() const { return impl().lights; }
 
 // ---------------------------------------------------------------------------------------------
 // backend (by name: backend_registry.cc)
 
 void Scene::SetRenderBackend(std::unique_ptr<RenderBackend> backend) {
   if (!backend) throw Error("set_render_backend: backend is null");
-  impl_->render_backend = std::move(backend);
+  impl().render_backend = std::move(backend);
 }
 
 // ---------------------------------------------------------------------------------------------
 // render world
 
 void Scene::UpdateRender() {
-  Impl& s = *impl_;
+  Impl& s = impl();
   s.EnsureCompiled();
   RenderWorld& world = s.render_world;
 
@@ -363,11 +363,11 @@ void Scene::UpdateRender() {
   }
 }
 
-const RenderWorld& Scene::GetRenderWorld() const { return impl_->render_world; }
+const RenderWorld& Scene::GetRenderWorld() const { return impl().render_world; }
 
 std::vector<RenderEntityInfo> Scene::GetRenderEntities() const {
   std::vector<RenderEntityInfo> out;
-  for (const auto& a : impl_->actors) {
+  for (const auto& a : impl().actors) {
     RenderEntityInfo e;
     e.id = a.render_id;
     e.is_link = false;
@@ -376,7 +376,7 @@ std::vector<RenderEntityInfo> Scene::GetRenderEntities() const {
     e.semantic_label = a.desc.semantic_label;
     out.push_back(std::move(e));
   }
-  for (const auto& a : impl_->articulations) {
+  for (const auto& a : impl().articulations) {
     for (size_t i = 0; i < a.desc.links.size(); ++i) {
       RenderEntityInfo e;
       e.id = a.render_id_base + static_cast<uint32_t>(i);
@@ -394,11 +394,11 @@ std::vector<RenderEntityInfo> Scene::GetRenderEntities() const {
 
 std::vector<RenderVisualInfo> Scene::GetRenderVisuals() const {
   std::vector<RenderVisualInfo> out;
-  for (const auto& a : impl_->actors)
+  for (const auto& a : impl().actors)
     for (size_t j = 0; j < a.desc.visuals.size(); ++j)
       out.push_back(
           {a.visual_id_base + static_cast<uint32_t>(j), a.render_id, a.desc.visuals[j].name});
-  for (const auto& a : impl_->articulations)
+  for (const auto& a : impl().articulations)
     for (size_t i = 0; i < a.desc.links.size(); ++i)
       for (size_t j = 0; j < a.desc.links[i].visuals.size(); ++j)
         out.push_back({a.visual_id_base[i] + static_cast<uint32_t>(j),

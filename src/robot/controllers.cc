@@ -169,14 +169,17 @@ void JointEffortController::SetTarget(const Eigen::VectorXd& effort) {
   CheckVector(effort, "effort");
   effort_ = effort;
   std::string clamped;
-  const double limit = options_.force_limit;
   for (int i = 0; i < NumJoints(); ++i) {
+    // the controller's bound, and the joint's own actuator limit (URDF <limit effort>)
+    const double limit = std::min(options_.force_limit,
+                                  robot_.FindJointByName(joint_names_[i]).GetDesc().effort_limit);
     if (std::abs(effort_[i]) <= limit) continue;
-    clamped += (clamped.empty() ? "" : ", ") + joint_names_[i] + " (" + Num(effort_[i]) + ")";
+    clamped += (clamped.empty() ? "" : ", ") + joint_names_[i] + " (" + Num(effort_[i]) + " to +-" +
+               Num(limit) + ")";
     effort_[i] = std::clamp(effort_[i], -limit, limit);
   }
   status_.state = ControllerState::kReached;
-  status_.message = clamped.empty() ? "" : "efforts clamped to +-" + Num(limit) + ": " + clamped;
+  status_.message = clamped.empty() ? "" : "efforts clamped: " + clamped;
 }
 
 void JointEffortController::Update() {

@@ -252,7 +252,9 @@ class Writer {
     }
     out_ << "    <axis xyz=\"" << Vec(j.pose_in_child.q * Eigen::Vector3d::UnitX()) << "\"/>\n";
     // URDF requires limits on prismatic joints: an unlimited slide gets +-1e30
-    const double effort = std::isfinite(j.drive.force_limit) ? j.drive.force_limit : 0.0;
+    const double effort = std::isfinite(j.effort_limit)        ? j.effort_limit
+                          : std::isfinite(j.drive.force_limit) ? j.drive.force_limit
+                                                               : 0.0;
     out_ << "    <limit";
     if (type != "continuous") {
       out_ << " lower=\"" << Num(std::isfinite(j.lower) ? j.lower : -1e30) << "\" upper=\""

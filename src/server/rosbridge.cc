@@ -1,19 +1,25 @@
 #include "partsim/server/rosbridge.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <deque>
 #include <functional>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <set>
 #include <thread>
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
+#include "core/json_parse.h"
 #include "partsim/core/error.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
@@ -27,30 +33,55 @@ using WsServer = websocketpp::server<websocketpp::config::asio>;
 using Hdl = websocketpp::connection_hdl;
 using WallClock = std::chrono::steady_clock;
 
-// Deepest nesting of arrays and objects a client message may have: ROS messages nest a handful
-// of levels; a deeper one is refused while it is parsed, before a deep tree exists whose copy or
-// serialisation would recurse that deep.
-constexpr int kMaxJsonDepth = 64;
-
 // Most pieces of fragmented messages held for one client at a time (each costs a map node
 // beside its bytes): a 16 MB message arrives in pieces of 256 bytes or more.
 constexpr size_t kMaxFragmentsHeld = 65536;
+
+// Calls to client-advertised services: unanswered ones per caller, and how long one may wait.
+constexpr size_t kMaxPendingCalls = 100;
+constexpr std::chrono::seconds kCallTimeout{60};
+
+// Open subscribe requests (distinct ids) of one client on one topic.
+constexpr size_t kMaxRequestsPerTopic = 64;
+
+// Whether a page of `origin` ("scheme://host[:port]") may connect: one of `allowed`, or with
+// none given, a page of this machine.
+bool OriginAllowed(const std::string& origin, const std::vector<std::string>& allowed) {
+  if (origin.empty()) return true;  // not a browser: no page to protect against
+  std::string o = origin;
+  std::transform(o.begin(), o.end(), o.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  for (const std::string& a : allowed) {
+    std::string l = a;
+    std::transform(l.begin(), l.end(), l.begin(),
+                   [](unsigned char ch) { return std::tolower(ch); });
+    if (l == "*" || l == o) return true;
+  }
+  if (!allowed.empty()) return false;
+  for (const char* scheme : {"http://", "https://"}) {
+    if (o.rfind(scheme, 0) != 0) continue;
+    const std::string rest = o.substr(std::strlen(scheme));
+    for (const char* host : {"localhost", "127.0.0.1", "[::1]"}) {
+      const size_t n = std::strlen(host);
+      if (rest.compare(0, n, host) == 0 && (rest.size() == n || rest[n] == ':')) return true;
+    }
+  }
+  return false;
+}
+
+// Compares without stopping at the first difference (the time taken says nothing of where).
+bool SameToken(const std::string& a, const std::string& b) {
+  unsigned char diff = a.size() != b.size();
+  for (size_t i = 0; i < a.size(); ++i) diff |= a[i] ^ b[i % (b.empty() ? 1 : b.size())];
+  return diff == 0 && !b.empty();
+}
 
 // Text of a JSON value; bytes that are not UTF-8 (a client's string quoted back in an error)
 // become U+FFFD instead of throwing.
 std::string Dump(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
 
 // Parses a client's message; throws json::exception when it is malformed or nested deeper than
-// kMaxJsonDepth.
-json ParseClientJson(const std::string& text) {
-  json::parser_callback_t depth_guard = [](int depth, json::parse_event_t, json&) {
-    if (depth > kMaxJsonDepth)
-      throw json::out_of_range::create(
-          406, "nested deeper than " + std::to_string(kMaxJsonDepth) + " levels", nullptr);
-    return true;
-  };
-  return json::parse(text, depth_guard);
-}
+// internal::kMaxJsonDepth levels.
+json ParseClientJson(const std::string& text) { return internal::ParseJsonBounded(text); }
 
 // topics the simulation publishes, and the commands it takes
 const char* kClockType = "rosgraph_msgs/Clock";
@@ -167,10 +198,13 @@ struct RosbridgeServer::Impl {
       if (!all_fragment) fragment_size = 0;
     }
   };
+  /// A message waiting for a client. The text is shared by every client it goes to: the
+  /// simulation thread queues a pointer per client; fragmenting happens on the network thread.
   struct Outgoing {
-    std::string data;
-    bool binary;
-    std::string topic;  // the subscription it was published for; "" for replies and statuses
+    std::shared_ptr<const std::string> data;
+    bool binary = false;
+    std::string topic;         // the subscription it was published for; "" for replies
+    size_t fragment_size = 0;  // > 0: sent as rosbridge fragments of this many characters
   };
   /// An incoming message arriving in fragments.
   /// Only the pieces received are held: memory follows the bytes a client sent, never the
@@ -189,6 +223,7 @@ struct RosbridgeServer::Impl {
     std::mutex out_mutex;
     std::deque<Outgoing> out;
     std::atomic<bool> flush_scheduled{false};
+    bool authenticated = false;  // network thread; true from the start when no token is set
   };
   using ClientPtr = std::shared_ptr<Client>;
 
@@ -212,17 +247,20 @@ struct RosbridgeServer::Impl {
 
   mutable std::mutex clients_mutex;
   std::map<Hdl, ClientPtr, std::owner_less<Hdl>> clients;
-  // calls to client-advertised services: our id -> (caller, caller's id, service)
+  // calls to client-advertised services: our id -> (caller, caller's id, provider, service)
   struct PendingCall {
     std::weak_ptr<Client> caller;
     json id;
+    std::weak_ptr<Client> provider;
+    std::string service;
+    WallClock::time_point since;
   };
-  std::map<std::string, PendingCall> pending_calls;
-  long long next_call = 0;
+  std::map<std::string, PendingCall> pending_calls;  // clients_mutex
+  std::mt19937_64 call_ids{std::random_device{}()};  // clients_mutex
   std::atomic<long long> next_fragment{0};
   std::atomic<long long> next_request{0};
 
-  std::atomic<long long> sent{0}, dropped{0}, errors{0};
+  std::atomic<long long> sent{0}, dropped{0}, errors{0}, refused{0};
 
   // ---- outgoing ----
   /// Queues a message for a client from any thread; drops the oldest beyond the bound.
@@ -232,10 +270,14 @@ struct RosbridgeServer::Impl {
   /// exceeds max_client_queue, so that a busy subscription never evicts a service response.
   void Enqueue(const ClientPtr& c, const std::string& msg, size_t bound, bool binary = false,
                const std::string& topic = "") {
+    Enqueue(c, std::make_shared<const std::string>(msg), bound, binary, topic);
+  }
+  void Enqueue(const ClientPtr& c, std::shared_ptr<const std::string> msg, size_t bound,
+               bool binary, const std::string& topic, size_t fragment_size = 0) {
     if (bound == 0 || bound > options.max_client_queue) bound = options.max_client_queue;
     {
       std::lock_guard<std::mutex> lock(c->out_mutex);
-      c->out.push_back({msg, binary, topic});
+      c->out.push_back({std::move(msg), binary, topic, fragment_size});
       if (!topic.empty()) {
         size_t same = 0;
         for (const Outgoing& o : c->out) same += o.topic == topic;
@@ -278,11 +320,82 @@ struct RosbridgeServer::Impl {
         ++dropped;
         continue;
       }
-      ec = con->send(
-          m.data, m.binary ? websocketpp::frame::opcode::binary : websocketpp::frame::opcode::text);
-      if (ec) return;
+      if (m.fragment_size > 0) {
+        if (!SendFragments(con, *m.data, m.fragment_size)) return;
+      } else {
+        ec = con->send(*m.data, m.binary ? websocketpp::frame::opcode::binary
+                                         : websocketpp::frame::opcode::text);
+        if (ec) return;
+      }
       ++sent;
     }
+  }
+  /// rosbridge fragments: pieces of at most fragment_size characters of the JSON text, sent
+  /// one after the other (network thread). False when the connection failed.
+  bool SendFragments(const WsServer::connection_ptr& con, const std::string& text,
+                     size_t fragment_size) {
+    const size_t n = (text.size() + fragment_size - 1) / fragment_size;
+    const std::string id = "partsim_fragment_" + std::to_string(next_fragment++);
+    for (size_t i = 0; i < n; ++i) {
+      websocketpp::lib::error_code ec =
+          con->send(Dump(json{{"op", "fragment"},
+                              {"id", id},
+                              {"data", text.substr(i * fragment_size, fragment_size)},
+                              {"num", i},
+                              {"total", n}}),
+                    websocketpp::frame::opcode::text);
+      if (ec) return false;
+    }
+    return true;
+  }
+
+  /// Answers the callers of `provider`'s pending calls (of `service`, or all when empty) with a
+  /// failed service_response saying `why`, and forgets the calls (clients_mutex held).
+  void AbandonCalls(const ClientPtr& provider, const std::string& service, const std::string& why) {
+    for (auto it = pending_calls.begin(); it != pending_calls.end();) {
+      const PendingCall& call = it->second;
+      if (call.provider.lock() == provider && (service.empty() || call.service == service)) {
+        FailCall(call, why);
+        it = pending_calls.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+  void FailCall(const PendingCall& call, const std::string& why) {
+    ClientPtr caller = call.caller.lock();
+    if (!caller) return;
+    json r = {
+        {"op", "service_response"}, {"service", call.service}, {"values", why}, {"result", false}};
+    if (!call.id.is_null()) r["id"] = call.id;
+    Enqueue(caller, Dump(r), 0);
+  }
+  /// Drops calls whose caller left and fails calls unanswered for kCallTimeout (clients_mutex
+  /// held).
+  void ExpireCalls() {
+    const WallClock::time_point now = WallClock::now();
+    for (auto it = pending_calls.begin(); it != pending_calls.end();) {
+      const PendingCall& call = it->second;
+      if (call.caller.expired()) {
+        it = pending_calls.erase(it);
+      } else if (now - call.since > kCallTimeout) {
+        FailCall(call, "the provider of " + call.service + " did not answer in " +
+                           std::to_string(kCallTimeout.count()) + " s");
+        it = pending_calls.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+  /// A client left: its calls are forgotten and the callers of the services it provided told.
+  void ClientGone(const ClientPtr& c) {
+    for (auto it = pending_calls.begin(); it != pending_calls.end();) {
+      if (it->second.caller.lock() == c)
+        it = pending_calls.erase(it);
+      else
+        ++it;
+    }
+    AbandonCalls(c, "", "the provider disconnected");
   }
 
   void Status(const ClientPtr& c, const std::string& level, const std::string& msg,
@@ -387,7 +500,7 @@ struct RosbridgeServer::Impl {
   void Publish(const std::string& topic, const std::function<json()>& make,
                WallClock::time_point now) {
     json msg;
-    std::string text, cbor;
+    std::shared_ptr<const std::string> text, cbor;
     std::lock_guard<std::mutex> lock(clients_mutex);
     for (auto& [h, c] : clients) {
       auto it = c->subs.find(topic);
@@ -398,19 +511,18 @@ struct RosbridgeServer::Impl {
         continue;
       if (msg.is_null()) msg = json{{"op", "publish"}, {"topic", topic}, {"msg", make()}};
       s.last_sent = now;
+      // encoded once; each client gets a pointer (this is the simulation thread)
       if (s.cbor) {
-        if (cbor.empty()) {
+        if (!cbor) {
           std::vector<uint8_t> bytes = json::to_cbor(msg);
-          cbor.assign(bytes.begin(), bytes.end());
+          cbor = std::make_shared<const std::string>(bytes.begin(), bytes.end());
         }
         Enqueue(c, cbor, s.queue_length, true, topic);
         continue;
       }
-      if (text.empty()) text = Dump(TextForm(msg));
-      if (s.fragment_size > 0 && text.size() > s.fragment_size)
-        EnqueueFragments(c, text, s, topic);
-      else
-        Enqueue(c, text, s.queue_length, false, topic);
+      if (!text) text = std::make_shared<const std::string>(Dump(TextForm(msg)));
+      const size_t fragment = text->size() > s.fragment_size ? s.fragment_size : 0;
+      Enqueue(c, text, s.queue_length, false, topic, fragment);
     }
   }
   /// The message for JSON clients: binary fields become base64 strings.
@@ -419,22 +531,6 @@ struct RosbridgeServer::Impl {
     if (j.is_object() || j.is_array())
       for (auto& v : j) v = TextForm(std::move(v));
     return j;
-  }
-  /// rosbridge fragments: pieces of at most fragment_size characters of the JSON text.
-  void EnqueueFragments(const ClientPtr& c, const std::string& text, const Subscription& s,
-                        const std::string& topic) {
-    const size_t n = (text.size() + s.fragment_size - 1) / s.fragment_size;
-    const std::string id = "partsim_fragment_" + std::to_string(next_fragment++);
-    // the bound counts whole messages: all pieces of one message fit together
-    const size_t bound = (s.queue_length ? s.queue_length : options.max_client_queue) * n;
-    for (size_t i = 0; i < n; ++i)
-      Enqueue(c,
-              Dump(json{{"op", "fragment"},
-                        {"id", id},
-                        {"data", text.substr(i * s.fragment_size, s.fragment_size)},
-                        {"num", i},
-                        {"total", n}}),
-              bound, false, topic);
   }
   static json Header(double t, const std::string& frame) {
     return {{"seq", 0}, {"stamp", Stamp(t)}, {"frame_id", frame}};
@@ -609,6 +705,16 @@ struct RosbridgeServer::Impl {
 
   // ---- services ----
   /// Built-in services; returns false if `service` is not one.
+  std::vector<std::string> BuiltinServices() const {
+    return {"/rosapi/topics", "/rosapi/topic_type", "/rosapi/services",
+            "/partsim/pause", "/partsim/resume",    "/partsim/reset",
+            "/partsim/step",  "/partsim/stats",     Prefix() + "/plan"};
+  }
+  bool CallBuiltinName(const std::string& service) const {
+    for (const std::string& b : BuiltinServices())
+      if (b == service) return true;
+    return false;
+  }
   bool CallBuiltin(const ClientPtr& c, const std::string& service, const json& args,
                    const json& id) {
     json values;
@@ -628,9 +734,7 @@ struct RosbridgeServer::Impl {
       auto it = all.find(args["topic"].get<std::string>());
       values = {{"type", it == all.end() ? "" : it->second}};
     } else if (service == "/rosapi/services") {
-      json names = {"/rosapi/topics", "/rosapi/topic_type", "/rosapi/services",
-                    "/partsim/pause", "/partsim/resume",    "/partsim/reset",
-                    "/partsim/step",  "/partsim/stats",     Prefix() + "/plan"};
+      json names = BuiltinServices();
       std::lock_guard<std::mutex> lock(clients_mutex);
       for (auto& [h, cl] : clients)
         for (const std::string& s : cl->services) names.push_back(s);
@@ -754,6 +858,7 @@ struct RosbridgeServer::Impl {
     s.mean_latency_steps = cs.mean_latency_steps;
     s.max_latency_steps = cs.max_latency_steps;
     s.errors = errors;
+    s.refused = refused;
     return s;
   }
 
@@ -788,6 +893,26 @@ struct RosbridgeServer::Impl {
       return;
     }
     json id = j.is_object() && j.contains("id") ? j["id"] : json();
+    if (!c->authenticated) {
+      // with a token set, nothing but the auth op until it has come right
+      const bool auth = j.is_object() && j.contains("op") && j["op"] == "auth";
+      if (!auth) {
+        Status(c, "error",
+               "authenticate first: send {\"op\": \"auth\", \"mac\": <the server's token>}", id);
+        return;
+      }
+      const bool ok = j.contains("mac") && j["mac"].is_string() &&
+                      SameToken(j["mac"].get<std::string>(), options.auth_token);
+      if (!ok) {
+        Status(c, "error", "auth: wrong token; closing the connection", id);
+        websocketpp::lib::error_code ec;
+        ws.close(c->hdl, websocketpp::close::status::policy_violation, "authentication failed", ec);
+        return;
+      }
+      c->authenticated = true;
+      Status(c, "info", "authenticated", id);
+      return;
+    }
     if (j.is_object() && j.value("op", "") == "fragment") {
       try {
         std::string whole;
@@ -907,7 +1032,15 @@ struct RosbridgeServer::Impl {
                                  : id.is_string() ? id.get<std::string>()
                                                   : Dump(id);
       std::lock_guard<std::mutex> lock(clients_mutex);
+      if (!c->subs.count(topic) && c->subs.size() >= options.max_subscriptions)
+        throw Error("subscribe " + topic + ": this client already subscribes to " +
+                    std::to_string(c->subs.size()) + " topics (at most " +
+                    std::to_string(options.max_subscriptions) + ")");
       Subscription& sub = c->subs[topic];
+      if (!sub.requests.count(sub_id) && sub.requests.size() >= kMaxRequestsPerTopic)
+        throw Error("subscribe " + topic + ": " + std::to_string(sub.requests.size()) +
+                    " subscribe requests of this client are open on it (at most " +
+                    std::to_string(kMaxRequestsPerTopic) + ")");
       sub.requests[sub_id] = s;
       sub.Merge();
     } else if (op == "unsubscribe") {
@@ -935,6 +1068,10 @@ struct RosbridgeServer::Impl {
         if (o != other->advertised.end() && o->second != type)
           throw Error("advertise " + topic + ": already advertised as " + o->second);
       }
+      if (!c->advertised.count(topic) && c->advertised.size() >= options.max_subscriptions)
+        throw Error("advertise " + topic + ": this client already advertises " +
+                    std::to_string(c->advertised.size()) + " topics (at most " +
+                    std::to_string(options.max_subscriptions) + ")");
       c->advertised[topic] = type;
     } else if (op == "unadvertise") {
       std::string topic = Name(j, "topic", op);
@@ -960,34 +1097,58 @@ struct RosbridgeServer::Impl {
       std::string service = Name(j, "service", op);
       json args = j.contains("args") ? j["args"] : json::object();
       if (CallBuiltin(c, service, args, id)) return;
-      // a service some client advertised: forward it with our own id
+      // a service some client advertised: forward it with our own id, which no other client
+      // can guess
       std::lock_guard<std::mutex> lock(clients_mutex);
+      ExpireCalls();
       for (auto& [h, provider] : clients) {
         if (!provider->services.count(service)) continue;
-        std::string call_id = "partsim_call_" + std::to_string(next_call++);
-        pending_calls[call_id] = {c, id};
-        Enqueue(provider,
-                Dump(json{
-                    {"op", "call_service"}, {"service", service}, {"args", args}, {"id", call_id}}),
-                0);
+        size_t mine = 0;
+        for (const auto& [k, call] : pending_calls) mine += call.caller.lock() == c;
+        if (mine >= kMaxPendingCalls)
+          throw Error("call_service " + service + ": " + std::to_string(mine) +
+                      " calls of this client are still unanswered (at most " +
+                      std::to_string(kMaxPendingCalls) + ")");
+        char buf[64];
+        std::snprintf(buf, sizeof(buf), "partsim_call_%016llx%016llx",
+                      static_cast<unsigned long long>(call_ids()),
+                      static_cast<unsigned long long>(call_ids()));
+        pending_calls[buf] = {c, id, provider, service, WallClock::now()};
+        Enqueue(
+            provider,
+            Dump(json{{"op", "call_service"}, {"service", service}, {"args", args}, {"id", buf}}),
+            0);
         return;
       }
       throw Error("call_service: no service '" + service + "'");
     } else if (op == "advertise_service") {
       std::string service = Name(j, "service", op);
       std::lock_guard<std::mutex> lock(clients_mutex);
+      if (CallBuiltinName(service))
+        throw Error("advertise_service " + service + ": partsim provides this service");
+      for (auto& [h, other] : clients)
+        if (other != c && other->services.count(service))
+          throw Error("advertise_service " + service +
+                      ": another client provides this service (it must unadvertise first)");
+      if (!c->services.count(service) && c->services.size() >= options.max_services)
+        throw Error("advertise_service " + service + ": this client already provides " +
+                    std::to_string(c->services.size()) + " services (at most " +
+                    std::to_string(options.max_services) + ")");
       c->services.insert(service);
     } else if (op == "unadvertise_service") {
       std::string service = Name(j, "service", op);
       std::lock_guard<std::mutex> lock(clients_mutex);
       c->services.erase(service);
+      AbandonCalls(c, service, "the provider unadvertised " + service);
     } else if (op == "service_response") {
       if (!j.contains("id") || !j["id"].is_string())
         throw Error("service_response needs the 'id' of the call it answers");
       std::lock_guard<std::mutex> lock(clients_mutex);
       auto it = pending_calls.find(j["id"].get<std::string>());
-      if (it == pending_calls.end())
-        throw Error("service_response: no pending call '" + j["id"].get<std::string>() + "'");
+      // only the client the call went to may answer it
+      if (it == pending_calls.end() || it->second.provider.lock() != c)
+        throw Error("service_response: no pending call '" + j["id"].get<std::string>() +
+                    "' to this client");
       json r = j;
       if (it->second.id.is_null())
         r.erase("id");
@@ -995,6 +1156,9 @@ struct RosbridgeServer::Impl {
         r["id"] = it->second.id;
       if (ClientPtr caller = it->second.caller.lock()) Enqueue(caller, Dump(r), 0);
       pending_calls.erase(it);
+    } else if (op == "auth") {
+      // already authenticated, or no token is set
+      Status(c, "info", options.auth_token.empty() ? "no token needed" : "authenticated", id);
     } else {
       throw Error("unknown op '" + op + "'");
     }
@@ -1026,15 +1190,40 @@ RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& opt
   m.ws.init_asio();
   m.ws.set_reuse_addr(true);
   m.ws.set_max_message_size(options.max_message_bytes);
+  // the handshake: a browser page from an origin not allowed, or one connection too many,
+  // is refused before it becomes a client
+  m.ws.set_validate_handler([this](Hdl h) {
+    Impl& im = *impl_;
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = im.ws.get_con_from_hdl(h, ec);
+    if (ec || !con) return false;
+    if (!OriginAllowed(con->get_origin(), im.options.allowed_origins)) {
+      ++im.refused;
+      con->set_status(websocketpp::http::status_code::forbidden);
+      return false;
+    }
+    std::lock_guard<std::mutex> lock(im.clients_mutex);
+    if (im.clients.size() >= im.options.max_clients) {
+      ++im.refused;
+      con->set_status(websocketpp::http::status_code::service_unavailable);
+      return false;
+    }
+    return true;
+  });
   m.ws.set_open_handler([this](Hdl h) {
     auto c = std::make_shared<Impl::Client>();
     c->hdl = h;
+    c->authenticated = impl_->options.auth_token.empty();
     std::lock_guard<std::mutex> lock(impl_->clients_mutex);
     impl_->clients[h] = c;
   });
   auto gone = [this](Hdl h) {
     std::lock_guard<std::mutex> lock(impl_->clients_mutex);
-    impl_->clients.erase(h);
+    auto it = impl_->clients.find(h);
+    if (it == impl_->clients.end()) return;
+    Impl::ClientPtr c = it->second;
+    impl_->clients.erase(it);
+    impl_->ClientGone(c);
   };
   m.ws.set_close_handler(gone);
   m.ws.set_fail_handler(gone);
@@ -1047,15 +1236,30 @@ void RosbridgeServer::Start() {
   Impl& m = *impl_;
   if (m.started) throw Error("RosbridgeServer: already started");
   websocketpp::lib::error_code ec;
-  boost::asio::ip::tcp::endpoint ep(boost::asio::ip::make_address(m.options.address),
-                                    static_cast<unsigned short>(m.options.port));
+  // an address, or a host name resolved to its first address
+  boost::system::error_code bec;
+  boost::asio::ip::address addr = boost::asio::ip::make_address(m.options.address, bec);
+  if (bec) {
+    boost::asio::ip::tcp::resolver resolver(m.ws.get_io_service());
+    auto found = resolver.resolve(m.options.address, "", bec);
+    if (bec || found.empty())
+      throw Error("rosbridge: cannot resolve the address '" + m.options.address +
+                  "': " + (bec ? bec.message() : "no address"));
+    addr = found.begin()->endpoint().address();
+  }
+  if (!addr.is_loopback())
+    std::fprintf(stderr,
+                 "partsim: warning: rosbridge listens on %s (%s), reachable from other machines: "
+                 "anyone who can connect can move the robot and stop the simulation%s\n",
+                 m.options.address.c_str(), addr.to_string().c_str(),
+                 m.options.auth_token.empty() ? "; set a token (--token)" : "");
+  boost::asio::ip::tcp::endpoint ep(addr, static_cast<unsigned short>(m.options.port));
   m.ws.listen(ep, ec);
   if (ec)
     throw Error("rosbridge: cannot listen on " + m.options.address + ":" +
                 std::to_string(m.options.port) + ": " + ec.message());
   m.ws.start_accept(ec);
   if (ec) throw Error("rosbridge: cannot accept: " + ec.message());
-  boost::system::error_code bec;
   m.port = m.ws.get_local_endpoint(bec).port();
   m.io_thread = std::thread([this] { impl_->ws.run(); });
   m.started = true;

@@ -1,6 +1,7 @@
 // `partsim serve`: a scene stepped in real time (or faster) behind a rosbridge v2 server.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -8,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "commands.h"
 #include "partsim/assets/default_objects.h"
@@ -27,7 +29,8 @@ namespace {
 constexpr char kServeUsage[] = R"(usage:
   partsim serve [SCENE] [--port P] [--rate R | --realtime-factor F | --fast]
                 [--robot gripper|panda] [--address A] [--duration S] [--camera WxH]
-                [--camera-rate HZ] [--ros1 [--ros1-wall-time]]
+                [--camera-rate HZ] [--token T] [--allow-origin O]... [--max-clients N]
+                [--ros1 [--ros1-wall-time]]
 
 Steps a scene on its own thread and serves it over the rosbridge v2 protocol (JSON over
 WebSocket): /clock, /joint_states and /tf out; /<robot>/joint_position_controller/command,
@@ -52,7 +55,13 @@ With no SCENE, a built-in cabinet stands in front of the robot.
   --realtime-factor F    simulated seconds per wall second (default 1)
   --fast                 step as fast as possible
   --robot gripper|panda  the robot (default panda), commanded under /panda or /flying_gripper
-  --address A            interface to listen on (default 127.0.0.1)
+  --address A            interface to listen on, an address or a host name (default
+                         127.0.0.1; anything else is reachable from other machines: see --token)
+  --token T              clients must first send {"op": "auth", "mac": "T"} (default: none;
+                         also read from the PARTSIM_SERVE_TOKEN environment variable)
+  --allow-origin O       web pages from origin O (e.g. http://myhost:8000, or * for any) may
+                         connect; repeatable (default: pages of this machine only)
+  --max-clients N        connections at once (default 100)
   --duration S           stop after S wall-clock seconds (default: run until SIGINT/SIGTERM)
   --camera WxH           image size of /front_camera (default 640x480)
   --camera-rate HZ       camera topics per simulated second (default 10; 0: every step)
@@ -80,6 +89,10 @@ void OnSignal(int) { g_stop = true; }
 
 int RunServeCommand(int argc, char** argv) {
   std::string scene_file, robot_kind = "panda", address = "127.0.0.1";
+  const char* env_token = std::getenv("PARTSIM_SERVE_TOKEN");
+  std::string token = env_token ? env_token : "";
+  std::vector<std::string> origins;
+  size_t max_clients = 100;
   int port = 9090;
   double rate = 500, factor = 1, duration = 0;
   bool fast = false, ros1 = false, ros1_sim_time = true;
@@ -126,6 +139,17 @@ int RunServeCommand(int argc, char** argv) {
         ros1_sim_time = false;
       } else if (a == "--address") {
         address = value();
+      } else if (a == "--token") {
+        token = value();
+        if (token.empty())
+          throw ServeUsageError("partsim serve: --token expects a non-empty token");
+      } else if (a == "--allow-origin") {
+        origins.push_back(value());
+      } else if (a == "--max-clients") {
+        const double n = ParsePositive(a, value());
+        if (n != std::floor(n) || n > 100000)
+          throw ServeUsageError("partsim serve: --max-clients expects an integer from 1 to 100000");
+        max_clients = static_cast<size_t>(n);
       } else if (a == "--robot") {
         robot_kind = value();
         if (robot_kind != "gripper" && robot_kind != "panda")
@@ -202,6 +226,9 @@ int RunServeCommand(int argc, char** argv) {
     RosbridgeOptions ro;
     ro.address = address;
     ro.port = port;
+    ro.auth_token = token;
+    ro.allowed_origins = origins;
+    ro.max_clients = max_clients;
     RosbridgeServer bridge(&served, ro);
     bridge.Start();
 #ifdef PARTSIM_WITH_ROS1

@@ -470,14 +470,46 @@ TEST(UrdfTest, InertialOffDiagonalAndRotatedOrigin) {
   EXPECT_TRUE(in.cmass_local_pose.p.isApprox(Eigen::Vector3d(0.1, 0, 0)));
 }
 
-TEST(UrdfTest, ZeroInertiaBecomesSmallPositive) {
+// A zero inertia tensor once became 1e-9 kg m^2: a link whose centre of mass lies on its axis
+// then spun without resistance (-283,062 rad in 0.4 s). It now gets a 5 cm solid sphere's, with
+// a warning naming the link.
+TEST(UrdfTest, ZeroInertiaBecomesASolidSpheresInertiaWithAWarning) {
   std::string urdf = Robot(
       "<link name=\"a\"><inertial><mass value=\"1\"/>"
       "<inertia ixx=\"0\" ixy=\"0\" ixz=\"0\" iyy=\"0\" iyz=\"0\" izz=\"0\"/></inertial></link>");
-  ArticulationDesc d = UrdfLoader().Parse(urdf, kMeshDir);
+  UrdfLoader loader;
+  ArticulationDesc d = loader.Parse(urdf, kMeshDir);
   ASSERT_TRUE(d.links[0].inertial.has_value());
-  EXPECT_GT(d.links[0].inertial->inertia.minCoeff(), 0.0);
-  EXPECT_LT(d.links[0].inertial->inertia.maxCoeff(), 1e-6);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(d.links[0].inertial->inertia[k], 0.4 * 0.05 * 0.05, 1e-12);
+  ASSERT_EQ(loader.LastReport().warnings.size(), 1u);
+  EXPECT_NE(loader.LastReport().warnings[0].message.find("link 'a' <inertial> has no inertia"),
+            std::string::npos)
+      << loader.LastReport().warnings[0].message;
+  loader.strict = true;
+  EXPECT_THROW(loader.Parse(urdf, kMeshDir), Error);
+}
+
+// The spinning case itself: a wheel-like link with its centre of mass on its hinge, a zero
+// tensor, and a torque. With the sphere's inertia it turns at a bounded rate.
+TEST(UrdfTest, ZeroInertiaLinkOnItsAxisTurnsAtABoundedRate) {
+  std::string urdf = Robot(
+      "<link name=\"base\"><inertial><mass value=\"1\"/>"
+      "<inertia ixx=\"1\" ixy=\"0\" ixz=\"0\" iyy=\"1\" iyz=\"0\" izz=\"1\"/></inertial></link>"
+      "<link name=\"wheel\"><inertial><mass value=\"0.5\"/>"
+      "<inertia ixx=\"0\" ixy=\"0\" ixz=\"0\" iyy=\"0\" iyz=\"0\" izz=\"0\"/></inertial></link>" +
+      Joint("spin", "continuous", "base", "wheel"));
+  Scene scene;
+  UrdfLoader loader(&scene);
+  loader.fix_root_link = true;
+  Articulation art = loader.LoadFromString(urdf, kMeshDir);
+  partsim::Joint spin = art.FindJointByName("spin");
+  for (int i = 0; i < 200; ++i) {  // 0.4 s of a 0.01 N m torque
+    art.SetQf(Eigen::VectorXd::Constant(1, 0.01));
+    scene.Step();
+  }
+  // I = 0.4 m r^2 = 5e-4 kg m^2: q = tau t^2 / (2 I) = 1.6 rad
+  EXPECT_NEAR(spin.GetQpos(), 0.01 * 0.4 * 0.4 / (2 * 0.4 * 0.5 * 0.0025), 0.05);
 }
 
 TEST(UrdfTest, NoInertialLeavesItUnsetAndDensityApplies) {

@@ -39,7 +39,8 @@ using testing::WaitFor;
 /// A WebSocket client on its own thread that keeps every message it receives.
 class TestClient {
  public:
-  explicit TestClient(int port) {
+  /// `origin`: the Origin header a browser would send ("" sends none).
+  explicit TestClient(int port, const std::string& origin = "") {
     c_.clear_access_channels(websocketpp::log::alevel::all);
     c_.clear_error_channels(websocketpp::log::elevel::all);
     c_.init_asio();
@@ -80,6 +81,7 @@ class TestClient {
     });
     websocketpp::lib::error_code ec;
     con_ = c_.get_connection("ws://127.0.0.1:" + std::to_string(port), ec);
+    if (!origin.empty()) con_->replace_header("Origin", origin);
     c_.connect(con_);
     thread_ = std::thread([this] { c_.run(); });
   }
@@ -144,6 +146,12 @@ class TestClient {
   /// Keep /tf messages (set before subscribing).
   void KeepTf() { keep_tf_ = true; }
   bool Closed() const { return closed_; }
+  /// Closes the connection and waits until it is closed.
+  void Close() {
+    websocketpp::lib::error_code ec;
+    c_.close(con_->get_handle(), websocketpp::close::status::normal, "", ec);
+    WaitFor([this] { return closed_.load(); });
+  }
   int CloseCode() const { return close_code_; }
 
  private:
@@ -236,7 +244,7 @@ class RosbridgeTest : public ::testing::Test {
     sim_ = std::make_unique<SimServer>(scene_.get(), loop_.get());
     served_ = std::make_unique<ServedRobot>(sim_.get(), scene_.get(), loop_.get(), robot_,
                                             robot_.GetName());
-    RosbridgeOptions o;
+    RosbridgeOptions o = Options();
     o.port = 0;
     bridge_ = std::make_unique<RosbridgeServer>(served_.get(), o);
     bridge_->Start();
@@ -247,6 +255,8 @@ class RosbridgeTest : public ::testing::Test {
     sim_->Stop();
     bridge_->Stop();
   }
+  /// The server's options (a fixture may set origins, a token, caps).
+  virtual RosbridgeOptions Options() const { return RosbridgeOptions(); }
   /// A client subscribed to /clock, once the clock is flowing to it.
   std::unique_ptr<TestClient> ClockWatcher() {
     auto c = std::make_unique<TestClient>(port_);
@@ -665,6 +675,154 @@ TEST_F(RosbridgeTest, TrajectoryWithAFarTimeIsRefusedAndTheSimulationGoesOn) {
       << e["msg"];
   EXPECT_TRUE(ClockAdvances(*c, 0.05));
   EXPECT_EQ(sim_->GetErrorCount(), 0);
+}
+
+// ---- who may connect, and what one client may hold ----
+
+/// A page on another site, opened in the user's browser, must not reach the server.
+TEST_F(RosbridgeTest, PagesFromOtherOriginsAreRefusedAndLocalPagesAndToolsAreNot) {
+  TestClient evil(port_, "http://evil.example.com");
+  EXPECT_FALSE(evil.WaitOpen());
+  TestClient evil_port(port_, "http://localhost.example.com:9090");
+  EXPECT_FALSE(evil_port.WaitOpen());
+  EXPECT_EQ(bridge_->GetStats().refused, 2);
+  for (const char* origin : {"http://localhost:8000", "http://127.0.0.1", "https://[::1]:3000"}) {
+    TestClient local(port_, origin);
+    EXPECT_TRUE(local.WaitOpen()) << origin;
+  }
+  TestClient tool(port_);  // roslib in Node.js, rospy: no Origin at all
+  ASSERT_TRUE(tool.WaitOpen());
+  tool.Send(json{{"op", "subscribe"}, {"topic", "/clock"}});
+  EXPECT_TRUE(ClockAdvances(tool, 0.05));
+}
+
+TEST_F(RosbridgeTest, ASubscriberCapsItsTopicsAndRequests) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  for (int k = 0; k < 256; ++k)
+    c.Send(json{{"op", "subscribe"}, {"topic", "/t" + std::to_string(k)}});
+  c.Send(json{{"op", "subscribe"}, {"topic", "/one_too_many"}, {"id", "over"}});
+  json e = c.WaitMessage([](const json& m) { return m.value("id", "") == "over"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("at most 256"), std::string::npos) << e["msg"];
+  for (int k = 0; k < 64; ++k)
+    c.Send(json{{"op", "subscribe"}, {"topic", "/t0"}, {"id", "r" + std::to_string(k)}});
+  c.Send(json{{"op", "subscribe"}, {"topic", "/t0"}, {"id", "r64"}});
+  e = c.WaitMessage([](const json& m) { return m.value("id", "") == "r64"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("at most 64"), std::string::npos) << e["msg"];
+}
+
+TEST_F(RosbridgeTest, ServiceCallsGoToTheirProviderAloneAndNeverHang) {
+  TestClient provider(port_), rival(port_), caller(port_);
+  ASSERT_TRUE(provider.WaitOpen() && rival.WaitOpen() && caller.WaitOpen());
+  provider.Send(json{{"op", "advertise_service"}, {"service", "/add"}, {"type", "x/Add"}});
+  std::this_thread::sleep_for(50ms);
+  // no silent take-over of the name, and partsim's own services are not for advertising
+  rival.Send(
+      json{{"op", "advertise_service"}, {"service", "/add"}, {"type", "x/Add"}, {"id", "t"}});
+  json e = rival.WaitMessage([](const json& m) { return m.value("id", "") == "t"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("another client provides"), std::string::npos);
+  rival.Send(json{{"op", "advertise_service"}, {"service", "/partsim/pause"}, {"id", "p"}});
+  e = rival.WaitMessage([](const json& m) { return m.value("id", "") == "p"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  // the call reaches the provider under an id no one can guess; only the provider answers it
+  caller.Send(
+      json{{"op", "call_service"}, {"service", "/add"}, {"args", {{"a", 1}}}, {"id", "c1"}});
+  json call =
+      provider.WaitMessage([](const json& m) { return m.value("op", "") == "call_service"; });
+  ASSERT_FALSE(call.is_null());
+  const std::string call_id = call["id"].get<std::string>();
+  EXPECT_EQ(call_id.size(), std::string("partsim_call_").size() + 32) << call_id;
+  rival.Send(json{
+      {"op", "service_response"}, {"id", call_id}, {"values", {{"sum", 666}}}, {"result", true}});
+  std::this_thread::sleep_for(50ms);
+  provider.Send(json{{"op", "service_response"},
+                     {"service", "/add"},
+                     {"id", call_id},
+                     {"values", {{"sum", 2}}},
+                     {"result", true}});
+  json r = caller.WaitMessage([](const json& m) { return m.value("id", "") == "c1"; });
+  ASSERT_FALSE(r.is_null());
+  EXPECT_EQ(r["values"]["sum"], 2);  // the provider's answer, not the rival's
+  bool rival_refused = false;
+  for (const json& m : rival.Messages())
+    rival_refused |=
+        IsError(m) && m["msg"].get<std::string>().find("to this client") != std::string::npos;
+  EXPECT_TRUE(rival_refused);
+  // a provider that leaves mid-call: the caller is told, not left waiting
+  caller.Send(
+      json{{"op", "call_service"}, {"service", "/add"}, {"args", {{"a", 2}}}, {"id", "c2"}});
+  ASSERT_TRUE(WaitFor([&] {
+    int calls = 0;
+    for (const json& m : provider.Messages()) calls += m.value("op", "") == "call_service";
+    return calls == 2;
+  }));
+  provider.Close();
+  json gone = caller.WaitMessage([](const json& m) { return m.value("id", "") == "c2"; });
+  ASSERT_FALSE(gone.is_null());
+  EXPECT_EQ(gone["result"], false);
+  EXPECT_NE(gone.dump().find("the provider disconnected"), std::string::npos) << gone.dump();
+  // the name is free again
+  rival.Send(
+      json{{"op", "advertise_service"}, {"service", "/add"}, {"type", "x/Add"}, {"id", "t2"}});
+  std::this_thread::sleep_for(100ms);
+  for (const json& m : rival.Messages()) EXPECT_NE(m.value("id", ""), "t2") << m.dump();
+}
+
+/// A server with an origin allow-list, a token and room for two clients.
+class RosbridgeGuardedTest : public RosbridgeTest {
+ protected:
+  RosbridgeOptions Options() const override {
+    RosbridgeOptions o;
+    o.allowed_origins = {"http://lab.example:8000"};
+    o.auth_token = "s3cret";
+    o.max_clients = 2;
+    return o;
+  }
+};
+
+TEST_F(RosbridgeGuardedTest, AllowListReplacesTheLocalOrigins) {
+  TestClient local(port_, "http://localhost:8000");
+  EXPECT_FALSE(local.WaitOpen());
+  TestClient lab(port_, "http://LAB.example:8000");  // origins compare without case
+  EXPECT_TRUE(lab.WaitOpen());
+}
+
+TEST_F(RosbridgeGuardedTest, NothingButAuthUntilTheTokenComesRight) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "call_service"}, {"service", "/partsim/pause"}, {"id", "early"}});
+  json e = c.WaitMessage([](const json& m) { return m.value("id", "") == "early"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("authenticate first"), std::string::npos);
+  EXPECT_FALSE(sim_->IsPaused());
+  c.Send(json{{"op", "auth"}, {"mac", "s3cret"}, {"id", "a"}});
+  json ok = c.WaitMessage([](const json& m) { return m.value("id", "") == "a"; });
+  EXPECT_EQ(ok.value("level", ""), "info") << ok.dump();
+  c.Send(json{{"op", "subscribe"}, {"topic", "/clock"}});
+  EXPECT_TRUE(ClockAdvances(c, 0.05));
+  // a wrong token closes the connection
+  TestClient w(port_);
+  ASSERT_TRUE(w.WaitOpen());
+  w.Send(json{{"op", "auth"}, {"mac", "s3cret!"}, {"id", "bad"}});
+  EXPECT_TRUE(WaitFor([&] { return w.Closed(); }));
+}
+
+TEST_F(RosbridgeGuardedTest, ConnectionsBeyondTheCapAreRefused) {
+  auto a = std::make_unique<TestClient>(port_);
+  TestClient b(port_);
+  ASSERT_TRUE(a->WaitOpen() && b.WaitOpen());
+  {
+    TestClient c(port_);
+    EXPECT_FALSE(c.WaitOpen());
+  }
+  EXPECT_GE(bridge_->GetStats().refused, 1);
+  a.reset();
+  ASSERT_TRUE(WaitFor([&] { return bridge_->GetStats().clients == 1; }));
+  TestClient d(port_);
+  EXPECT_TRUE(d.WaitOpen());
 }
 
 TEST_F(RosbridgeTest, SubscriptionWithFragmentSizeGetsPiecesThatRebuildTheMessage) {

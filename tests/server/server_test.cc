@@ -82,6 +82,18 @@ TEST(ServeTest, RejectsBadArgumentsAndServesForADuration) {
   EXPECT_EQ(code, 2);
   RunShell(cli + "--port 70000 2>&1", &code);
   EXPECT_EQ(code, 2);
+  out = RunShell(cli + "--max-clients 0 2>&1", &code);
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(out.find("--max-clients expects"), std::string::npos) << out;
+  out = RunShell(cli + "--token '' 2>&1", &code);
+  EXPECT_EQ(code, 2);
+  // a host name, a token and an origin: served, and no warning for a loopback address
+  out = RunShell(cli +
+                     "--robot gripper --fast --port 0 --duration 0.3 --address localhost "
+                     "--token t0k --allow-origin http://lab.example:8000 --max-clients 4 2>&1",
+                 &code);
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_EQ(out.find("warning"), std::string::npos) << out;
   out = RunShell(cli + "/nonexistent/scene.urdf --port 0 2>&1", &code);
   EXPECT_EQ(code, 1);
   EXPECT_NE(out.find("/nonexistent/scene.urdf"), std::string::npos) << out;

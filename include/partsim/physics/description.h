@@ -159,6 +159,9 @@ struct JointDesc {
   double damping = 0.0;   ///< viscous damping (N s/m or N m s/rad), >= 0
   double armature = 0.0;  ///< added rotor inertia (kg or kg m^2), >= 0
   double pitch = 0.0;     ///< screw joints: metres of translation per radian
+  /// Largest effort the joint's actuator gives (N or N m, > 0; URDF <limit effort>): effort
+  /// controllers clamp to it. inf: none given.
+  double effort_limit = kInf;
   DriveDesc drive;
 };
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -435,9 +436,31 @@ class Scene {
   /// The MJCF text the last compile used (for debugging).
   std::string GetMjcf() const;
 
-  // Internals used by the handles; not part of the stable API.
+  /// A scene is used by one thread at a time. Step (and rendering, and the Python calls that
+  /// run without the GIL) hold the scene for their thread while they run: meanwhile another
+  /// thread's Step waits its turn, and any other call from another thread, on the scene or on
+  /// one of its handles, throws partsim::Error instead of racing. Hold a Use to keep other
+  /// threads out across several calls. Re-entrant on its thread.
+  class Use {
+   public:
+    /// Waits until no other thread holds the scene.
+    explicit Use(const Scene& scene);
+    /// Takes the scene only if no other thread holds it: see owns().
+    Use(const Scene& scene, std::try_to_lock_t);
+    ~Use();
+    Use(const Use&) = delete;
+    Use& operator=(const Use&) = delete;
+    bool owns() const { return owns_; }
+
+   private:
+    const Scene* scene_;
+    bool owns_ = false;
+  };
+
+  // Internals used by the handles; not part of the stable API. Throws partsim::Error when
+  // another thread holds the scene (Use).
   struct Impl;
-  Impl& impl() const { return *impl_; }
+  Impl& impl() const;
 
  private:
   std::unique_ptr<Impl> impl_;

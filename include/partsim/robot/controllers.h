@@ -89,8 +89,9 @@ class Controller {
   std::string name_;
 };
 
-/// Applies joint efforts (N m or N), clamped to +-force_limit (documented clamp: the status
-/// message says which were clamped), plus gravity compensation if enabled. The controlled
+/// Applies joint efforts (N m or N), clamped to +-force_limit and to each joint's own
+/// effort_limit (URDF <limit effort>; the status message says which were clamped), plus gravity
+/// compensation if enabled. The controlled
 /// joints' drives are switched off. With no target yet it applies only the compensation; once
 /// a target is set the status is kReached (there is nothing to wait for).
 class JointEffortController : public Controller {

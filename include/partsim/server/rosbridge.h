@@ -11,14 +11,29 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "partsim/server/served_robot.h"
 
 namespace partsim {
 
 struct RosbridgeOptions {
-  std::string address = "127.0.0.1";  ///< interface to listen on ("0.0.0.0" for all)
-  int port = 9090;                    ///< 0 picks a free port (see GetPort)
+  /// Interface to listen on: an address or a host name ("localhost"); "0.0.0.0" or "::" for
+  /// all. Anything but a loopback address is reachable from other machines: Start() warns.
+  std::string address = "127.0.0.1";
+  int port = 9090;  ///< 0 picks a free port (see GetPort)
+  /// Web pages may connect only from these origins (the handshake's Origin header, e.g.
+  /// "http://localhost:8000"); clients that send no Origin (roslib in Node.js, rospy, ROS
+  /// tools) are not concerned. Empty: the pages of this machine (http or https, host localhost,
+  /// 127.0.0.1 or [::1], any port). "*" allows every origin. Refused handshakes get HTTP 403.
+  std::vector<std::string> allowed_origins;
+  /// When not empty, a client must first send {"op": "auth", "mac": <this token>} (rosbridge's
+  /// auth op, with a shared token in place of rosauth's digest); every other op is refused
+  /// until then, and a wrong token closes the connection.
+  std::string auth_token;
+  size_t max_clients = 100;        ///< connections at once; more get HTTP 503
+  size_t max_subscriptions = 256;  ///< topics a client may subscribe to, and advertise
+  size_t max_services = 64;        ///< services a client may advertise
   /// Incoming messages larger than this close the connection with WebSocket code 1009.
   size_t max_message_bytes = 16u << 20;
   size_t max_client_queue = 200;          ///< messages waiting per client before drops
@@ -33,7 +48,8 @@ struct RosbridgeStats {
   long long commands = 0;           ///< robot commands applied (from any front-end)
   double mean_latency_steps = 0.0;  ///< steps between a command's arrival and its application
   long long max_latency_steps = 0;
-  long long errors = 0;  ///< status errors sent
+  long long errors = 0;   ///< status errors sent
+  long long refused = 0;  ///< handshakes refused (origin, connection cap)
 };
 
 class RosbridgeServer {
