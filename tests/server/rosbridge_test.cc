@@ -15,6 +15,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <set>
 #include <string>
 #include <thread>
@@ -920,6 +921,114 @@ TEST_F(RosbridgeTest, FiftyClientsSubscribedToEverything) {
   const long long steps = sim_->GetClockSteps();
   std::this_thread::sleep_for(200ms);
   EXPECT_GT(sim_->GetClockSteps(), steps);
+}
+
+// One subscriber asking for /tf in one-character pieces once slowed the simulation from 500 to
+// 110 steps/s for every client: the simulation thread cut the pieces. Now it queues one shared
+// message, and the network thread fragments what the client can take.
+TEST_F(RosbridgeTest, OneCharacterFragmentsCostTheSimulationNothing) {
+  RawSocket greedy(port_);  // asks for everything in pieces and reads nothing
+  ASSERT_TRUE(greedy.Ok());
+  for (const char* t : {"/tf", "/joint_states", "/clock"})
+    greedy.SendText(json{{"op", "subscribe"}, {"topic", t}, {"fragment_size", 1}}.dump());
+  std::this_thread::sleep_for(200ms);
+  const long long steps = sim_->GetClockSteps();
+  std::this_thread::sleep_for(1000ms);
+  // real time at 500 Hz; before, about 110
+  EXPECT_GT(sim_->GetClockSteps() - steps, 350);
+}
+
+// Random and mutated messages from one client (bounded in count and time, loopback only): the
+// server answers or refuses each, another client's clock keeps advancing throughout, and nothing
+// goes wrong on the simulation thread.
+TEST_F(RosbridgeTest, FuzzedMessagesNeverStopTheServer) {
+  auto watcher = ClockWatcher();
+  TestClient fuzz(port_);
+  ASSERT_TRUE(fuzz.WaitOpen());
+  const std::string robot = "/" + robot_.GetName();
+  const std::vector<std::string> seeds = {
+      json{{"op", "subscribe"}, {"topic", "/joint_states"}, {"throttle_rate", 100}}.dump(),
+      json{{"op", "subscribe"}, {"topic", "/tf"}, {"fragment_size", 50}, {"queue_length", 2}}
+          .dump(),
+      json{{"op", "unsubscribe"}, {"topic", "/tf"}}.dump(),
+      json{{"op", "publish"},
+           {"topic", robot + "/joint_position_controller/command"},
+           {"msg", {{"data", std::vector<double>(robot_.Dof(), 0.05)}}}}
+          .dump(),
+      json{{"op", "publish"},
+           {"topic", robot + "/joint_trajectory_controller/command"},
+           {"msg",
+            {{"joint_names", {"x", "y"}},
+             {"points", {{{"positions", {0.1, 0.1}}, {"time_from_start", {{"secs", 1}}}}}}}}}
+          .dump(),
+      json{{"op", "call_service"}, {"service", "/rosapi/topics"}, {"id", "f"}}.dump(),
+      json{{"op", "call_service"}, {"service", "/partsim/stats"}}.dump(),
+      json{{"op", "call_service"},
+           {"service", robot + "/plan"},
+           {"args", {{"joint_goal", std::vector<double>(robot_.Dof(), 0.0)}, {"time_limit", 0.05}}}}
+          .dump(),
+      json{{"op", "advertise"}, {"topic", "/chat"}, {"type", "std_msgs/String"}}.dump(),
+      json{{"op", "publish"}, {"topic", "/chat"}, {"msg", {{"data", "hi"}}}}.dump(),
+      json{{"op", "advertise_service"}, {"service", "/svc"}, {"type", "x/Y"}}.dump(),
+      json{{"op", "service_response"}, {"id", "partsim_call_0"}, {"result", true}}.dump(),
+      json{{"op", "fragment"}, {"id", "q"}, {"data", "{\"op\":"}, {"num", 0}, {"total", 3}}.dump(),
+      json{{"op", "auth"}, {"mac", "x"}}.dump()};
+  const std::vector<std::string> junk = {"null",         "1e999",
+                                         "-1",           "18446744073709551617",
+                                         "[]",           "{}",
+                                         "\"\xff\xfe\"", "[[[[[[[[[[1]]]]]]]]]]",
+                                         "true",         "\"/partsim/resume\""};
+  std::mt19937 rng(20261125);
+  auto pick = [&](size_t n) { return static_cast<size_t>(rng() % n); };
+  const auto t0 = std::chrono::steady_clock::now();
+  double last_clock = watcher->LastClock();
+  int sent = 0;
+  for (int i = 0; i < 3000 && std::chrono::steady_clock::now() - t0 < 15s; ++i) {
+    std::string m = seeds[pick(seeds.size())];
+    switch (pick(5)) {
+      case 0:  // flip bytes
+        for (int k = 0; k < 3; ++k) m[pick(m.size())] = static_cast<char>(rng());
+        break;
+      case 1:  // cut
+        m.resize(pick(m.size()));
+        break;
+      case 2: {  // a value replaced by junk
+        const size_t colon = m.find(':', pick(m.size()));
+        if (colon != std::string::npos) {
+          const size_t end = m.find_first_of(",}", colon);
+          m = m.substr(0, colon + 1) + junk[pick(junk.size())] +
+              (end == std::string::npos ? "" : m.substr(end));
+        }
+        break;
+      }
+      case 3:  // bytes inserted
+        m.insert(pick(m.size()), std::string(1 + pick(8), static_cast<char>(rng())));
+        break;
+      default:  // as it is, or as a binary frame
+        if (pick(2)) {
+          fuzz.SendBinary(m);
+          ++sent;
+          continue;
+        }
+    }
+    fuzz.Send(m);
+    ++sent;
+    if (i % 500 == 499) {  // the clock keeps advancing throughout
+      ASSERT_TRUE(WaitFor([&] { return watcher->LastClock() > last_clock; })) << "after " << i;
+      last_clock = watcher->LastClock();
+    }
+  }
+  EXPECT_GT(sent, 500);
+  EXPECT_GT(bridge_->GetStats().errors, sent / 10);  // the handlers were reached and refused
+  EXPECT_TRUE(ClockAdvances(*watcher, 0.05));
+  EXPECT_FALSE(sim_->IsPaused());
+  EXPECT_EQ(sim_->GetErrorCount(), 0) << sim_->GetLastError();
+  // and it still answers a newcomer
+  TestClient late(port_);
+  ASSERT_TRUE(late.WaitOpen());
+  late.Send(json{{"op", "call_service"}, {"service", "/rosapi/topics"}, {"id", "late"}});
+  json r = late.WaitMessage([](const json& m) { return m.value("id", "") == "late"; });
+  EXPECT_EQ(r.value("result", false), true) << r.dump();
 }
 
 TEST_F(RosbridgeTest, ClientThatNeverReadsDoesNotStallOthers) {
