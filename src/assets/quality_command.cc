@@ -9,11 +9,13 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "partsim/assets/generator.h"
 #include "partsim/assets/quality.h"
 #include "partsim/core/error.h"
 
@@ -34,6 +36,22 @@ constexpr const char* kCheckUsage =
 int Usage(const std::string& error) {
   std::cerr << "partsim assets check: " << error << "\n" << kCheckUsage;
   return 2;
+}
+
+bool IsPartialFolder(const std::string& folder) {
+  const std::string suffix = kPartialSuffix;
+  return folder.size() > suffix.size() &&
+         folder.compare(folder.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// A generate run was stopped while writing this object: it fails without being loaded.
+ObjectQualityReport PartialReport(const std::string& folder) {
+  ObjectQualityReport r;
+  r.folder = folder;
+  r.checks.push_back({"load", false,
+                      "left by a generate run that was stopped before the object was whole; "
+                      "generate again with --overwrite"});
+  return r;
 }
 
 }  // namespace
@@ -80,12 +98,17 @@ int RunQualityCommand(int argc, char** argv) {
     std::cerr << "partsim assets check: '" << dir << "' is not a folder\n";
     return 1;
   }
-  // every folder with a mobility_v2.json, in path order
-  std::vector<std::string> folders;
-  for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
-    if (e.is_regular_file() && e.path().filename() == "mobility_v2.json")
-      folders.push_back(e.path().parent_path().string());
-  std::sort(folders.begin(), folders.end());
+  // every object folder, in path order: one that holds any file of the dataset's layout (a
+  // folder with textured_objs/ alone fails to load, it is not skipped), and the leftovers of
+  // generate runs that were stopped (*.partial, failed without loading)
+  std::set<std::string> found;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name == "mobility_v2.json" || name == "mobility.urdf" || name == "semantics.txt" ||
+        (name == "textured_objs" && e.is_directory()))
+      found.insert(e.path().parent_path().string());
+  }
+  std::vector<std::string> folders(found.begin(), found.end());
   if (limit >= 0 && static_cast<long>(folders.size()) > limit) folders.resize(limit);
   if (folders.empty()) {
     std::cerr << "partsim assets check: no object folder (with mobility_v2.json) under '" << dir
@@ -100,7 +123,8 @@ int RunQualityCommand(int argc, char** argv) {
   auto start = std::chrono::steady_clock::now();
   auto worker = [&] {
     for (size_t i = next++; i < folders.size(); i = next++) {
-      reports[i] = CheckPartNetObject(folders[i], options);
+      reports[i] = IsPartialFolder(folders[i]) ? PartialReport(folders[i])
+                                               : CheckPartNetObject(folders[i], options);
       size_t n = ++done;
       std::lock_guard<std::mutex> lock(print);
       double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -2,6 +2,7 @@
 #include "partsim/render/image_io.h"
 
 #include <png.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -20,27 +21,35 @@
 namespace partsim {
 namespace {
 
-// a file opened for writing, closed on scope exit; throws naming the path
+// A file written under a temporary name beside its path and renamed onto it by Close: a
+// process stopped meanwhile leaves no torn file under the real name. Throws naming the path.
 struct File {
-  File(const std::string& path, const char* what) : path_(path) {
-    f_ = std::fopen(path.c_str(), "wb");
+  File(const std::string& path, const char* what)
+      : path_(path), tmp_(path + ".partsim-tmp-" + std::to_string(::getpid())) {
+    f_ = std::fopen(tmp_.c_str(), "wb");
     if (!f_)
       throw Error(std::string(what) + ": cannot write '" + path + "': " + std::strerror(errno));
   }
   ~File() {
-    if (f_) std::fclose(f_);
+    if (!f_) return;
+    std::fclose(f_);  // not closed by Close: an error on the way, the temporary goes
+    std::remove(tmp_.c_str());
   }
-  // flushes and closes, reporting a failed write (a full disk) by the path
+  // flushes, closes and renames into place, reporting a failed write (a full disk) by the path
   void Close(const char* what) {
     bool bad = std::ferror(f_) != 0;
     bad = (std::fclose(f_) != 0) || bad;
     f_ = nullptr;
-    if (bad) throw Error(std::string(what) + ": writing '" + path_ + "' failed");
+    if (!bad) bad = std::rename(tmp_.c_str(), path_.c_str()) != 0;
+    if (bad) {
+      std::remove(tmp_.c_str());
+      throw Error(std::string(what) + ": writing '" + path_ + "' failed");
+    }
   }
   FILE* get() { return f_; }
 
  private:
-  std::string path_;
+  std::string path_, tmp_;
   FILE* f_ = nullptr;
 };
 

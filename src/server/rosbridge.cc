@@ -1190,6 +1190,9 @@ RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& opt
   m.ws.init_asio();
   m.ws.set_reuse_addr(true);
   m.ws.set_max_message_size(options.max_message_bytes);
+  // a connection that has not finished its handshake within 2 s is dropped, so that sockets
+  // opened and left silent do not pile up towards the descriptor limit
+  m.ws.set_open_handshake_timeout(2000);
   // the handshake: a browser page from an origin not allowed, or one connection too many,
   // is refused before it becomes a client
   m.ws.set_validate_handler([this](Hdl h) {

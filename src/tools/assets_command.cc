@@ -19,7 +19,7 @@ namespace {
 
 constexpr char kAssetsUsage[] = R"(usage:
   partsim assets generate --out DIR [--categories all|Cat1,Cat2] [--per-category N|paper]
-                          [--seed S] [--jobs J] [--by-category]
+                          [--seed S] [--jobs J] [--by-category] [--overwrite]
   partsim assets categories
   partsim assets check DIR [--jobs J] [--no-visibility] [--backend B] [--report FILE]
   partsim assets decompose MESH --out DIR [--concavity C] [--max-pieces N]
@@ -34,6 +34,9 @@ generate     writes DIR/<anno_id>/ folders in the PartNet-Mobility format, laid 
   --seed S                dataset seed, an unsigned integer (default 0)
   --jobs J                worker threads (default 1)
   --by-category           DIR/<Category>/<anno_id>/ instead
+  --overwrite             DIR may hold objects of an earlier run: they are replaced (without
+                          it a non-empty DIR is refused); other files there are left alone.
+                          Each object is written to <anno_id>.partial and renamed when whole.
 categories   lists the 46 categories with the paper's model and part counts.
 check        runs the quality checks on every object folder under DIR and prints the models and
              movable parts per category beside the paper's (`check --help` for more).
@@ -109,6 +112,8 @@ int Generate(const std::vector<std::string>& args) {
       opt.jobs = static_cast<int>(ParseInt(flag, next(), 1));
     } else if (flag == "--by-category" && !inline_value) {
       opt.by_category = true;
+    } else if (flag == "--overwrite" && !inline_value) {
+      opt.overwrite = true;
     } else {
       throw AssetsUsageError("partsim assets generate: unknown argument '" + args[i] + "'");
     }

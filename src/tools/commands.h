@@ -2,12 +2,21 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace partsim::tools {
 
 /// Reads a whole decimal integer >= `lo` from `text` into `out`; false if `text` is not one (or
 /// overflows).
 bool ParseInteger(const std::string& text, long long lo, long long* out);
+
+/// Removes the files of `dir` that an earlier run of the same command wrote: names starting with
+/// one of `prefixes` and ending with the matching entry of `suffixes` ("color_" + ".png"), so
+/// that a run with fewer views or frames leaves no stale ones beside its own. Other files stay.
+/// Returns how many were removed.
+int ClearOwnedOutputs(const std::string& dir,
+                      const std::vector<std::pair<std::string, std::string>>& names);
 
 /// `partsim assets ...`: generate procedural PartNet-Mobility objects. `argv` holds the
 /// arguments after "assets". Returns the exit code (0 success, 1 failure, 2 bad command line).

@@ -73,7 +73,8 @@ render     places the object on a ground under lights and renders it from N view
            (binary point cloud in the world frame with colours and ids); plus
            segmentation.json (id -> actor / link name, part label, colour) and cameras.json
            (K, extrinsics and pose per view).
-  --out DIR                      output folder (required; created if missing)
+  --out DIR                      output folder (required; created if missing; the files an
+                                 earlier render wrote there are removed first)
   --backend rasterizer|pathtracer   renderer (default rasterizer)
   --views N                      number of views (default 4)
   --width W --height H           image size in pixels (default 640 x 480)
@@ -551,6 +552,16 @@ int RunRender(const Args& args) {
     throw std::runtime_error("cannot create the output folder '" + args.out +
                              "': " + (ec ? ec.message() : "not a folder"));
   }
+  // what an earlier render wrote here goes first, so that no stale view is left beside this
+  // run's (other files in the folder stay)
+  partsim::tools::ClearOwnedOutputs(args.out, {{"color_", ".png"},
+                                               {"depth_", ".png"},
+                                               {"depth_preview_", ".png"},
+                                               {"normal_", ".png"},
+                                               {"segmentation_", ".png"},
+                                               {"cloud_", ".ply"},
+                                               {"segmentation", ".json"},
+                                               {"cameras", ".json"}});
 
   // the backend first: a renderer that cannot start fails before any work
   if (args.backend == "pathtracer") {

@@ -1,4 +1,6 @@
 // `partsim serve`: a scene stepped in real time (or faster) behind a rosbridge v2 server.
+#include <sys/resource.h>
+
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -176,6 +178,15 @@ int RunServeCommand(int argc, char** argv) {
     return 2;
   }
 #endif
+
+  // every connection costs a file descriptor: take the hard limit, so that the connection cap,
+  // not the descriptor limit, is what refuses clients (websocketpp retries a failed accept at
+  // once, and would spin there)
+  rlimit files{};
+  if (getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur < files.rlim_max) {
+    files.rlim_cur = files.rlim_max;
+    setrlimit(RLIMIT_NOFILE, &files);
+  }
 
   try {
     // the scene: what SCENE names (a URDF or a PartNet-Mobility folder 1 m ahead of the

@@ -208,6 +208,8 @@ int RunDemo(const TasksArgs& a) {
   o.type = a.type;
   o.object_index = a.object >= 0 ? a.object : FindTaskObjects(a.type, 1).front();
   std::filesystem::create_directories(a.out);
+  // the frames of an earlier demo in the same folder go first: none is left beside this run's
+  ClearOwnedOutputs(a.out, {{"frame_", ".png"}});
   ArticulationTask task(o);
   task.Reset(a.seed);
   std::printf("partsim tasks demo: %s task on StorageFurniture object %d, target %s\n",

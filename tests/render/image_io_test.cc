@@ -4,6 +4,7 @@
 #include <png.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -100,6 +101,28 @@ TEST_F(ImageIoTest, Png8RoundTrip) {
   PngImage g = ReadPng(Path("g.png"));
   EXPECT_EQ(g.color_type, PNG_COLOR_TYPE_GRAY);
   EXPECT_EQ(g.bytes, grey);
+}
+
+// Files are written under a temporary name and renamed: nothing else is left in the folder, and
+// a write that cannot land (the name is taken by a folder) fails naming the path, leaves the
+// old content alone and removes its temporary.
+TEST_F(ImageIoTest, WritesLandWholeOrNotAtAll) {
+  std::vector<uint8_t> grey = {0, 50, 100, 150, 200, 250};
+  WritePng(Path("g.png"), 3, 2, 1, grey.data());
+  WritePng(Path("g.png"), 3, 2, 1, grey.data());  // over an older one
+  fs::create_directories(dir_ / "taken.png" / "inside");
+  try {
+    WritePng(Path("taken.png"), 3, 2, 1, grey.data());
+    ADD_FAILURE() << "a folder was overwritten";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("taken.png"), std::string::npos) << e.what();
+  }
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"g.png", "taken.png"}));
+  EXPECT_TRUE(fs::exists(dir_ / "taken.png" / "inside"));
+  EXPECT_EQ(ReadPng(Path("g.png")).width, 3);
 }
 
 TEST_F(ImageIoTest, DepthPngIsSixteenBitMillimetres) {

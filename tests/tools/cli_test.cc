@@ -351,6 +351,23 @@ TEST_F(CliTest, RenderWritesImagesCloudsAndLegendWithTheNullBackend) {
   CheckRender(dir_, "null", 3, /*expect_points=*/false);
 }
 
+// A second render into the same folder with fewer views leaves none of the first's behind; files
+// it did not write stay.
+TEST_F(CliTest, RenderReplacesItsOwnOutputsAndKeepsOtherFiles) {
+  const fs::path out = dir_ / "again";
+  RunResult r =
+      RunCli("render --backend null --views 3 --width 32 --height 24 --out '" + out.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_TRUE(fs::exists(out / "color_2.png"));
+  std::ofstream(out / "mine.txt") << "keep";
+  r = RunCli("render --backend null --views 1 --width 32 --height 24 --out '" + out.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(out / "color_0.png"));
+  for (const char* stale : {"color_1.png", "color_2.png", "depth_2.png", "cloud_2.ply"})
+    EXPECT_FALSE(fs::exists(out / stale)) << stale;
+  EXPECT_TRUE(fs::exists(out / "mine.txt"));
+}
+
 TEST_F(CliTest, RenderWithThePathTracer) { CheckRender(dir_, "pathtracer", 2, true); }
 
 TEST_F(CliTest, RenderWithTheRasterizer) { CheckRender(dir_, "rasterizer", 2, true); }
@@ -427,6 +444,44 @@ TEST_F(CliTest, TasksRejectsBadArguments) {
   r = RunCli("tasks demo --task drawer --object 0 --out '" + (dir_ / "d").string() + "'");
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_TRUE(Contains(r.output, "has no drawer")) << r.output;
+}
+
+// Outputs are never mixed or torn: generate refuses a non-empty folder unless --overwrite, which
+// replaces only what partsim generated; objects appear whole (written to <id>.partial, then
+// renamed); check fails the leftovers of a stopped run and folders missing their files.
+TEST_F(CliTest, GenerateNeverMixesOrTearsAndCheckFindsWhatIsLeftOver) {
+  const fs::path out = dir_ / "gen";
+  const std::string gen =
+      "assets generate --categories Bottle --per-category 2 --out '" + out.string() + "'";
+  RunResult r = RunCli(gen);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::vector<std::string> ids;
+  for (const auto& e : fs::directory_iterator(out)) ids.push_back(e.path().filename().string());
+  ASSERT_EQ(ids.size(), 2u);
+  for (const std::string& id : ids) EXPECT_EQ(id.find(".partial"), std::string::npos) << id;
+  // a second run into the same folder is refused, and writes nothing
+  std::ofstream(out / "notes.txt") << "mine";
+  r = RunCli(gen);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(Contains(r.output, "is not empty")) << r.output;
+  // --overwrite replaces partsim's objects and leftovers, and keeps the rest
+  fs::create_directories(out / "123.partial" / "textured_objs");
+  std::ofstream(out / ids[0] / "stale.txt") << "old";
+  r = RunCli(gen + " --overwrite");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(out / ids[0] / "stale.txt"));
+  EXPECT_FALSE(fs::exists(out / "123.partial"));
+  EXPECT_TRUE(fs::exists(out / "notes.txt"));
+  EXPECT_TRUE(fs::exists(out / ids[1] / "mobility.urdf"));
+  // what a stopped run leaves, and a folder holding only meshes: both fail the check
+  fs::copy(out / ids[1], out / (ids[1] + "0.partial"), fs::copy_options::recursive);
+  fs::create_directories(out / "999" / "textured_objs");
+  std::ofstream(out / "999" / "textured_objs" / "original-0.obj") << "v 0 0 0\n";
+  r = RunCli("assets check '" + out.string() + "' --no-visibility");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(Contains(r.output, "left by a generate run that was stopped")) << r.output;
+  EXPECT_TRUE(Contains(r.output, "999")) << r.output;
+  EXPECT_TRUE(Contains(r.output, "checked 4 objects")) << r.output;
 }
 
 TEST_F(CliTest, TasksEvaluateRunsOnADatasetFolderTree) {

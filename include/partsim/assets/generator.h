@@ -87,7 +87,16 @@ struct GeneratorOptions {
   std::string out_dir;       ///< objects go to <out_dir>/<anno_id>/, the dataset's flat layout
   bool by_category = false;  ///< <out_dir>/<category>/<anno_id>/ instead
   int jobs = 1;              ///< worker threads, >= 1
+  /// A non-empty out_dir is refused (old and new objects would mix) unless this is set; then the
+  /// object folders partsim generated there before (meta.json names the generator) and the
+  /// leftovers of interrupted runs (*.partial) are removed first, and nothing else is touched.
+  bool overwrite = false;
 };
+
+/// Suffix of the folder an object is written into before it is renamed into place: an object
+/// folder is there whole or not at all, and a *.partial folder is the leftover of a run that
+/// was stopped (`assets check` fails it).
+constexpr const char* kPartialSuffix = ".partial";
 
 /// Progress of GenerateDataset: objects written so far, of `total`.
 using GeneratorProgress = std::function<void(int done, int total, const GeneratedObject& last)>;
@@ -111,8 +120,14 @@ GeneratedObject GenerateObject(const std::string& category, int index, std::uint
 /// Writes `object` into folder `dir` (created with its parents), as the dataset holds an object:
 /// mobility.urdf, mobility_v2.json, semantics.txt, meta.json, bounding_box.json, result.json,
 /// result_after_merging.json, textured_objs/original-K.obj and .mtl (one piece per file). Same
-/// object, same bytes. Throws partsim::Error naming the file it cannot write.
+/// object, same bytes. The files go to `dir`.partial first, which is renamed to `dir` once all
+/// are written (replacing a `dir` partsim generated before; a non-empty `dir` holding anything
+/// else is refused); a process killed meanwhile leaves no torn `dir`. Throws partsim::Error
+/// naming the file it cannot write.
 void WriteObject(const GeneratedObject& object, const std::string& dir);
+
+/// Whether `folder` holds an object WriteObject wrote (its meta.json names partsim's generator).
+bool IsGeneratedObjectFolder(const std::string& folder);
 
 /// Generates and writes the objects of `options` on `options.jobs` threads; calls `progress`
 /// (serialised) after each object. Returns the number of objects written.

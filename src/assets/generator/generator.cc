@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <mutex>
 #include <thread>
 
@@ -180,6 +182,48 @@ GeneratedObject GenerateObject(const std::string& category, int index, std::uint
   return out;
 }
 
+namespace {
+
+bool IsPartial(const std::filesystem::path& folder) {
+  const std::string name = folder.filename().string();
+  const std::string suffix = kPartialSuffix;
+  return name.size() > suffix.size() &&
+         name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// Refuses a non-empty output folder unless overwrite; then removes what partsim generated
+// there (object folders, leftovers of stopped runs), flat or by category, and nothing else.
+void PrepareOutDir(const GeneratorOptions& options) {
+  namespace fs = std::filesystem;
+  const fs::path out(options.out_dir);
+  std::error_code ec;
+  if (!fs::exists(out, ec)) return;
+  if (!fs::is_directory(out, ec))
+    throw Error("GenerateDataset: '" + options.out_dir + "' exists and is not a folder");
+  if (fs::is_empty(out, ec)) return;
+  if (!options.overwrite)
+    throw Error("GenerateDataset: '" + options.out_dir +
+                "' is not empty, and old and new objects would mix: choose an empty folder, or "
+                "overwrite (--overwrite) to replace the objects partsim generated there");
+  std::vector<fs::path> owned;
+  for (auto it = fs::recursive_directory_iterator(out, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    if (!it->is_directory()) continue;
+    if (IsPartial(it->path()) || IsGeneratedObjectFolder(it->path().string())) {
+      owned.push_back(it->path());
+      it.disable_recursion_pending();
+    } else if (it.depth() >= 1) {
+      it.disable_recursion_pending();  // objects lie at <out>/<id> or <out>/<category>/<id>
+    }
+  }
+  for (const fs::path& p : owned) {
+    fs::remove_all(p, ec);
+    if (ec) throw Error("GenerateDataset: cannot remove '" + p.string() + "': " + ec.message());
+  }
+}
+
+}  // namespace
+
 int GenerateDataset(const GeneratorOptions& options, const GeneratorProgress& progress) {
   // the work list, in category then index order
   std::vector<std::string> cats =
@@ -190,6 +234,7 @@ int GenerateDataset(const GeneratorOptions& options, const GeneratorProgress& pr
     for (int i = 0; i < n; ++i) work.emplace_back(Find(c).name, i);
   }
   if (options.out_dir.empty()) throw Error("GenerateDataset: out_dir is empty");
+  PrepareOutDir(options);
   const int total = static_cast<int>(work.size());
   std::atomic<int> next{0};
   std::mutex mutex;

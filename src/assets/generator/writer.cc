@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -405,10 +407,25 @@ std::string SemanticsKind(const GeneratedLink& l) {
 
 }  // namespace
 
+bool IsGeneratedObjectFolder(const std::string& folder) {
+  std::ifstream in(std::filesystem::path(folder) / "meta.json", std::ios::binary);
+  if (!in) return false;
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return text.find("\"generator\": \"partsim assets generate\"") != std::string::npos;
+}
+
 void WriteObject(const GeneratedObject& object, const std::string& dir) {
   namespace fs = std::filesystem;
-  fs::path root(dir);
+  // everything goes to a staging folder, renamed into place at the end
+  const fs::path target(dir);
+  fs::path root(dir + kPartialSuffix);
   std::error_code ec;
+  if (fs::exists(target, ec) &&
+      !(fs::is_directory(target, ec) &&
+        (fs::is_empty(target, ec) || IsGeneratedObjectFolder(target.string()))))
+    throw Error("WriteObject: '" + dir +
+                "' exists and holds something partsim did not generate: not replaced");
+  fs::remove_all(root, ec);
   fs::create_directories(root / "textured_objs", ec);
   if (ec) throw Error("WriteObject: cannot create '" + (root / "textured_objs").string() + "'");
 
@@ -454,6 +471,12 @@ void WriteObject(const GeneratedObject& object, const std::string& dir) {
   WriteFile(root / "result.json", "[" + ResultJson(tree, object.category) + "]\n");
   int next = 0;
   WriteFile(root / "result_after_merging.json", "[" + MergedJson(tree, &next) + "]\n");
+  // complete: into place
+  fs::remove_all(target, ec);
+  fs::rename(root, target, ec);
+  if (ec)
+    throw Error("WriteObject: cannot rename '" + root.string() + "' to '" + target.string() +
+                "': " + ec.message());
 }
 
 }  // namespace partsim
