@@ -56,10 +56,24 @@ class MjcfWriter {
         << "  <option timestep=\"" << Num(c.timestep) << "\" gravity=\"" << Vec(c.gravity)
         << "\" iterations=\"" << c.solver_iterations << "\" integrator=\"" << integrator
         << "\"/>\n";
-    // contact buffers sized from the scene: generous per collision geom, never tiny
-    int nconmax = 100 + 16 * num_collision_geoms_;
-    int njmax = 6 * nconmax + 4 * num_limits_ + 6 * num_equalities_ + 100;
-    out << "  <size nconmax=\"" << nconmax << "\" njmax=\"" << njmax << "\"/>\n";
+    // Contact and constraint buffers. MuJoCo 2.2.2 allocates them in mj_makeData, with dense
+    // njmax x njmax and njmax x nv matrices, so they are sized from the contacts the scene has
+    // needed (SceneImpl::Step doubles them when a step fills them), not from its size: memory
+    // grows with the contacts, not with the square of the bodies. The rows always cover every
+    // contact (4 rows each: condim 3, pyramidal cone), so contacts overflow before rows do.
+    const int nconmax = std::max(scene_.contact_capacity, kBaseContacts);
+    const int njmax =
+        4 * nconmax + 4 * num_limits_ + 6 * num_equalities_ + 2 * num_friction_dofs_ + 100;
+    // MuJoCo's scratch stack: its own default scales with njmax and came out too small with
+    // the buffers above ("Stack overflow" at compile). MuJoCo 2.2.2's implicit integrator works
+    // on dense nv x nv matrices: 300 free boxes (nv 1,800) need 33-36 M numbers, about 11 nv^2;
+    // the explicit integrators need under nv^2 / 36 (1,000 boxes: 0.5-1 M)
+    const long long nv = num_dofs_;
+    const long long dense = c.integrator == Integrator::kImplicit ? 12 * nv * nv : nv * nv / 32;
+    const long long nstack =
+        std::max(1000000 + 60 * nv + 20ll * njmax + dense, scene_.stack_capacity);
+    out << "  <size nconmax=\"" << nconmax << "\" njmax=\"" << njmax << "\" nstack=\"" << nstack
+        << "\"/>\n";
     if (!assets_.str().empty()) out << "  <asset>\n" << assets_.str() << "  </asset>\n";
     out << "  <worldbody>\n" << bodies_.str() << "  </worldbody>\n";
     if (!excludes_.empty()) {
@@ -238,6 +252,7 @@ class MjcfWriter {
     if (a.type == ActorType::kDynamic) {
       Indent(1);
       bodies_ << "<freejoint name=\"" << name << "_free\"/>\n";
+      num_dofs_ += 6;
     }
     if (a.type == ActorType::kDynamic) WriteInertial(a.inertial, !a.collisions.empty(), 1);
     WriteShapes(a.collisions, name, 1);
@@ -324,6 +339,8 @@ class MjcfWriter {
 
   void WriteJoint(int id, int index, const JointDesc& j, int depth) {
     Eigen::Vector3d axis = j.pose_in_child.q * Eigen::Vector3d::UnitX();
+    num_dofs_ += j.type == JointType::kScrew ? 2 : 1;
+    if (j.friction > 0) num_friction_dofs_ += j.type == JointType::kScrew ? 2 : 1;
     std::string where = " pos=\"" + Vec(j.pose_in_child.p) + "\" axis=\"" + Vec(axis) + "\"";
     // the implicit integrator steps drives by backward Euler: their inertia joins the armature
     const double drive_dt = DriveStep();
@@ -374,6 +391,8 @@ class MjcfWriter {
   std::map<uint32_t, std::vector<std::pair<std::string, const std::vector<CollisionShape>*>>>
       ignore_candidates_;
   int num_collision_geoms_ = 0;
+  int num_dofs_ = 0;           ///< dofs (MuJoCo's stack)
+  int num_friction_dofs_ = 0;  ///< dofs with dry friction (a friction-loss row each)
   int num_limits_ = 0;
   int num_equalities_ = 0;
 };

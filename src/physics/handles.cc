@@ -88,6 +88,10 @@ void Actor::SetPose(const Pose& pose) {
   CheckPoseArg(pose, "actor pose");
   SceneImpl& s = S(scene_);
   auto& a = s.GetActor(id_);
+  if (s.IsUncompiled(id_)) {  // not in the model yet: it will start there
+    a.desc.pose = Pose(pose.p, pose.q.normalized());
+    return;
+  }
   const auto& c = s.Compiled(a);
   Eigen::Quaterniond q = pose.q.normalized();
   double* dst;
@@ -150,7 +154,8 @@ void Actor::SetAngularVelocity(const Eigen::Vector3d& w) {
 
 double Actor::GetMass() const {
   SceneImpl& s = S(scene_);
-  return s.m->body_mass[s.Compiled(s.GetActor(id_)).body];
+  const int body = s.Compiled(s.GetActor(id_)).body;  // may compile: before reading s.m
+  return s.m->body_mass[body];
 }
 
 void Actor::SetDamping(double linear, double angular) {
@@ -252,12 +257,14 @@ Eigen::Vector3d Link::GetAngularVelocity() const {
 
 double Link::GetMass() const {
   SceneImpl& s = S(scene_);
-  return s.m->body_mass[LinkBody(s, articulation_id_, index_)];
+  const int body = LinkBody(s, articulation_id_, index_);  // may compile: before reading s.m
+  return s.m->body_mass[body];
 }
 
 Eigen::Vector3d Link::GetInertia() const {
   SceneImpl& s = S(scene_);
-  return V3(s.m->body_inertia + 3 * LinkBody(s, articulation_id_, index_));
+  const int body = LinkBody(s, articulation_id_, index_);  // may compile: before reading s.m
+  return V3(s.m->body_inertia + 3 * body);
 }
 
 void Link::AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point) {

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 
@@ -164,8 +165,62 @@ void SceneImpl::EnsureCompiled() {
   std::string xml = GenerateMjcf(*this);
   std::string error;
   mjModel* new_m = LoadMjcf(xml, &error);
-  if (!new_m) throw Error("MuJoCo could not compile the scene: " + DescribeMjNames(*this, error));
+  // the compiler's own use of MuJoCo's stack outgrew partsim's estimate: twice as much, again
+  for (int tries = 0; !new_m && tries < 6 && error.find("Stack overflow") != std::string::npos;
+       ++tries) {
+    const size_t at = xml.find("nstack=\"");
+    if (at == std::string::npos) break;
+    stack_capacity = 2 * std::atoll(xml.c_str() + at + 8);
+    xml = GenerateMjcf(*this);
+    new_m = LoadMjcf(xml, &error);
+  }
+  if (!new_m) {
+    std::string why = DescribeMjNames(*this, error);
+    if (why.find("Element nesting is too deep") != std::string::npos)
+      why =
+          "bodies are nested deeper than MuJoCo 2.2.2's XML parser takes (100 levels: an "
+          "articulation's chain of links can be about 95 deep from its root): " +
+          why;
+    if (!uncompiled_actors.empty()) {
+      // some actor added since the last compile breaks it: they are taken back out and put in
+      // again one by one, and those that MuJoCo refuses stay out; the error names them
+      std::vector<ActorEntry> pending;
+      for (const ActorEntry& a : actors)
+        if (IsUncompiled(a.id)) pending.push_back(a);
+      actors.erase(std::remove_if(actors.begin(), actors.end(),
+                                  [&](const ActorEntry& a) { return IsUncompiled(a.id); }),
+                   actors.end());
+      uncompiled_actors.clear();
+      EnsureCompiled();  // as it compiled last
+      std::string refused;
+      int count = 0;
+      for (const ActorEntry& a : pending) {
+        actors.push_back(a);
+        dirty = true;
+        try {
+          EnsureCompiled();
+        } catch (const Error& e) {
+          actors.pop_back();
+          dirty = true;
+          EnsureCompiled();
+          if (++count <= 3) refused += std::string(count > 1 ? "; " : "") + e.what();
+        }
+      }
+      if (count == 0) throw Error("MuJoCo could not compile the scene: " + why);
+      throw Error(std::to_string(count) + " of the " + std::to_string(pending.size()) +
+                  " actors added since the scene last compiled were refused and removed (the "
+                  "others are in): " +
+                  refused + (count > 3 ? "; ..." : ""));
+    }
+    throw Error("MuJoCo could not compile the scene: " + why);
+  }
   mjData* new_d = mj_makeData(new_m);
+  if (!new_d) {
+    const int ncon = new_m->nconmax, nj = new_m->njmax;
+    mj_deleteModel(new_m);
+    throw Error("MuJoCo could not allocate the data of the scene (" + std::to_string(ncon) +
+                " contacts, " + std::to_string(nj) + " constraint rows): out of memory");
+  }
   // carry the state of everything that existed before
   if (m && d)
     RestoreNamed(SaveNamed(m, d), new_m, new_d);
@@ -177,6 +232,7 @@ void SceneImpl::EnsureCompiled() {
   d = new_d;
   mjcf = std::move(xml);
   dirty = false;
+  uncompiled_actors.clear();
   ++description_version;
   BuildTables(*this);
   for (auto& a : articulations)
@@ -263,6 +319,32 @@ void SceneImpl::UpdateKinematicArticulation(ArticulationEntry& a) {
   Invalidate();
 }
 
+void SceneImpl::GrowBuffers(int contacts, long long stack, const std::string& why) {
+  const int old_contacts = contact_capacity;
+  const long long old_stack = stack_capacity;
+  const int nv = m->nv;
+  contact_capacity = contacts;
+  stack_capacity = stack;
+  dirty = true;
+  try {
+    EnsureCompiled();  // the state is carried over
+  } catch (const Error& e) {
+    // MuJoCo 2.2.2 sizes its data with dense constraint matrices (rows x rows, rows x dofs):
+    // past about 2 GB it cannot allocate them. The scene stays as it was.
+    contact_capacity = old_contacts;
+    stack_capacity = old_stack;
+    dirty = true;
+    EnsureCompiled();
+    throw Error("step: " + why + ", and MuJoCo cannot allocate more for this scene (" +
+                std::to_string(nv) + " dofs; its constraint buffers grow with the square of " +
+                "the contacts): " + e.what() +
+                ". Fewer bodies in contact at once, or fewer "
+                "dofs, fit");
+  }
+  warnings.push_back({d->time, why + ": grown to " + std::to_string(contact_capacity) +
+                                   " contacts and a stack of " + std::to_string(m->nstack)});
+}
+
 void SceneImpl::Step(int n) {
   if (n < 0) throw Error("step: n must be >= 0, got " + std::to_string(n));
   EnsureCompiled();
@@ -271,7 +353,24 @@ void SceneImpl::Step(int n) {
     ApplyDrives();
     int bad_before = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
                      d->warning[mjWARN_BADQVEL].number;
-    mj_step(m, d);
+    const int full_before = d->warning[mjWARN_CONTACTFULL].number;
+    try {
+      mj_step(m, d);
+    } catch (const Error& e) {
+      // MuJoCo's scratch stack ran out (contacts and dofs need more than the estimate): twice
+      // as much, recompiled with the state as it was, and the step again; a scene whose data
+      // MuJoCo cannot allocate fails in EnsureCompiled, saying so
+      if (std::string(e.what()).find("Stack overflow") == std::string::npos) throw;
+      d->pstack = 0;
+      GrowBuffers(std::max(contact_capacity, m->nconmax), 2 * static_cast<long long>(m->nstack),
+                  "MuJoCo's stack of " + std::to_string(m->nstack) + " numbers ran out");
+      --i;
+      continue;
+    }
+    if (d->warning[mjWARN_CONTACTFULL].number != full_before)
+      GrowBuffers(2 * m->nconmax, stack_capacity,
+                  "contacts filled MuJoCo's buffer of " + std::to_string(m->nconmax) +
+                      " (the excess was dropped for one step)");
     int bad_after = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
                     d->warning[mjWARN_BADQVEL].number;
     if (bad_after != bad_before)
@@ -316,6 +415,8 @@ std::unique_ptr<Scene> Scene::Clone() const {
   c.articulations = impl().articulations;
   c.next_id = impl().next_id;
   c.next_visual_id = impl().next_visual_id;
+  c.contact_capacity = impl().contact_capacity;
+  c.stack_capacity = impl().stack_capacity;
   c.lights = impl().lights;
   c.ambient = impl().ambient;
   for (const auto& cam : impl().cameras) {
@@ -425,11 +526,13 @@ void CompileOrUndo(internal::SceneImpl& s, Undo undo) {
 Actor Scene::AddActor(const ActorDesc& desc) {
   Validate(desc);
   Impl& s = impl();
-  s.EnsureCompiled();
   // an actor's id is its entity id in segmentation pictures too (as SAPIEN's)
   int id = s.next_id;
   s.actors.push_back({id, desc, static_cast<uint32_t>(id), s.next_visual_id});
-  CompileOrUndo(s, [&] { s.actors.pop_back(); });
+  // compiled with the next use of the model (EnsureCompiled): adding many actors one by one
+  // compiles once
+  s.uncompiled_actors.push_back(id);
+  s.dirty = true;
   ++s.next_id;
   s.next_visual_id += static_cast<uint32_t>(desc.visuals.size());
   return Actor(this, id);
@@ -470,6 +573,9 @@ void Scene::RemoveActor(const Actor& actor) {
   s.actors.erase(std::remove_if(s.actors.begin(), s.actors.end(),
                                 [&](const auto& a) { return a.id == actor.GetId(); }),
                  s.actors.end());
+  s.uncompiled_actors.erase(
+      std::remove(s.uncompiled_actors.begin(), s.uncompiled_actors.end(), actor.GetId()),
+      s.uncompiled_actors.end());
   s.dirty = true;
   s.EnsureCompiled();
 }

@@ -4,6 +4,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <atomic>
 #include <map>
 #include <memory>
@@ -116,6 +117,20 @@ struct SceneImpl {
   /// ids of actors, articulations, links and cameras, scene-wide; 0 is no entity (background
   /// in segmentation pictures)
   int next_id = 1;
+  /// Contacts MuJoCo's buffers hold (nconmax): grown by Step when a step fills them, kept
+  /// across recompiles and clones; the compiler never goes below kBaseContacts.
+  int contact_capacity = 0;
+  /// MuJoCo's scratch stack (nstack, numbers) when a step ran out of it: doubled by Step, kept
+  /// across recompiles and clones; 0 leaves the compiler's estimate.
+  long long stack_capacity = 0;
+  /// Actors added since the last compile: they join the model at the next compile (any use
+  /// that needs the model), so that adding n actors one by one compiles once, not n times.
+  /// A compile that fails takes them back out (see EnsureCompiled).
+  std::vector<int> uncompiled_actors;
+  bool IsUncompiled(int actor_id) const {
+    return std::find(uncompiled_actors.begin(), uncompiled_actors.end(), actor_id) !=
+           uncompiled_actors.end();
+  }
   uint32_t next_visual_id = 1;
 
   // rendering
@@ -173,6 +188,10 @@ struct SceneImpl {
   /// Places the links of kinematic articulations from their qpos.
   void UpdateKinematicArticulation(ArticulationEntry& a);
   void Step(int n);
+  /// Recompiles (state kept) with room for `contacts` contacts and a stack of `stack` numbers,
+  /// with a warning saying `why`; when MuJoCo cannot allocate that, the scene stays as it was
+  /// and partsim::Error says so.
+  void GrowBuffers(int contacts, long long stack, const std::string& why);
   /// Runs forward kinematics and body velocities if the state changed.
   void EnsureKinematics();
   void Invalidate() { forward_valid = kinematics_valid = false; }
@@ -186,6 +205,8 @@ std::string GenerateMjcf(const SceneImpl& scene);
 std::string DescribeMjNames(const SceneImpl& scene, const std::string& text);
 /// Fills compiled tables from a loaded model.
 void BuildTables(SceneImpl& scene);
+/// Contacts a fresh scene's buffers hold (SceneImpl::contact_capacity grows from there).
+constexpr int kBaseContacts = 256;
 /// Writes a dynamic actor's velocity damping into its free joint's dofs (compiled model).
 void SyncActorDamping(SceneImpl& scene, const ActorDesc& desc, const CompiledActor& compiled);
 

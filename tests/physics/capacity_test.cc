@@ -1,0 +1,139 @@
+// Scenes of many bodies: actors added one by one join the model at its next use (one compile,
+// not one per actor), MuJoCo's contact buffers start small and grow when a step fills them, and
+// what MuJoCo refuses or cannot allocate gives an error that leaves the scene as it was.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "partsim/core/error.h"
+#include "partsim/physics/scene.h"
+#include "physics/scene_internal.h"
+
+namespace partsim {
+namespace {
+
+ActorDesc Box(const std::string& name, const Eigen::Vector3d& at, double half = 0.05) {
+  ActorDesc d;
+  d.name = name;
+  d.pose = Pose(at);
+  CollisionShape s;
+  s.type = ShapeType::kBox;
+  s.half_size = Eigen::Vector3d::Constant(half);
+  d.collisions.push_back(s);
+  return d;
+}
+
+// A thousand actors added one by one cost one compile; a chain of 500 links loads and steps.
+TEST(CapacityTest, ActorsAddedOneByOneCompileOnceAtTheNextUse) {
+  SceneConfig cfg;
+  cfg.integrator = Integrator::kEuler;
+  cfg.gravity = Eigen::Vector3d::Zero();
+  Scene scene(cfg);
+  const uint64_t before = scene.impl().description_version;
+  for (int i = 0; i < 1000; ++i)
+    scene.AddActor(Box("b" + std::to_string(i),
+                       Eigen::Vector3d(0.3 * (i % 10), 0.3 * (i / 10 % 10), 0.3 * (i / 100))));
+  EXPECT_EQ(scene.impl().description_version, before);  // nothing compiled yet
+  EXPECT_EQ(scene.GetActors().size(), 1000u);
+  Actor last = scene.GetActors().back();
+  last.SetPose(Pose(Eigen::Vector3d(5, 5, 5)));  // placed before it is compiled: no compile
+  EXPECT_EQ(scene.impl().description_version, before);
+  scene.Step(10);
+  EXPECT_EQ(scene.impl().description_version, before + 1);
+  EXPECT_NEAR(last.GetPose().p.x(), 5.0, 1e-12);
+  EXPECT_NEAR(scene.GetActors()[123].GetPose().p.z(), 0.3, 1e-12);
+}
+
+ArticulationDesc Chain(int links) {
+  ArticulationDesc chain;
+  chain.name = "chain";
+  chain.fix_root = true;
+  for (int i = 0; i < links; ++i) {
+    LinkDesc l;
+    l.name = "l" + std::to_string(i);
+    l.parent = i - 1;
+    CollisionShape s;
+    s.type = ShapeType::kCapsule;
+    s.radius = 0.01;
+    s.half_length = 0.04;
+    l.collisions.push_back(s);
+    if (i > 0) {
+      l.joint.name = "j" + std::to_string(i);
+      l.joint.type = JointType::kRevolute;
+      l.joint.lower = -0.5;
+      l.joint.upper = 0.5;
+      l.joint.pose_in_parent = Pose(Eigen::Vector3d(0.1, 0, 0));
+    }
+    chain.links.push_back(l);
+  }
+  return chain;
+}
+
+// MuJoCo 2.2.2 reads bodies nested in XML, and its XML parser stops at 100 levels: a chain of
+// 90 links loads and steps; a longer one is refused saying so, and the scene stays usable.
+TEST(CapacityTest, ChainsLoadUpToTheDepthMuJoCosParserTakes) {
+  Scene scene;
+  Articulation a = scene.AddArticulation(Chain(90));
+  EXPECT_EQ(a.Dof(), 89);
+  scene.Step(5);
+  EXPECT_TRUE(a.GetQpos().allFinite());
+  try {
+    scene.AddArticulation(Chain(120));
+    ADD_FAILURE() << "a 120-link chain was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nested deeper than MuJoCo 2.2.2's XML parser takes"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(scene.GetArticulations().size(), 1u);
+  scene.Step(1);
+}
+
+// Boxes dropped on the ground need more contacts than a fresh scene holds: the buffer grows
+// (with a warning) and every box comes to rest on the ground, none through it.
+TEST(CapacityTest, ContactBuffersGrowWhenAStepFillsThem) {
+  Scene scene;
+  scene.AddGround(0.0);
+  for (int i = 0; i < 80; ++i)  // 4 contacts each on the ground: 320 > 256
+    scene.AddActor(
+        Box("b" + std::to_string(i), Eigen::Vector3d(0.3 * (i % 10), 0.3 * (i / 10), 0.06)));
+  scene.Step(200);
+  bool grew = false;
+  for (const Warning& w : scene.GetWarnings())
+    grew |= w.message.find("contacts filled MuJoCo's buffer of 256") != std::string::npos;
+  EXPECT_TRUE(grew);
+  EXPECT_GE(scene.GetMjModel()->nconmax, 512);
+  for (const Actor& a : scene.GetActors())
+    if (a.GetName() != "ground") EXPECT_NEAR(a.GetPose().p.z(), 0.05, 2e-3) << a.GetName();
+  // a clone keeps the grown buffers
+  std::unique_ptr<Scene> copy = scene.Clone();
+  EXPECT_EQ(copy->GetMjModel()->nconmax, scene.GetMjModel()->nconmax);
+}
+
+// An actor MuJoCo refuses (an inertia that breaks A + B >= C, which only the compiler checks)
+// is named when the scene next compiles and left out; the actors added with it stay in.
+TEST(CapacityTest, AnActorMuJoCoRefusesIsLeftOutAndTheOthersStay) {
+  Scene scene;
+  scene.AddGround(0.0);
+  scene.AddActor(Box("good1", Eigen::Vector3d(0, 0, 0.5)));
+  ActorDesc bad = Box("bad", Eigen::Vector3d(1, 0, 0.5));
+  bad.inertial = Inertial{1.0, Pose(), Eigen::Vector3d(0.01, 0.01, 1.0)};
+  scene.AddActor(bad);  // validated, not compiled yet
+  scene.AddActor(Box("good2", Eigen::Vector3d(2, 0, 0.5)));
+  try {
+    scene.Step(1);
+    ADD_FAILURE() << "the bad actor was compiled";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("1 of the 4 actors"), std::string::npos) << m;
+    EXPECT_NE(m.find("'bad'"), std::string::npos) << m;
+  }
+  std::vector<std::string> names;
+  for (const Actor& a : scene.GetActors()) names.push_back(a.GetName());
+  EXPECT_EQ(names, (std::vector<std::string>{"ground", "good1", "good2"}));
+  scene.Step(10);
+  EXPECT_LT(scene.GetActors()[1].GetPose().p.z(), 0.5);  // falling
+}
+
+}  // namespace
+}  // namespace partsim
