@@ -241,6 +241,8 @@ struct RosbridgeServer::Impl {
   double imu_next = 0;
 
   WsServer ws;
+  std::unique_ptr<boost::asio::steady_timer> accept_timer;  // network thread
+  std::atomic<long long> accept_errors{0};
   std::thread io_thread;
   int port = 0;
   std::atomic<bool> started{false};
@@ -261,6 +263,33 @@ struct RosbridgeServer::Impl {
   std::atomic<long long> next_request{0};
 
   std::atomic<long long> sent{0}, dropped{0}, errors{0}, refused{0};
+
+  // ---- accepting ----
+  /// partsim's accept loop (network thread), in place of websocketpp's, which retries a failed
+  /// accept at once: out of file descriptors that spun a core. A failure waits 100 ms.
+  void StartAccept() {
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = ws.get_connection();
+    if (!con) return;
+    ws.async_accept(
+        websocketpp::lib::static_pointer_cast<WsServer::transport_con_type>(con),
+        [this, con](const websocketpp::lib::error_code& e) { OnAccept(con, e); }, ec);
+    if (ec) con->terminate(websocketpp::lib::error_code());
+  }
+  void OnAccept(const WsServer::connection_ptr& con, const websocketpp::lib::error_code& ec) {
+    if (!ec) {
+      con->start();
+      StartAccept();
+      return;
+    }
+    con->terminate(ec);
+    if (ec == websocketpp::error::operation_canceled || !ws.is_listening()) return;
+    ++accept_errors;
+    accept_timer->expires_after(std::chrono::milliseconds(100));
+    accept_timer->async_wait([this](const boost::system::error_code& e) {
+      if (!e && ws.is_listening()) StartAccept();
+    });
+  }
 
   // ---- outgoing ----
   /// Queues a message for a client from any thread; drops the oldest beyond the bound.
@@ -859,6 +888,7 @@ struct RosbridgeServer::Impl {
     s.max_latency_steps = cs.max_latency_steps;
     s.errors = errors;
     s.refused = refused;
+    s.accept_errors = accept_errors;
     return s;
   }
 
@@ -1261,8 +1291,8 @@ void RosbridgeServer::Start() {
   if (ec)
     throw Error("rosbridge: cannot listen on " + m.options.address + ":" +
                 std::to_string(m.options.port) + ": " + ec.message());
-  m.ws.start_accept(ec);
-  if (ec) throw Error("rosbridge: cannot accept: " + ec.message());
+  m.accept_timer = std::make_unique<boost::asio::steady_timer>(m.ws.get_io_service());
+  m.StartAccept();
   m.port = m.ws.get_local_endpoint(bec).port();
   m.io_thread = std::thread([this] { impl_->ws.run(); });
   m.started = true;
@@ -1274,6 +1304,7 @@ void RosbridgeServer::Stop() {
   m.started = false;
   websocketpp::lib::error_code ec;
   m.ws.stop_listening(ec);
+  if (m.accept_timer) m.accept_timer->cancel();
   m.ws.stop();
   if (m.io_thread.joinable()) m.io_thread.join();
 }

@@ -50,6 +50,8 @@ struct RosbridgeStats {
   long long max_latency_steps = 0;
   long long errors = 0;   ///< status errors sent
   long long refused = 0;  ///< handshakes refused (origin, connection cap)
+  long long accept_errors =
+      0;  ///< failed accepts (out of file descriptors), each then waits 100 ms
 };
 
 class RosbridgeServer {
