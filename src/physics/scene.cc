@@ -162,6 +162,10 @@ mjModel* LoadMjcf(const std::string& xml, std::string* error) {
 
 void SceneImpl::EnsureCompiled() {
   if (!dirty) return;
+  // compiling, computing on the data (EnsureForward, EnsureKinematics) and changing it
+  // (Invalidate, after every setter) are refused while another thread holds the scene; reading
+  // the description and the compiled tables (names, counts, dof indices) is not
+  CheckUser();
   std::string xml = GenerateMjcf(*this);
   std::string error;
   mjModel* new_m = LoadMjcf(xml, &error);
@@ -241,6 +245,7 @@ void SceneImpl::EnsureCompiled() {
 }
 
 void SceneImpl::EnsureForward() {
+  CheckUser();
   EnsureCompiled();
   if (forward_valid) return;
   ApplyDrives();
@@ -249,6 +254,7 @@ void SceneImpl::EnsureForward() {
 }
 
 void SceneImpl::EnsureKinematics() {
+  CheckUser();
   EnsureCompiled();
   if (kinematics_valid || forward_valid) return;
   mj_kinematics(m, d);
@@ -526,6 +532,7 @@ void CompileOrUndo(internal::SceneImpl& s, Undo undo) {
 Actor Scene::AddActor(const ActorDesc& desc) {
   Validate(desc);
   Impl& s = impl();
+  s.CheckUser();  // added without compiling: the check EnsureCompiled would make
   // an actor's id is its entity id in segmentation pictures too (as SAPIEN's)
   int id = s.next_id;
   s.actors.push_back({id, desc, static_cast<uint32_t>(id), s.next_visual_id});
@@ -642,10 +649,7 @@ Scene::Use::~Use() {
   s.use_mutex.unlock();
 }
 
-Scene::Impl& Scene::impl() const {
-  impl_->CheckUser();
-  return *impl_;
-}
+Scene::Impl& Scene::impl() const { return *impl_; }
 
 namespace internal {
 

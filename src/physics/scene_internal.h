@@ -194,7 +194,12 @@ struct SceneImpl {
   void GrowBuffers(int contacts, long long stack, const std::string& why);
   /// Runs forward kinematics and body velocities if the state changed.
   void EnsureKinematics();
-  void Invalidate() { forward_valid = kinematics_valid = false; }
+  /// After a change of the state: derived quantities are stale. Refused (partsim::Error) on a
+  /// thread other than the one holding the scene.
+  void Invalidate() {
+    CheckUser();
+    forward_valid = kinematics_valid = false;
+  }
 };
 
 /// Writes MJCF for the whole scene and fills the compiled tables (ids resolved after loading).

@@ -438,9 +438,11 @@ class Scene {
 
   /// A scene is used by one thread at a time. Step (and rendering, and the Python calls that
   /// run without the GIL) hold the scene for their thread while they run: meanwhile another
-  /// thread's Step waits its turn, and any other call from another thread, on the scene or on
-  /// one of its handles, throws partsim::Error instead of racing. Hold a Use to keep other
-  /// threads out across several calls. Re-entrant on its thread.
+  /// thread's Step waits its turn, and any other call from another thread that reads or
+  /// changes the simulation (poses, velocities, forces, drives, contacts, adding or removing,
+  /// pictures), on the scene or on one of its handles, throws partsim::Error instead of
+  /// racing; reading the description (names, counts, the configuration) does not. Hold a Use
+  /// to keep other threads out across several calls. Re-entrant on its thread.
   class Use {
    public:
     /// Waits until no other thread holds the scene.
@@ -457,8 +459,7 @@ class Scene {
     bool owns_ = false;
   };
 
-  // Internals used by the handles; not part of the stable API. Throws partsim::Error when
-  // another thread holds the scene (Use).
+  // Internals used by the handles; not part of the stable API.
   struct Impl;
   Impl& impl() const;
 
