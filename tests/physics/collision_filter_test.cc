@@ -35,7 +35,8 @@ Articulation AddOverlappingChain(Scene& scene, bool gap_link = false) {
   column->SetName("column")
       .SetJointName("j1")
       .SetJointProperties(JointType::kRevolute, Eigen::Vector2d(-1, 1),
-                          Pose(Eigen::Vector3d(0, 0, 0.1), kXToY), Pose(Eigen::Vector3d(), kXToY))
+                          Pose(Eigen::Vector3d(0, 0, 0.1), kXToY),
+                          Pose(Eigen::Vector3d::Zero(), kXToY))
       .AddBoxCollision(Pose(Eigen::Vector3d(0, 0, 0.1)), Eigen::Vector3d(0.02, 0.02, 0.1));
   LinkBuilder* holder = column;
   Eigen::Vector3d tip_at(0.1, 0, 0);  // in the holder
@@ -44,7 +45,8 @@ Articulation AddOverlappingChain(Scene& scene, bool gap_link = false) {
     holder->SetName("upper")
         .SetJointName("j2")
         .SetJointProperties(JointType::kRevolute, Eigen::Vector2d(-1, 1),
-                            Pose(Eigen::Vector3d(0, 0, 0.2), kXToY), Pose(Eigen::Vector3d(), kXToY))
+                            Pose(Eigen::Vector3d(0, 0, 0.2), kXToY),
+                            Pose(Eigen::Vector3d::Zero(), kXToY))
         .AddBoxCollision(Pose(Eigen::Vector3d(0, 0, 0.05)), Eigen::Vector3d(0.02, 0.02, 0.05));
     tip_at = Eigen::Vector3d(0.1, 0, -0.2);
   }
