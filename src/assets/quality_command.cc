@@ -38,12 +38,6 @@ int Usage(const std::string& error) {
   return 2;
 }
 
-bool IsPartialFolder(const std::string& folder) {
-  const std::string suffix = kPartialSuffix;
-  return folder.size() > suffix.size() &&
-         folder.compare(folder.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // A generate run was stopped while writing this object: it fails without being loaded.
 ObjectQualityReport PartialReport(const std::string& folder) {
   ObjectQualityReport r;
@@ -123,8 +117,8 @@ int RunQualityCommand(int argc, char** argv) {
   auto start = std::chrono::steady_clock::now();
   auto worker = [&] {
     for (size_t i = next++; i < folders.size(); i = next++) {
-      reports[i] = IsPartialFolder(folders[i]) ? PartialReport(folders[i])
-                                               : CheckPartNetObject(folders[i], options);
+      reports[i] = IsPartialObjectFolder(folders[i]) ? PartialReport(folders[i])
+                                                     : CheckPartNetObject(folders[i], options);
       size_t n = ++done;
       std::lock_guard<std::mutex> lock(print);
       double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -299,12 +299,6 @@ class MjcfWriter {
     return -1;  // Validate() has already rejected unknown names
   }
 
-  // The step over which drives are backward Euler (DriveVelocityGain): the implicit integrator's;
-  // 0, plain gains, for the explicit ones.
-  double DriveStep() const {
-    return scene_.config.integrator == Integrator::kImplicit ? scene_.config.timestep : 0.0;
-  }
-
   // Couplings must hold tightly even against stiff, implicitly damped drives: the shortest time
   // constant MuJoCo accepts and the highest impedance.
   std::string EqualitySolver() const {
@@ -343,7 +337,7 @@ class MjcfWriter {
     if (j.friction > 0) num_friction_dofs_ += j.type == JointType::kScrew ? 2 : 1;
     std::string where = " pos=\"" + Vec(j.pose_in_child.p) + "\" axis=\"" + Vec(axis) + "\"";
     // the implicit integrator steps drives by backward Euler: their inertia joins the armature
-    const double drive_dt = DriveStep();
+    const double drive_dt = DriveStep(scene_.config);
     std::string dyn = " damping=\"" + Num(j.damping) + "\" frictionloss=\"" + Num(j.friction) +
                       "\" armature=\"" + Num(j.armature + DriveArmature(j.drive, drive_dt)) + "\"";
     bool limited =

@@ -160,6 +160,10 @@ void CheckBody(const BodyDesc& b, const std::string& where, const std::string& w
 
 }  // namespace
 
+void Validate(const PhysicalMaterial& material, const std::string& where) {
+  CheckMaterial(material, where, "material");
+}
+
 void Validate(const ActorDesc& a, const std::string& where) {
   std::string what = "actor '" + a.name + "'";
   CheckPose(a.pose, where, what + " pose");

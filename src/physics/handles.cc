@@ -9,6 +9,7 @@ namespace partsim {
 
 using internal::CompiledArticulation;
 using internal::CompiledJoint;
+using internal::DriveStep;
 using internal::SceneImpl;
 
 namespace {
@@ -165,9 +166,10 @@ void Actor::SetDamping(double linear, double angular) {
   if (c.dofadr < 0)
     throw Error("actor '" + a.desc.name + "' is " + ActorTypeName(a.desc.type) +
                 ": only dynamic actors have velocity damping");
-  if (!std::isfinite(linear) || linear < 0 || !std::isfinite(angular) || angular < 0)
-    throw Error("actor '" + a.desc.name + "': damping must be finite and >= 0, got linear " +
-                std::to_string(linear) + ", angular " + std::to_string(angular));
+  ActorDesc changed = a.desc;  // checked as a description would be, before it changes
+  changed.linear_damping = linear;
+  changed.angular_damping = angular;
+  Validate(changed);
   a.desc.linear_damping = linear;
   a.desc.angular_damping = angular;
   SyncActorDamping(s, a.desc, c);
@@ -358,11 +360,6 @@ void CheckDriveParam(double v, const char* what) {
   if (!std::isfinite(v) || v < 0) throw Error(std::string(what) + " must be finite and >= 0");
 }
 
-// The step over which drives are backward Euler (DriveVelocityGain), as the compiler takes it.
-double DriveStep(const SceneImpl& s) {
-  return s.config.integrator == Integrator::kImplicit ? s.config.timestep : 0.0;
-}
-
 // Sets a dof's armature in the compiled model, and the constants MuJoCo derives from it when it
 // compiles (the mass matrix of simple dofs, dof_M0, used as is; the constraint weights; the mean
 // inertia), as a compile would: mj_setConst works at qpos0, and changes no state but qpos.
@@ -381,7 +378,7 @@ void SyncDrive(SceneImpl& s, const JointRef& j) {
   if (j.compiled->actuator < 0) return;
   int a = j.compiled->actuator;
   const DriveDesc& dr = j.desc->drive;
-  const double dt = DriveStep(s);
+  const double dt = DriveStep(s.config);
   s.m->actuator_biasprm[a * mjNBIAS + 1] = -dr.stiffness;
   s.m->actuator_biasprm[a * mjNBIAS + 2] = dt > 0 ? 0.0 : -dr.damping;
   SetDofArmature(s, j.compiled->dofadr, j.desc->armature + DriveArmature(dr, dt));
@@ -477,7 +474,7 @@ void Joint::SetArmature(double v) {
   j.desc->armature = v;
   if (j.compiled->dofadr >= 0)
     SetDofArmature(S(scene_), j.compiled->dofadr,
-                   v + DriveArmature(j.desc->drive, DriveStep(S(scene_))));
+                   v + DriveArmature(j.desc->drive, DriveStep(S(scene_).config)));
   S(scene_).Invalidate();
 }
 
@@ -592,7 +589,7 @@ Eigen::MatrixXd MjMassMatrix(const ArtRef& r) {
   int nv = r.s.m->nv;
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> full(nv, nv);
   mj_fullM(r.s.m, full.data(), r.s.d->qM);
-  const double dt = DriveStep(r.s);
+  const double dt = DriveStep(r.s.config);
   for (int li : r.c.dof_links) {
     const int v = r.c.joints[li].dofadr;
     full(v, v) -= DriveArmature(r.a.desc.links[li].joint.drive, dt);

@@ -266,7 +266,7 @@ void SceneImpl::EnsureKinematics() {
 void SceneImpl::ApplyDrives() {
   // with the implicit integrator drives are backward Euler: the velocity gain acts here, on the
   // velocity at the step's start, and the armature the compiler added makes up the rest
-  const double dt = config.integrator == Integrator::kImplicit ? config.timestep : 0.0;
+  const double dt = DriveStep(config);
   for (const auto& a : articulations) {
     if (a.desc.kinematic) continue;
     const CompiledArticulation& c = compiled_articulations.at(a.id);
@@ -470,15 +470,7 @@ double Scene::GetTime() const {
 }
 
 void Scene::SetDefaultMaterial(const PhysicalMaterial& material) {
-  const PhysicalMaterial& m = material;
-  if (!(m.static_friction >= 0) || !std::isfinite(m.static_friction) ||
-      !(m.dynamic_friction >= 0) || !std::isfinite(m.dynamic_friction) ||
-      !(m.restitution >= 0 && m.restitution <= 1))
-    throw Error(
-        "default material: frictions must be finite and >= 0 and restitution in [0, 1], "
-        "got static_friction " +
-        std::to_string(m.static_friction) + ", dynamic_friction " +
-        std::to_string(m.dynamic_friction) + ", restitution " + std::to_string(m.restitution));
+  Validate(material, "set_default_material");
   impl().config.default_material = material;
   impl().dirty = true;
   impl().EnsureCompiled();

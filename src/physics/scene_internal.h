@@ -210,6 +210,12 @@ std::string GenerateMjcf(const SceneImpl& scene);
 std::string DescribeMjNames(const SceneImpl& scene, const std::string& text);
 /// Fills compiled tables from a loaded model.
 void BuildTables(SceneImpl& scene);
+/// The step over which joint drives are backward Euler (DriveVelocityGain, DriveArmature): the
+/// implicit integrator's timestep; 0, the plain gains, for the explicit integrators.
+inline double DriveStep(const SceneConfig& config) {
+  return config.integrator == Integrator::kImplicit ? config.timestep : 0.0;
+}
+
 /// Contacts a fresh scene's buffers hold (SceneImpl::contact_capacity grows from there).
 constexpr int kBaseContacts = 256;
 /// Writes a dynamic actor's velocity damping into its free joint's dofs (compiled model).

@@ -128,6 +128,8 @@ void WriteObject(const GeneratedObject& object, const std::string& dir);
 
 /// Whether `folder` holds an object WriteObject wrote (its meta.json names partsim's generator).
 bool IsGeneratedObjectFolder(const std::string& folder);
+/// Whether `folder` is a staging folder WriteObject left behind (its name ends in kPartialSuffix).
+bool IsPartialObjectFolder(const std::string& folder);
 
 /// Generates and writes the objects of `options` on `options.jobs` threads; calls `progress`
 /// (serialised) after each object. Returns the number of objects written.

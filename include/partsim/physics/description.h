@@ -198,5 +198,6 @@ struct ArticulationDesc {
 /// every message (e.g. a file name).
 void Validate(const ActorDesc& actor, const std::string& where = "");
 void Validate(const ArticulationDesc& art, const std::string& where = "");
+void Validate(const PhysicalMaterial& material, const std::string& where = "");
 
 }  // namespace partsim

@@ -7,8 +7,6 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <mutex>
 #include <thread>
 
@@ -184,13 +182,6 @@ GeneratedObject GenerateObject(const std::string& category, int index, std::uint
 
 namespace {
 
-bool IsPartial(const std::filesystem::path& folder) {
-  const std::string name = folder.filename().string();
-  const std::string suffix = kPartialSuffix;
-  return name.size() > suffix.size() &&
-         name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // Refuses a non-empty output folder unless overwrite; then removes what partsim generated
 // there (object folders, leftovers of stopped runs), flat or by category, and nothing else.
 void PrepareOutDir(const GeneratorOptions& options) {
@@ -209,7 +200,8 @@ void PrepareOutDir(const GeneratorOptions& options) {
   for (auto it = fs::recursive_directory_iterator(out, ec);
        !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
     if (!it->is_directory()) continue;
-    if (IsPartial(it->path()) || IsGeneratedObjectFolder(it->path().string())) {
+    if (IsPartialObjectFolder(it->path().string()) ||
+        IsGeneratedObjectFolder(it->path().string())) {
       owned.push_back(it->path());
       it.disable_recursion_pending();
     } else if (it.depth() >= 1) {

@@ -4,12 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
 #include "assets/generator/mesh_builder.h"
+#include "core/file_read.h"
 #include "partsim/assets/generator.h"
 #include "partsim/core/error.h"
 
@@ -408,10 +407,21 @@ std::string SemanticsKind(const GeneratedLink& l) {
 }  // namespace
 
 bool IsGeneratedObjectFolder(const std::string& folder) {
-  std::ifstream in(std::filesystem::path(folder) / "meta.json", std::ios::binary);
-  if (!in) return false;
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text;
+  try {  // a user's folder: meta.json may be anything, a link to a device included
+    text = internal::ReadWholeFile((std::filesystem::path(folder) / "meta.json").string(),
+                                   "meta.json");
+  } catch (const Error&) {
+    return false;
+  }
   return text.find("\"generator\": \"partsim assets generate\"") != std::string::npos;
+}
+
+bool IsPartialObjectFolder(const std::string& folder) {
+  const std::string name = std::filesystem::path(folder).filename().string();
+  const std::string suffix = kPartialSuffix;
+  return name.size() > suffix.size() &&
+         name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 void WriteObject(const GeneratedObject& object, const std::string& dir) {
