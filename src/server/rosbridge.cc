@@ -46,16 +46,16 @@ constexpr size_t kMaxRequestsPerTopic = 64;
 
 // Whether a page of `origin` ("scheme://host[:port]") may connect: one of `allowed`, or with
 // none given, a page of this machine.
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  return s;
+}
+
 bool OriginAllowed(const std::string& origin, const std::vector<std::string>& allowed) {
   if (origin.empty()) return true;  // not a browser: no page to protect against
-  std::string o = origin;
-  std::transform(o.begin(), o.end(), o.begin(), [](unsigned char ch) { return std::tolower(ch); });
-  for (const std::string& a : allowed) {
-    std::string l = a;
-    std::transform(l.begin(), l.end(), l.begin(),
-                   [](unsigned char ch) { return std::tolower(ch); });
-    if (l == "*" || l == o) return true;
-  }
+  const std::string o = Lower(origin);
+  for (const std::string& a : allowed)
+    if (a == "*" || Lower(a) == o) return true;
   if (!allowed.empty()) return false;
   for (const char* scheme : {"http://", "https://"}) {
     if (o.rfind(scheme, 0) != 0) continue;
