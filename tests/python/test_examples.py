@@ -34,9 +34,9 @@ EXPECTED = {
 
 
 def run(script, *args, cwd):
+    # the examples that generate objects find the partsim command beside the package they
+    # import (<build>/partsim) or on PATH, as they do for a user
     env = dict(os.environ, PYTHONPATH=os.path.abspath(PYTHON_DIR))
-    env.setdefault("PARTSIM_CLI", os.path.join(os.path.dirname(os.path.abspath(PYTHON_DIR)),
-                                               "partsim"))
     p = subprocess.run([sys.executable, os.path.join(EXAMPLES, script), *args], cwd=cwd,
                        env=env, capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, f"{script} failed:\n{p.stdout}\n{p.stderr}"
