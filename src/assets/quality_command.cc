@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/progress.h"
 #include "partsim/assets/generator.h"
 #include "partsim/assets/quality.h"
 #include "partsim/core/error.h"
@@ -113,7 +114,8 @@ int RunQualityCommand(int argc, char** argv) {
   // check on a few threads; each object has its own scene
   std::vector<ObjectQualityReport> reports(folders.size());
   std::atomic<size_t> next{0}, done{0};
-  std::mutex print;
+  std::mutex print;  // guards stderr and progress
+  internal::ProgressLine progress(stderr);
   auto start = std::chrono::steady_clock::now();
   auto worker = [&] {
     for (size_t i = next++; i < folders.size(); i = next++) {
@@ -122,15 +124,20 @@ int RunQualityCommand(int argc, char** argv) {
       size_t n = ++done;
       std::lock_guard<std::mutex> lock(print);
       double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (!reports[i].Passed()) std::cerr << "\n" << reports[i].ToString();
-      std::fprintf(stderr, "\rchecked %zu/%zu objects, %.0f s elapsed, %.0f s left   ", n,
-                   folders.size(), t, t / n * (folders.size() - n));
+      if (!reports[i].Passed()) {
+        progress.Break();
+        std::cerr << reports[i].ToString();
+      }
+      char line[128];
+      std::snprintf(line, sizeof(line), "checked %zu/%zu objects, %.0f s elapsed, %.0f s left", n,
+                    folders.size(), t, t / n * (folders.size() - n));
+      progress.Update(static_cast<long>(n), static_cast<long>(folders.size()), line);
     }
   };
   std::vector<std::thread> threads;
   for (int j = 0; j < jobs; ++j) threads.emplace_back(worker);
   for (auto& t : threads) t.join();
-  std::fprintf(stderr, "\n");
+  progress.Break();
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   // summary, per check and per category

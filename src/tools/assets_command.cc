@@ -1,5 +1,6 @@
 // `partsim assets generate`: writes procedural articulated objects of the PartNet-Mobility
 // categories as dataset folders, with progress on stderr.
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "../core/progress.h"
 #include "commands.h"
 #include "partsim/assets/convex_decomposition.h"
 #include "partsim/assets/generator.h"
@@ -119,22 +121,25 @@ int Generate(const std::vector<std::string>& args) {
     }
   }
   if (!have_out) throw AssetsUsageError("partsim assets generate: --out DIR is required");
-  // unknown categories fail before anything is written
-  for (const std::string& c : opt.categories) PaperModelCount(c);
+  // unknown categories are a bad command line, refused before anything is written
+  const std::vector<std::string> known = GeneratorCategories();
+  for (const std::string& c : opt.categories) {
+    if (std::find(known.begin(), known.end(), c) == known.end())
+      throw AssetsUsageError("partsim assets generate: unknown category '" + c +
+                             "' in --categories" + DidYouMean(c, known) +
+                             " (partsim assets categories lists them)");
+  }
 
   auto start = std::chrono::steady_clock::now();
-  double last_print = -1.0;
+  internal::ProgressLine progress(stderr);
   int written = GenerateDataset(opt, [&](int done, int total, const GeneratedObject& o) {
     double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (done == total || t - last_print >= 0.5) {
-      last_print = t;
-      double eta = done > 0 ? t / done * (total - done) : 0.0;
-      std::fprintf(stderr, "\r[%d/%d] %s %s  elapsed %s  eta %s   ", done, total,
-                   o.category.c_str(), o.anno_id.c_str(), Clock(t).c_str(), Clock(eta).c_str());
-      if (done == total) std::fprintf(stderr, "\n");
-      std::fflush(stderr);
-    }
+    double eta = done > 0 ? t / done * (total - done) : 0.0;
+    progress.Update(done, total,
+                    "[" + std::to_string(done) + "/" + std::to_string(total) + "] " + o.category +
+                        " " + o.anno_id + "  elapsed " + Clock(t) + "  eta " + Clock(eta));
   });
+  progress.Break();
   double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::fprintf(stderr, "wrote %d objects to %s in %.1f s\n", written, opt.out_dir.c_str(), t);
   return 0;
@@ -172,8 +177,9 @@ int RunAssetsCommand(int argc, char** argv) {
     args.erase(args.begin());
     if (sub == "generate") return Generate(args);
     if (sub == "categories" && args.empty()) return ListCategories();
-    throw AssetsUsageError("partsim assets: unknown sub-command '" + sub +
-                           "' (expected generate, categories, check or decompose)");
+    throw AssetsUsageError("partsim assets: unknown sub-command '" + sub + "'" +
+                           DidYouMean(sub, {"generate", "categories", "check", "decompose"}) +
+                           " (expected generate, categories, check or decompose)");
   } catch (const AssetsUsageError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;

@@ -11,6 +11,16 @@ namespace partsim::tools {
 /// overflows).
 bool ParseInteger(const std::string& text, long long lo, long long* out);
 
+/// The entry of `candidates` closest to `word` by edit distance (insertions, deletions,
+/// substitutions; letters compared case-insensitively) when it is near enough to be a typo of it:
+/// at most a third of the longer word's letters differ, and at least one is the same. "" when
+/// none is, or when `word` is one of `candidates`.
+std::string ClosestMatch(const std::string& word, const std::vector<std::string>& candidates);
+
+/// " (did you mean 'X'?)" with X = ClosestMatch(word, candidates), or "" when there is none: to
+/// append to a usage error that names `word`.
+std::string DidYouMean(const std::string& word, const std::vector<std::string>& candidates);
+
 /// Removes the files of `dir` that an earlier run of the same command wrote: names starting with
 /// one of `prefixes` and ending with the matching entry of `suffixes` ("color_" + ".png"), so
 /// that a run with fewer views or frames leaves no stale ones beside its own. Other files stay.
