@@ -216,6 +216,7 @@ struct RosbridgeServer::Impl {
   };
   struct Client {
     Hdl hdl;
+    std::string address;  // the peer's address and port, for the log
     std::map<std::string, Subscription> subs;
     std::map<std::string, std::string> advertised;  // topic -> type
     std::set<std::string> services;                 // advertised by this client
@@ -1243,20 +1244,31 @@ RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& opt
     }
     return true;
   });
-  m.ws.set_open_handler([this](Hdl h) {
+  // with log_clients, a line per client that comes or goes: its address and the count after
+  auto log_client = [this](const Impl::Client& c, const char* what, size_t count) {
+    if (!impl_->options.log_clients) return;
+    std::fprintf(stderr, "partsim serve: client %s %s (%zu client%s connected)\n",
+                 c.address.c_str(), what, count, count == 1 ? "" : "s");
+  };
+  m.ws.set_open_handler([this, log_client](Hdl h) {
     auto c = std::make_shared<Impl::Client>();
     c->hdl = h;
     c->authenticated = impl_->options.auth_token.empty();
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = impl_->ws.get_con_from_hdl(h, ec);
+    c->address = !ec && con ? con->get_remote_endpoint() : "(unknown address)";
     std::lock_guard<std::mutex> lock(impl_->clients_mutex);
     impl_->clients[h] = c;
+    log_client(*c, "connected", impl_->clients.size());
   });
-  auto gone = [this](Hdl h) {
+  auto gone = [this, log_client](Hdl h) {
     std::lock_guard<std::mutex> lock(impl_->clients_mutex);
     auto it = impl_->clients.find(h);
     if (it == impl_->clients.end()) return;
     Impl::ClientPtr c = it->second;
     impl_->clients.erase(it);
     impl_->ClientGone(c);
+    log_client(*c, "disconnected", impl_->clients.size());
   };
   m.ws.set_close_handler(gone);
   m.ws.set_fail_handler(gone);
@@ -1288,9 +1300,24 @@ void RosbridgeServer::Start() {
                  m.options.auth_token.empty() ? "; set a token (--token)" : "");
   boost::asio::ip::tcp::endpoint ep(addr, static_cast<unsigned short>(m.options.port));
   m.ws.listen(ep, ec);
-  if (ec)
+  if (ec) {
+    // websocketpp reports socket errors as "Underlying Transport Error"; the operating
+    // system's reason ("Address already in use") comes from binding a plain socket the same way
+    std::string why = ec.message();
+    boost::asio::ip::tcp::acceptor probe(m.ws.get_io_service());
+    probe.open(ep.protocol(), bec);
+    if (!bec) probe.set_option(boost::asio::socket_base::reuse_address(true), bec);
+    if (!bec) probe.bind(ep, bec);
+    if (!bec) probe.listen(boost::asio::socket_base::max_listen_connections, bec);
+    if (bec == boost::asio::error::address_in_use)
+      why =
+          "address already in use (another program, perhaps another partsim serve, listens "
+          "there)";
+    else if (bec)
+      why = bec.message();
     throw Error("rosbridge: cannot listen on " + m.options.address + ":" +
-                std::to_string(m.options.port) + ": " + ec.message());
+                std::to_string(m.options.port) + ": " + why);
+  }
   m.accept_timer = std::make_unique<boost::asio::steady_timer>(m.ws.get_io_service());
   m.StartAccept();
   m.port = m.ws.get_local_endpoint(bec).port();

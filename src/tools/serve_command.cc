@@ -111,9 +111,13 @@ int RunServeCommand(int argc, char** argv) {
         std::fputs(kServeUsage, stdout);
         return 0;
       } else if (a == "--port") {
-        double p = ParsePositive(a, value(), true);
-        if (p > 65535 || p != static_cast<int>(p))
-          throw ServeUsageError("partsim serve: --port expects an integer in [0, 65535]");
+        const std::string v = value();
+        long long p = 0;
+        if (!ParseInteger(v, 0, &p) || p > 65535)
+          throw ServeUsageError(
+              "partsim serve: --port expects an integer from 0 to 65535 (0 picks a free port), "
+              "got '" +
+              v + "'");
         port = static_cast<int>(p);
       } else if (a == "--rate") {
         rate = ParsePositive(a, value());
@@ -156,9 +160,14 @@ int RunServeCommand(int argc, char** argv) {
         robot_kind = value();
         if (robot_kind != "gripper" && robot_kind != "panda")
           throw ServeUsageError("partsim serve: --robot expects gripper or panda, got '" +
-                                robot_kind + "'");
+                                robot_kind + "'" + DidYouMean(robot_kind, {"gripper", "panda"}));
       } else if (!a.empty() && a[0] == '-') {
-        throw ServeUsageError("partsim serve: unknown option '" + a + "'");
+        throw ServeUsageError(
+            "partsim serve: unknown option '" + a + "'" +
+            DidYouMean(a,
+                       {"--port", "--rate", "--realtime-factor", "--fast", "--robot", "--address",
+                        "--duration", "--camera", "--camera-rate", "--token", "--allow-origin",
+                        "--max-clients", "--ros1", "--ros1-wall-time", "--help"}));
       } else if (scene_file.empty()) {
         scene_file = a;
       } else {
@@ -166,7 +175,7 @@ int RunServeCommand(int argc, char** argv) {
       }
     }
   } catch (const ServeUsageError& e) {
-    std::fprintf(stderr, "%s\n%s", e.what(), kServeUsage);
+    std::fprintf(stderr, "%s\nsee partsim serve --help\n", e.what());
     return 2;
   }
 #ifndef PARTSIM_WITH_ROS1
@@ -240,8 +249,14 @@ int RunServeCommand(int argc, char** argv) {
     ro.auth_token = token;
     ro.allowed_origins = origins;
     ro.max_clients = max_clients;
+    ro.log_clients = true;
     RosbridgeServer bridge(&served, ro);
-    bridge.Start();
+    try {
+      bridge.Start();
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string(e.what()) +
+                               "; choose another port with --port P, or --port 0 for a free one");
+    }
 #ifdef PARTSIM_WITH_ROS1
     std::unique_ptr<Ros1Bridge> ros1_bridge;
     if (ros1) {
@@ -259,6 +274,18 @@ int RunServeCommand(int argc, char** argv) {
         scene.GetArticulations().size(), rate,
         fast ? "as fast as possible" : ("real-time factor " + std::to_string(factor)).c_str(),
         ros1 ? ", ROS 1 node /partsim" : "");
+    // what to do next: connect a client, find the topics and services
+    const std::string url = "ws://" + address + ":" + std::to_string(bridge.GetPort());
+    char stop[64] = "stop with Ctrl-C";
+    if (duration > 0) std::snprintf(stop, sizeof(stop), "stops after %g s", duration);
+    std::printf(
+        "  connect a rosbridge client to %s, e.g. Python roslibpy: "
+        "roslibpy.Ros(host='%s', port=%d), or JavaScript roslib: new ROSLIB.Ros({url: '%s'})\n"
+        "  topics: /joint_states, /tf, /clock, /%s/joint_position_controller/command, "
+        "/front_camera/image_raw, ...; the service /rosapi/topics lists them all "
+        "(partsim serve --help)\n"
+        "  clients are logged on stderr as they connect and leave; %s\n",
+        url.c_str(), address.c_str(), bridge.GetPort(), url.c_str(), robot.GetName().c_str(), stop);
     std::fflush(stdout);
 
     std::signal(SIGINT, OnSignal);

@@ -38,6 +38,9 @@ struct RosbridgeOptions {
   size_t max_message_bytes = 16u << 20;
   size_t max_client_queue = 200;          ///< messages waiting per client before drops
   size_t max_client_buffered = 4u << 20;  ///< bytes in a client's socket queue before drops
+  /// Writes a line on stderr when a client connects or leaves: its address and port, and the
+  /// number of clients then connected.
+  bool log_clients = false;
 };
 
 /// Counters for the README and the tests.
