@@ -1,7 +1,7 @@
-// The `partsim` command-line program: inspect a URDF articulation (`info`), simulate it and
-// write its joint trajectory (`simulate`), or render it from a few views (`render`). With no
-// file, all use the built-in cabinet of MakeCabinetUrdf(). Exit codes: 0 success, 1 failure while
-// running (missing or bad file), 2 bad command line.
+// The `partsim` command-line program: inspect a URDF articulation or a PartNet-Mobility object
+// (`info`), simulate it and write its joint trajectory (`simulate`), or render it from a few
+// views (`render`). With no file, all use the built-in cabinet of MakeCabinetUrdf(). Exit codes: 0
+// success, 1 failure while running (missing or bad file), 2 bad command line.
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -25,6 +26,7 @@
 
 #include "commands.h"
 #include "partsim/assets/default_objects.h"
+#include "partsim/assets/partnet_mobility.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/core/error.h"
 #include "partsim/physics/scene.h"
@@ -40,13 +42,17 @@ constexpr char kVersion[] = "0.1.0";
 constexpr char kUsage[] = R"(partsim: simulate robots and articulated objects (doors, drawers, ...)
 
 usage:
-  partsim info [FILE.urdf] [--fix-root | --free-root] [--json]
-  partsim simulate [FILE.urdf] --steps N [options]
-  partsim render [FILE.urdf] --out DIR [options]
+  partsim info [OBJECT] [--fix-root | --free-root] [--json]
+  partsim simulate [OBJECT] --steps N [options]
+  partsim render [OBJECT] --out DIR [options]
   partsim assets generate --out DIR [options]   (see partsim assets --help)
   partsim tasks demo|evaluate [options]         (see partsim tasks --help)
   partsim serve [SCENE] [options]               (see partsim serve --help)
   partsim --help | --version
+
+OBJECT is a URDF file or a PartNet-Mobility folder (mobility.urdf with mobility_v2.json,
+semantics.txt, meta.json, as `partsim assets generate` writes them); a folder's mobility.urdf
+given alone loads as its folder does, with the part labels of semantics.txt.
 
 info       prints the links (name, parent, mass), the joints (name, type, parent -> child,
            limits in rad or m), the total mass and the number of degrees of freedom.
@@ -68,11 +74,12 @@ simulate   steps the articulation and writes its joint trajectory: time, then th
 
 render     places the object on a ground under lights and renders it from N views around it,
            looking at its centre. Writes into DIR, per view K: color_K.png (8-bit sRGB),
-           depth_K.png (16-bit, millimetres, 0 = nothing), normal_K.png (camera frame,
+           depth_K.png (16-bit, millimetres, 0 = nothing), depth_preview_K.png (8-bit grey
+           for viewing: near bright, far dark, nothing black), normal_K.png (camera frame,
            (n + 1) / 2), segmentation_K.png (one colour per actor or link) and cloud_K.ply
            (binary point cloud in the world frame with colours and ids); plus
            segmentation.json (id -> actor / link name, part label, colour) and cameras.json
-           (K, extrinsics and pose per view).
+           (K, extrinsics and pose per view, the object's world bounds).
   --out DIR                      output folder (required; created if missing; the files an
                                  earlier render wrote there are removed first)
   --backend rasterizer|pathtracer   renderer (default rasterizer)
@@ -81,7 +88,7 @@ render     places the object on a ground under lights and renders it from N view
   --spp N                        path tracer samples per pixel (default 64)
   --fix-root | --free-root       as for info (default --fix-root)
 
-With no FILE, all commands use the built-in cabinet (a drawer and a door); `simulate` then runs
+With no OBJECT, all commands use the built-in cabinet (a drawer and a door); `simulate` then runs
 a demo that drives the drawer and the door open and prints their final positions.
 Exit codes: 0 success, 1 runtime failure (missing or invalid file), 2 bad command line.
 )";
@@ -95,7 +102,7 @@ class UsageError : public std::runtime_error {
 /// Parsed command line.
 struct Args {
   std::string command;  // "info", "simulate" or "render"
-  std::string file;     // "" for the built-in cabinet
+  std::string file;     // URDF file or PartNet-Mobility folder; "" for the built-in cabinet
   bool fix_root = true;
   bool json = false;
   std::optional<long> steps;
@@ -158,7 +165,7 @@ Args ParseArgs(const std::vector<std::string>& argv) {
   };
   for (size_t i = 1; i < argv.size(); ++i) {
     std::string arg = argv[i];
-    // positional: the URDF file
+    // positional: the URDF file or PartNet-Mobility folder
     if (arg.empty() || arg[0] != '-' || arg == "-") {
       if (!args.file.empty()) {
         throw UsageError(prefix + "unexpected extra argument '" + arg + "' (one file at most)");
@@ -212,7 +219,8 @@ Args ParseArgs(const std::vector<std::string>& argv) {
       args.backend = value();
       if (args.backend != "rasterizer" && args.backend != "pathtracer" && args.backend != "null") {
         throw UsageError(prefix + "--backend must be rasterizer or pathtracer, got '" +
-                         args.backend + "'");
+                         args.backend + "'" +
+                         partsim::tools::DidYouMean(args.backend, {"rasterizer", "pathtracer"}));
       }
     } else if (flag == "--views" && render) {
       args.views = count(flag, value(), 360);
@@ -225,7 +233,8 @@ Args ParseArgs(const std::vector<std::string>& argv) {
     } else if (flag == "--format" && simulate) {
       args.format = value();
       if (args.format != "csv" && args.format != "json") {
-        throw UsageError(prefix + "--format must be csv or json, got '" + args.format + "'");
+        throw UsageError(prefix + "--format must be csv or json, got '" + args.format + "'" +
+                         partsim::tools::DidYouMean(args.format, {"csv", "json"}));
       }
     } else if (flag == "--drive-stiffness" && simulate) {
       args.stiffness = ParseNumber(prefix + "--drive-stiffness", value());
@@ -243,7 +252,18 @@ Args ParseArgs(const std::vector<std::string>& argv) {
       }
       args.gravity = Eigen::Vector3d(g[0], g[1], g[2]);
     } else {
-      throw UsageError(prefix + "unknown option '" + arg + "' (see partsim --help)");
+      std::vector<std::string> flags = {"--fix-root", "--free-root"};
+      if (simulate) {
+        flags.insert(flags.end(), {"--steps", "--dt", "--out", "--format", "--drive-stiffness",
+                                   "--drive-damping", "--target", "--gravity"});
+      } else if (render) {
+        flags.insert(flags.end(),
+                     {"--out", "--backend", "--views", "--width", "--height", "--spp"});
+      } else {
+        flags.push_back("--json");
+      }
+      throw UsageError(prefix + "unknown option '" + arg + "'" +
+                       partsim::tools::DidYouMean(flag, flags) + " (see partsim --help)");
     }
   }
   if (simulate && !args.file.empty() && !args.steps) {
@@ -271,6 +291,33 @@ struct Loaded {
   std::string source;  // file name, or "built-in cabinet"
 };
 
+// The built-in cabinet's part labels, in the PartNet-Mobility vocabulary of semantics.txt that
+// generated objects and the tasks use.
+void LabelCabinetParts(partsim::ArticulationDesc* desc) {
+  for (partsim::LinkDesc& link : desc->links) {
+    if (link.name == "body")
+      link.semantic_label = "furniture_body";
+    else if (link.name.rfind("drawer_", 0) == 0)
+      link.semantic_label = "drawer";
+    else if (link.name.rfind("door_", 0) == 0)
+      link.semantic_label = "rotation_door";
+  }
+}
+
+// The PartNet-Mobility folder that `file` names: the folder itself, or the folder of a
+// mobility.urdf that has the dataset's annotation files beside it; "" for any other file.
+std::string PartNetFolder(const std::string& file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path path(file);
+  if (fs::is_directory(path, ec)) return file;
+  if (path.filename() != "mobility.urdf") return "";
+  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  for (const char* annotation : {"mobility_v2.json", "semantics.txt", "meta.json"})
+    if (fs::is_regular_file(folder / annotation, ec)) return folder.string();
+  return "";
+}
+
 Loaded Load(const Args& args, const partsim::SceneConfig& config) {
   Loaded out;
   out.scene = std::make_unique<partsim::Scene>(config);
@@ -278,17 +325,32 @@ Loaded Load(const Args& args, const partsim::SceneConfig& config) {
   loader.fix_root_link = args.fix_root;
   if (args.file.empty()) {
     std::cerr << "partsim: no file given, using the built-in cabinet (a drawer and a door)\n";
-    out.art = loader.LoadFromString(partsim::MakeCabinetUrdf(), ".");
+    partsim::ArticulationDesc desc = loader.Parse(partsim::MakeCabinetUrdf(), ".");
+    LabelCabinetParts(&desc);
+    out.art = out.scene->AddArticulation(desc);
     out.source = "built-in cabinet";
-  } else {
-    // a missing file is reported with the system's reason
-    std::ifstream probe(args.file);
-    if (!probe) {
-      throw std::runtime_error("cannot open '" + args.file + "': " + std::strerror(errno));
-    }
-    out.art = loader.Load(args.file);
-    out.source = args.file;
+    return out;
   }
+  // a PartNet-Mobility object loads through the dataset's loader, whichever of the folder
+  // and its mobility.urdf is named: same articulation, with the labels of semantics.txt
+  if (const std::string folder = PartNetFolder(args.file); !folder.empty()) {
+    if (folder != args.file) {
+      std::cerr << "partsim: " << args.file << " belongs to a PartNet-Mobility folder; loading "
+                << folder << " (part labels from semantics.txt)\n";
+    }
+    partsim::PartNetMobilityLoader partnet(out.scene.get());
+    partnet.urdf = loader;
+    out.art = partnet.Load(folder);
+    out.source = args.file;
+    return out;
+  }
+  // a missing file is reported with the system's reason
+  std::ifstream probe(args.file);
+  if (!probe) {
+    throw std::runtime_error("cannot open '" + args.file + "': " + std::strerror(errno));
+  }
+  out.art = loader.Load(args.file);
+  out.source = args.file;
   return out;
 }
 
@@ -536,6 +598,29 @@ std::string ViewFile(const std::filesystem::path& dir, const char* stem, int k, 
   return (dir / (std::string(stem) + "_" + std::to_string(k) + ext)).string();
 }
 
+/// Writes `depth` (width x height, metres along the view axis, 0 where nothing is seen) as an
+/// 8-bit grey PNG for viewing: linear from 255 at the nearest surface seen to 48 at the farthest,
+/// and 0 where nothing is seen. (The metric 16-bit depth PNG holds millimetres, a few thousand of
+/// 65535, which viewers show black.)
+void WriteDepthPreviewPng(const std::string& path, int width, int height,
+                          const std::vector<float>& depth) {
+  constexpr float kNear = 255.0f, kFar = 48.0f;
+  float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
+  for (float d : depth) {
+    if (d > 0) {
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
+    }
+  }
+  std::vector<uint8_t> grey(depth.size(), 0);
+  for (size_t i = 0; i < depth.size(); ++i) {
+    if (!(depth[i] > 0)) continue;
+    const float t = hi > lo ? (depth[i] - lo) / (hi - lo) : 0.0f;
+    grey[i] = static_cast<uint8_t>(std::lround(kNear + t * (kFar - kNear)));
+  }
+  partsim::WritePng(path, width, height, 1, grey.data());
+}
+
 void WriteJsonFile(const std::filesystem::path& path, const nlohmann::ordered_json& j) {
   std::ofstream out(path);
   out << j.dump(2) << "\n";
@@ -629,6 +714,8 @@ int RunRender(const Args& args) {
     const partsim::Picture& picture = cam.GetPictureData();
     partsim::WriteColorPng(ViewFile(dir, "color", k, ".png"), picture);
     partsim::WriteDepthPng(ViewFile(dir, "depth", k, ".png"), picture);
+    WriteDepthPreviewPng(ViewFile(dir, "depth_preview", k, ".png"), args.width, args.height,
+                         partsim::DepthImage(picture));
     partsim::WriteNormalPng(ViewFile(dir, "normal", k, ".png"), picture);
     partsim::WriteSegmentationPng(ViewFile(dir, "segmentation", k, ".png"), picture, 1);
     partsim::PointCloud cloud = partsim::MakePointCloud(cam, partsim::PointCloudFrame::kWorld);
@@ -679,6 +766,11 @@ int RunRender(const Args& args) {
       "K and extrinsic [R|t] in OpenCV's camera frame (x right, y down, z forward); pose X_WC "
       "with x forward, y left, z up; quaternion w, x, y, z";
   cams["views"] = views;
+  cams["object_bounds"] = {{"min", {lo.x(), lo.y(), lo.z()}},
+                           {"max", {hi.x(), hi.y(), hi.z()}},
+                           {"note",
+                            "world frame, m: box of the object's visuals (of its link origins, "
+                            "0.25 m wider, when it has none)"}};
   WriteJsonFile(dir / "cameras.json", cams);
   std::printf("wrote %d views to %s\n", args.views, args.out.c_str());
   return 0;
@@ -706,11 +798,12 @@ int main(int argc, char** argv) {
   if (command == "tasks") return partsim::tools::RunTasksCommand(argc - 2, argv + 2);
   if (command == "serve") return partsim::tools::RunServeCommand(argc - 2, argv + 2);
   if (command != "info" && command != "simulate" && command != "render") {
+    const std::string hint = partsim::tools::DidYouMean(
+        command, {"info", "simulate", "render", "assets", "tasks", "serve", "--help", "--version"});
     std::fprintf(stderr,
-                 "partsim: unknown %s '%s' (expected info, simulate, render, assets, tasks or "
-                 "serve; see partsim "
-                 "--help)\n",
-                 command[0] == '-' ? "option" : "command", command.c_str());
+                 "partsim: unknown %s '%s'%s (expected info, simulate, render, assets, tasks or "
+                 "serve; see partsim --help)\n",
+                 command[0] == '-' ? "option" : "command", command.c_str(), hint.c_str());
     return 2;
   }
   try {

@@ -1,5 +1,6 @@
 // Runs the built `partsim` program through popen and checks its output and exit codes.
 #include <gtest/gtest.h>
+#include <png.h>
 #include <sys/wait.h>
 
 #include <Eigen/Core>
@@ -260,6 +261,17 @@ std::array<int, 4> PngHeader(const std::string& path) {
   return {be32(16), be32(20), b[24], b[25]};
 }
 
+/// An 8-bit grey PNG's pixels (row-major, top row first); empty when it cannot be read as one.
+std::vector<uint8_t> ReadGreyPng(const std::string& path) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str())) return {};
+  image.format = PNG_FORMAT_GRAY;
+  std::vector<uint8_t> pixels(PNG_IMAGE_SIZE(image));
+  if (!png_image_finish_read(&image, nullptr, pixels.data(), 0, nullptr)) return {};
+  return pixels;
+}
+
 /// Points of a binary PLY written by partsim: position and entity id.
 struct PlyPoint {
   Eigen::Vector3f p;
@@ -306,6 +318,11 @@ void CheckRender(const fs::path& dir, const std::string& backend, int views, boo
     EXPECT_EQ(by_name[link]["articulation"], "cabinet") << link;
     EXPECT_EQ(by_name[link]["color"].size(), 3u);
   }
+  // part labels in semantics.txt's vocabulary, as generated objects have
+  EXPECT_EQ(by_name["drawer_0"]["semantic_label"], "drawer");
+  EXPECT_EQ(by_name["door_0"]["semantic_label"], "rotation_door");
+  EXPECT_EQ(by_name["body"]["semantic_label"], "furniture_body");
+  EXPECT_EQ(by_name["ground"]["semantic_label"], "");
   EXPECT_FALSE(legend["visuals"].empty());
   uint32_t ground_id = by_name["ground"]["id"].get<uint32_t>();
   nlohmann::json cams;
@@ -317,6 +334,7 @@ void CheckRender(const fs::path& dir, const std::string& backend, int views, boo
     std::string n = std::to_string(k);
     EXPECT_EQ(PngHeader(out + "/color_" + n + ".png"), (std::array<int, 4>{64, 48, 8, 6}));
     EXPECT_EQ(PngHeader(out + "/depth_" + n + ".png"), (std::array<int, 4>{64, 48, 16, 0}));
+    EXPECT_EQ(PngHeader(out + "/depth_preview_" + n + ".png"), (std::array<int, 4>{64, 48, 8, 0}));
     EXPECT_EQ(PngHeader(out + "/normal_" + n + ".png"), (std::array<int, 4>{64, 48, 8, 2}));
     EXPECT_EQ(PngHeader(out + "/segmentation_" + n + ".png"), (std::array<int, 4>{64, 48, 8, 2}));
     std::string header;
@@ -344,7 +362,113 @@ void CheckRender(const fs::path& dir, const std::string& backend, int views, boo
       EXPECT_LT(pt.p.z(), 0.8f + 2e-3f);
     }
     EXPECT_GT(on_cabinet, 64u * 48 / 10) << "view " << k;
+
+    // the depth preview spans its grey scale: the nearest surface white, the farthest 48, what
+    // sees nothing black; one pixel per point of the cloud is not black
+    std::vector<uint8_t> preview = ReadGreyPng(out + "/depth_preview_" + n + ".png");
+    ASSERT_EQ(preview.size(), 64u * 48);
+    std::set<uint8_t> greys;
+    size_t lit = 0;
+    for (uint8_t g : preview) {
+      if (g == 0) continue;
+      greys.insert(g);
+      ++lit;
+    }
+    EXPECT_EQ(lit, points.size()) << "view " << k;
+    EXPECT_EQ(*greys.rbegin(), 255) << "view " << k;
+    EXPECT_EQ(*greys.begin(), 48) << "view " << k;
+    EXPECT_GT(greys.size(), 20u) << "view " << k;
   }
+}
+
+/// The world bounds of the object that a render into `out` framed (cameras.json).
+std::array<double, 6> ObjectBounds(const fs::path& out) {
+  nlohmann::json cams;
+  std::ifstream(out / "cameras.json") >> cams;
+  const nlohmann::json& b = cams["object_bounds"];
+  if (!b.contains("min")) return {};
+  return {b["min"][0], b["min"][1], b["min"][2], b["max"][0], b["max"][1], b["max"][2]};
+}
+
+/// Part labels of the links of a render into `out` (segmentation.json), by link name.
+std::map<std::string, std::string> LinkLabels(const fs::path& out) {
+  nlohmann::json legend;
+  std::ifstream(out / "segmentation.json") >> legend;
+  std::map<std::string, std::string> labels;
+  for (const auto& e : legend["entities"])
+    if (e["kind"] == "link") labels[e["name"]] = e["semantic_label"];
+  return labels;
+}
+
+// A PartNet-Mobility folder loads through the dataset's loader in info, simulate and render; its
+// mobility.urdf named alone loads the same: upright (the y-up height of bounding_box.json is the
+// world z extent) and with the labels of semantics.txt.
+TEST_F(CliTest, APartNetMobilityFolderAndItsUrdfLoadTheSameUpright) {
+  const fs::path gen = dir_ / "gen";
+  RunResult g =
+      RunCli("assets generate --categories StorageFurniture --seed 3 --out '" + gen.string() + "'");
+  ASSERT_EQ(g.code, 0) << g.output;
+  fs::path folder;
+  for (const auto& e : fs::directory_iterator(gen)) folder = e.path();
+  ASSERT_TRUE(fs::exists(folder / "mobility.urdf")) << g.output;
+
+  RunResult info = RunCli("info '" + folder.string() + "' --json", /*stderr_too=*/false);
+  ASSERT_EQ(info.code, 0) << info.output;
+  nlohmann::json j = nlohmann::json::parse(info.output);
+  EXPECT_EQ(j["name"].get<std::string>().rfind("StorageFurniture_", 0), 0u) << j["name"];
+  EXPECT_GE(j["dof"].get<int>(), 1);
+  EXPECT_EQ(RunCli("simulate '" + folder.string() + "' --steps 5").code, 0);
+
+  nlohmann::json bbox;
+  std::ifstream(folder / "bounding_box.json") >> bbox;
+  const double height = bbox["max"][1].get<double>() - bbox["min"][1].get<double>();
+  std::map<std::string, std::string> labels;
+  for (const fs::path& object : {folder, folder / "mobility.urdf"}) {
+    const fs::path out = dir_ / ("render_" + object.filename().string());
+    RunResult r = RunCli("render --backend null --views 1 --width 16 --height 12 --out '" +
+                         out.string() + "' '" + object.string() + "'");
+    ASSERT_EQ(r.code, 0) << r.output;
+    std::array<double, 6> b = ObjectBounds(out);
+    EXPECT_NEAR(b[5] - b[2], height, 1e-3) << object;
+    std::map<std::string, std::string> l = LinkLabels(out);
+    if (labels.empty()) labels = l;
+    EXPECT_EQ(l, labels) << object;
+  }
+  EXPECT_EQ(labels["link_0"], "furniture_body");
+
+  // the real sample: a bottle with a lid on a screw joint
+  const fs::path real =
+      fs::path(PARTSIM_SOURCE_DIR) / ".." / "shared" / "realdata" / "partnet-mobility-3763";
+  if (!fs::exists(real)) return;
+  for (const fs::path& object : {real, real / "mobility.urdf"}) {
+    RunResult r = RunCli("info '" + object.string() + "'");
+    EXPECT_EQ(r.code, 0) << r.output;
+    EXPECT_TRUE(Contains(r.output, "articulation 'Bottle_")) << r.output;
+  }
+}
+
+TEST_F(CliTest, TyposGetASuggestion) {
+  struct Case {
+    std::string args, suggestion;
+  };
+  const std::vector<Case> cases = {
+      {"rendr", "did you mean 'render'?"},
+      {"info --jsn", "did you mean '--json'?"},
+      {"render --out OUT --backend rasterizr", "did you mean 'rasterizer'?"},
+      {"render --out OUT --view 3", "did you mean '--views'?"},
+      {"simulate --steps 3 --format jsn", "did you mean 'json'?"},
+  };
+  for (const Case& c : cases) {
+    std::string args = c.args;
+    if (size_t at = args.find("OUT"); at != std::string::npos)
+      args.replace(at, 3, (dir_ / "out").string());
+    RunResult r = RunCli(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.output;
+    EXPECT_TRUE(Contains(r.output, c.suggestion)) << args << "\n" << r.output;
+  }
+  // no suggestion for what is far from every choice
+  RunResult r = RunCli("render --out " + (dir_ / "out").string() + " --backend vulkan");
+  EXPECT_FALSE(Contains(r.output, "did you mean")) << r.output;
 }
 
 TEST_F(CliTest, RenderWritesImagesCloudsAndLegendWithTheNullBackend) {
