@@ -90,31 +90,40 @@ std::vector<size_t> Shape(const py::array& a) {
 }
 
 void BindTypes(py::module_& m) {
-  py::enum_<LightType>(m, "LightType", "Light kinds.")
+  py::enum_<LightType>(m, "LightType",
+                       "Light kinds: DIRECTIONAL (parallel rays along a direction), POINT (from "
+                       "a position in all directions), SPOT (a cone from a position).")
       .value("DIRECTIONAL", LightType::kDirectional)
       .value("POINT", LightType::kPoint)
       .value("SPOT", LightType::kSpot);
 
   py::class_<LightDesc>(m, "LightDesc", "A light of the scene (read from scene.get_lights()).")
-      .def_readonly("type", &LightDesc::type)
-      .def_readonly("color", &LightDesc::color, "(3,) linear RGB.")
+      .def_readonly("type", &LightDesc::type, "LightType: DIRECTIONAL, POINT or SPOT.")
+      .def_readonly("color", &LightDesc::color, "Linear RGB radiance scale (3,), float32.")
       .def_readonly("position", &LightDesc::position, "(3,) world, m (point and spot).")
       .def_readonly("direction", &LightDesc::direction, "(3,) world, unit (directional, spot).")
       .def_readonly("inner_angle", &LightDesc::inner_angle, "Spot: half angle (rad).")
       .def_readonly("outer_angle", &LightDesc::outer_angle, "Spot: half angle (rad).")
-      .def_readonly("shadow", &LightDesc::shadow)
-      .def_readonly("name", &LightDesc::name);
+      .def_readonly("shadow", &LightDesc::shadow,
+                    "True when the light casts shadows (directional and spot lights in the "
+                    "rasterizer).")
+      .def_readonly("name", &LightDesc::name, "Light name ('' if none).");
 
   py::class_<RenderEntityInfo>(m, "RenderEntityInfo",
                                "A render id (segmentation channel 1) and the actor or link it "
                                "names.")
-      .def_readonly("id", &RenderEntityInfo::id)
-      .def_readonly("is_link", &RenderEntityInfo::is_link)
+      .def_readonly("id", &RenderEntityInfo::id,
+                    "The render id, equal to the actor's or link's scene-wide id (get_id()).")
+      .def_readonly("is_link", &RenderEntityInfo::is_link,
+                    "True for a link of an articulation, False for an actor.")
       .def_readonly("name", &RenderEntityInfo::name, "Actor or link name.")
-      .def_readonly("actor_id", &RenderEntityInfo::actor_id, "-1 for a link.")
-      .def_readonly("articulation_id", &RenderEntityInfo::articulation_id, "-1 for an actor.")
-      .def_readonly("link_index", &RenderEntityInfo::link_index, "-1 for an actor.")
-      .def_readonly("articulation_name", &RenderEntityInfo::articulation_name)
+      .def_readonly("actor_id", &RenderEntityInfo::actor_id, "The actor's id; -1 for a link.")
+      .def_readonly("articulation_id", &RenderEntityInfo::articulation_id,
+                    "The link's articulation id; -1 for an actor.")
+      .def_readonly("link_index", &RenderEntityInfo::link_index,
+                    "The link's index in its articulation; -1 for an actor.")
+      .def_readonly("articulation_name", &RenderEntityInfo::articulation_name,
+                    "Name of the link's articulation ('' for an actor).")
       .def_readonly("semantic_label", &RenderEntityInfo::semantic_label, "Part label, '' if none.")
       .def("__repr__", [](const RenderEntityInfo& self) {
         return "<RenderEntityInfo " + std::to_string(self.id) + " '" + self.name + "'>";
@@ -122,9 +131,11 @@ void BindTypes(py::module_& m) {
 
   py::class_<RenderVisualInfo>(m, "RenderVisualInfo",
                                "A visual id (segmentation channel 0), its entity and its name.")
-      .def_readonly("id", &RenderVisualInfo::id)
-      .def_readonly("entity_id", &RenderVisualInfo::entity_id)
-      .def_readonly("name", &RenderVisualInfo::name)
+      .def_readonly("id", &RenderVisualInfo::id, "Scene-wide id of the visual shape (>= 1).")
+      .def_readonly("entity_id", &RenderVisualInfo::entity_id,
+                    "Id of the actor or link the visual belongs to (a RenderEntityInfo id).")
+      .def_readonly("name", &RenderVisualInfo::name,
+                    "The visual's name, e.g. a PartNet-Mobility part 'handle-15' ('' if none).")
       .def("__repr__", [](const RenderVisualInfo& self) {
         return "<RenderVisualInfo " + std::to_string(self.id) + " '" + self.name + "'>";
       });
@@ -138,13 +149,13 @@ void BindCamera(py::module_& m) {
   py::class_<Camera>(m, "Camera",
                      "Handle to a camera (x forward, y left, z up). Pictures are read-only numpy "
                      "views that stay valid after the next take_picture().")
-      .def("get_id", &Camera::GetId)
-      .def("get_name", &Camera::GetName)
-      .def_property_readonly("name", &Camera::GetName)
-      .def_property_readonly("width", &Camera::GetWidth, "Pixels.")
-      .def_property_readonly("height", &Camera::GetHeight, "Pixels.")
-      .def("get_width", &Camera::GetWidth)
-      .def("get_height", &Camera::GetHeight)
+      .def("get_id", &Camera::GetId, "The camera's id in its scene.")
+      .def("get_name", &Camera::GetName, "The camera's name.")
+      .def_property_readonly("name", &Camera::GetName, "The camera's name.")
+      .def_property_readonly("width", &Camera::GetWidth, "Image width in pixels.")
+      .def_property_readonly("height", &Camera::GetHeight, "Image height in pixels.")
+      .def("get_width", &Camera::GetWidth, "Image width in pixels.")
+      .def("get_height", &Camera::GetHeight, "Image height in pixels.")
       .def_property_readonly("near", &Camera::GetNear, "Near clipping distance (m).")
       .def_property_readonly("far", &Camera::GetFar, "Far clipping distance (m).")
       .def("set_near_far", &Camera::SetNearFar, py::arg("near"), py::arg("far"),
@@ -153,9 +164,11 @@ void BindCamera(py::module_& m) {
                     "Vertical field of view (rad); setting it makes fx = fy and centres the "
                     "principal point.")
       .def_property_readonly("fovx", &Camera::GetFovx, "Horizontal field of view (rad).")
-      .def("get_fovy", &Camera::GetFovy)
-      .def("set_fovy", &Camera::SetFovy, py::arg("fovy"))
-      .def("get_fovx", &Camera::GetFovx)
+      .def("get_fovy", &Camera::GetFovy, "Vertical field of view (rad).")
+      .def("set_fovy", &Camera::SetFovy, py::arg("fovy"),
+           "Sets the vertical field of view (rad); fx = fy and the principal point goes to the "
+           "image centre.")
+      .def("get_fovx", &Camera::GetFovx, "Horizontal field of view (rad).")
       .def("set_intrinsics", &Camera::SetIntrinsics, py::arg("fx"), py::arg("fy"), py::arg("cx"),
            py::arg("cy"), "Focal lengths and principal point in pixels (OpenCV).")
       .def("get_intrinsic_matrix", &Camera::GetIntrinsicMatrix, "3x3 OpenCV K (pixels).")
@@ -170,7 +183,9 @@ void BindCamera(py::module_& m) {
       .def("set_pose", &Camera::SetLocalPose, py::arg("pose"),
            "Same as set_local_pose: the world pose of a free camera, the pose in the mount's "
            "frame of a mounted one.")
-      .def("get_local_pose", &Camera::GetLocalPose)
+      .def("get_local_pose", &Camera::GetLocalPose,
+           "World pose of a free camera, or pose in the mount's frame of a mounted one (camera "
+           "frame: x forward, y left, z up).")
       .def(
           "set_parent",
           [](Camera& self, const py::object& parent, bool keep_pose) {
@@ -248,9 +263,13 @@ void BindSceneRender(py::module_& m) {
            py::arg("name"), py::arg("mount"), py::arg("pose"), py::arg("width"), py::arg("height"),
            py::arg("fovy"), py::arg("near"), py::arg("far"), ka,
            "A camera moving with a link; `pose` is its pose in the link's frame.")
-      .def("remove_camera", &Scene::RemoveCamera, py::arg("camera"))
-      .def("get_cameras",
-           [](py::object self) { return HandleList(self.cast<const Scene&>().GetCameras(), self); })
+      .def("remove_camera", &Scene::RemoveCamera, py::arg("camera"),
+           "Removes a camera; raises PartsimError when it was removed already or belongs to "
+           "another scene.")
+      .def(
+          "get_cameras",
+          [](py::object self) { return HandleList(self.cast<const Scene&>().GetCameras(), self); },
+          "Handles of every camera of the scene, fixed and mounted.")
       .def("add_directional_light", &Scene::AddDirectionalLight, py::arg("direction"),
            py::arg("color"), py::arg("shadow") = false,
            "Light travelling along `direction` (3,) (world); color (3,) linear RGB.")
@@ -262,7 +281,8 @@ void BindSceneRender(py::module_& m) {
            "Spot light; half angles in radians, 0 <= inner <= outer <= pi/2.")
       .def("set_ambient_light", &Scene::SetAmbientLight, py::arg("color"),
            "Ambient light (3,), linear RGB.")
-      .def("get_lights", &Scene::GetLights)
+      .def("get_lights", &Scene::GetLights,
+           "list of LightDesc: the scene's directional, point and spot lights.")
       .def("set_render_backend", py::overload_cast<const std::string&>(&Scene::SetRenderBackend),
            py::arg("name"), "'rasterizer' (the default), 'pathtracer' or 'null'.")
       .def("get_render_backend", &Scene::GetRenderBackend, py::return_value_policy::reference, ka,
