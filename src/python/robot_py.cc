@@ -13,12 +13,13 @@ void BindRobots(py::module_& m) {
                          "the direction in which the fingers open. List attributes are copies: "
                          "assign a whole list to change them.")
       .def(py::init<>())
-      .def_readwrite("articulation", &RobotModel::articulation, "ArticulationDesc.")
+      .def_readwrite("articulation", &RobotModel::articulation,
+                     "ArticulationDesc of the robot (load it with Scene.add_articulation).")
       .def_readwrite("arm_joints", &RobotModel::arm_joints,
                      "Joints that move the hand, base to tip.")
       .def_readwrite("gripper_joints", &RobotModel::gripper_joints,
                      "Finger joints (prismatic, 0 = closed).")
-      .def_readwrite("ee_link", &RobotModel::ee_link, "Link that carries the hand.")
+      .def_readwrite("ee_link", &RobotModel::ee_link, "Name of the link that carries the hand.")
       .def_readwrite("tcp_in_ee", &RobotModel::tcp_in_ee, "TCP frame in the ee_link frame.")
       .def_readwrite("gripper_open", &RobotModel::gripper_open,
                      "Finger joint position when fully open (m).")
@@ -36,12 +37,14 @@ void BindRobots(py::module_& m) {
 
   py::class_<FlyingGripperOptions>(m, "FlyingGripperOptions", "Options of the flying gripper.")
       .def(py::init<>())
-      .def_readwrite("name", &FlyingGripperOptions::name)
+      .def_readwrite("name", &FlyingGripperOptions::name,
+                     "Articulation name (default 'flying_gripper').")
       .def_readwrite("workspace", &FlyingGripperOptions::workspace,
                      "Limits of the x, y, z slides: +-workspace (m).")
       .def_readwrite("finger_travel", &FlyingGripperOptions::finger_travel,
                      "Each finger slides from 0 (closed) to this (m).")
-      .def_readwrite("finger_length", &FlyingGripperOptions::finger_length, "m.")
+      .def_readwrite("finger_length", &FlyingGripperOptions::finger_length,
+                     "Length of each finger (m).")
       .def_readwrite("finger_force", &FlyingGripperOptions::finger_force,
                      "Force limit of each finger drive (N).")
       .def_readwrite("arm_force", &FlyingGripperOptions::arm_force,
