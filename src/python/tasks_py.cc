@@ -10,10 +10,13 @@
 namespace partsim::python {
 
 void BindTasks(py::module_& m) {
-  py::enum_<TaskType>(m, "TaskType", "The two interaction tasks of the SAPIEN paper.")
+  py::enum_<TaskType>(m, "TaskType",
+                      "The two interaction tasks of the SAPIEN paper: PULL_DRAWER ('drawer') "
+                      "and OPEN_DOOR ('door').")
       .value("PULL_DRAWER", TaskType::kPullDrawer)
       .value("OPEN_DOOR", TaskType::kOpenDoor);
-  m.def("parse_task_type", &ParseTaskType, py::arg("name"), "'drawer' or 'door' to a TaskType.");
+  m.def("parse_task_type", &ParseTaskType, py::arg("name"),
+        "'drawer' or 'door' to a TaskType; raises PartsimError naming anything else.");
   m.def("task_target_label", &TaskTargetLabel, py::arg("type"),
         "The semantics.txt label of the task's targets: 'drawer' or 'rotation_door'.");
   m.def("find_task_targets", &FindTaskTargets, py::arg("object"), py::arg("type"),
@@ -21,11 +24,12 @@ void BindTasks(py::module_& m) {
         "task_target_label(type), with a handle and a finite joint range.");
 
   py::class_<TaskOptions>(m, "TaskOptions", "Settings of a door or drawer task.")
-      .def(py::init<>())
-      .def_readwrite("type", &TaskOptions::type)
+      .def(py::init<>(), "The defaults: a drawer task on generated object 0.")
+      .def_readwrite("type", &TaskOptions::type, "TaskType (default PULL_DRAWER).")
       .def_readwrite("object_index", &TaskOptions::object_index,
                      "Index of the generated StorageFurniture object.")
-      .def_readwrite("dataset_seed", &TaskOptions::dataset_seed)
+      .def_readwrite("dataset_seed", &TaskOptions::dataset_seed,
+                     "Seed of the object generator (default 0).")
       .def_readwrite("object_folder", &TaskOptions::object_folder,
                      "A PartNet-Mobility folder (real or generated) instead of the generator's "
                      "object; '' uses object_index and dataset_seed.")
@@ -33,19 +37,29 @@ void BindTasks(py::module_& m) {
                      "Which drawer (door) of the object; -1: drawn by reset's seed.")
       .def_readwrite("asset_dir", &TaskOptions::asset_dir,
                      "Folder for the generated object ('' = a temporary folder).")
-      .def_readwrite("cameras", &TaskOptions::cameras)
-      .def_readwrite("camera_width", &TaskOptions::camera_width)
-      .def_readwrite("camera_height", &TaskOptions::camera_height)
-      .def_readwrite("render_backend", &TaskOptions::render_backend)
-      .def_readwrite("timestep", &TaskOptions::timestep)
-      .def_readwrite("control_rate", &TaskOptions::control_rate)
-      .def_readwrite("max_seconds", &TaskOptions::max_seconds)
-      .def_readwrite("success_fraction", &TaskOptions::success_fraction)
-      .def_readwrite("init_on_handle", &TaskOptions::init_on_handle);
+      .def_readwrite("cameras", &TaskOptions::cameras,
+                     "Add the left, right and front cameras (default True).")
+      .def_readwrite("camera_width", &TaskOptions::camera_width,
+                     "Camera image width in pixels (default 320).")
+      .def_readwrite("camera_height", &TaskOptions::camera_height,
+                     "Camera image height in pixels (default 240).")
+      .def_readwrite("render_backend", &TaskOptions::render_backend,
+                     "'rasterizer' (default), 'pathtracer' or 'null'.")
+      .def_readwrite("timestep", &TaskOptions::timestep, "Physics step in s (default 1/500).")
+      .def_readwrite("control_rate", &TaskOptions::control_rate,
+                     "Control rate in Hz (default 50): step() advances one control period.")
+      .def_readwrite("max_seconds", &TaskOptions::max_seconds,
+                     "Episode length in simulated seconds before truncation (default 20).")
+      .def_readwrite("success_fraction", &TaskOptions::success_fraction,
+                     "Fraction of the target joint's range that counts as success (default "
+                     "0.9).")
+      .def_readwrite("init_on_handle", &TaskOptions::init_on_handle,
+                     "reset() places the gripper, closed, on the handle (default False).");
 
   m.def("find_task_objects", &FindTaskObjects, py::arg("type"), py::arg("count"),
         py::arg("dataset_seed") = 0,
-        "The first `count` StorageFurniture indices with a drawer (door) that has a handle.");
+        "The first `count` generated StorageFurniture indices (from 0, for dataset_seed) whose "
+        "object has a drawer (door) with a handle, as a list of int.");
 
   using Twist = Eigen::Matrix<double, 6, 1>;
   auto ka = py::keep_alive<0, 1>();
@@ -55,69 +69,119 @@ void BindTasks(py::module_& m) {
       "gripper and three cameras (left, right, front). Actions: TCP twist (world, 6) and gripper "
       "command in [-1, 1].")
       .def(py::init<const TaskOptions&>(), py::arg("options"),
-           py::call_guard<py::gil_scoped_release>())
+           py::call_guard<py::gil_scoped_release>(),
+           "Builds the task's scene: the object (generated or from object_folder), the gripper "
+           "and the cameras. Releases the GIL.")
       .def(
           "reset",
           [](ArticulationTask& t, std::uint64_t seed) {
             WithoutGil(t.GetScene(), [&] { t.Reset(seed); });
           },
-          py::arg("seed") = 0, "Starts a new episode.")
+          py::arg("seed") = 0,
+          "Starts a new episode: the same cabinet, joints closed, the target drawn from `seed` "
+          "(unless options.target is set), the gripper open at a pose drawn from `seed` in "
+          "front of the cabinet (or on the handle with init_on_handle).")
       .def_property_readonly(
           "options", [](const ArticulationTask& t) { return t.GetOptions(); },
           "A copy of the task's options (they are fixed when the task is made).")
       .def_property_readonly("scene", &ArticulationTask::GetSharedScene,
                              "The task's scene (shared).")
-      .def_property_readonly("robot_model", &ArticulationTask::GetRobotModel)
-      .def_property_readonly("robot", &ArticulationTask::GetRobot, ka)
-      .def_property_readonly("object", &ArticulationTask::GetObject, ka)
-      .def_property_readonly("target_link", &ArticulationTask::GetTargetLink, ka)
-      .def_property_readonly("target_joint", &ArticulationTask::GetTargetJoint, ka)
-      .def("get_target_candidates", &ArticulationTask::GetTargetCandidates)
-      .def("get_handle_visual_ids", &ArticulationTask::GetHandleVisualIds)
-      .def("get_target_entity_id", &ArticulationTask::GetTargetEntityId)
+      .def_property_readonly("robot_model", &ArticulationTask::GetRobotModel,
+                             "RobotModel of the flying gripper.")
+      .def_property_readonly("robot", &ArticulationTask::GetRobot, ka,
+                             "The flying gripper's Articulation.")
+      .def_property_readonly("object", &ArticulationTask::GetObject, ka,
+                             "The cabinet's Articulation (base on z = 0, front facing +x).")
+      .def_property_readonly("target_link", &ArticulationTask::GetTargetLink, ka,
+                             "Link of the target drawer or door.")
+      .def_property_readonly("target_joint", &ArticulationTask::GetTargetJoint, ka,
+                             "Joint of the target drawer or door.")
+      .def("get_target_candidates", &ArticulationTask::GetTargetCandidates,
+           "Link names of the target's candidates (links with the task's label and a "
+           "handle).")
+      .def("get_handle_visual_ids", &ArticulationTask::GetHandleVisualIds,
+           "Render visual ids (segmentation channel 0) of the target's handle pieces.")
+      .def("get_target_entity_id", &ArticulationTask::GetTargetEntityId,
+           "Render entity id (segmentation channel 1) of the target link.")
       .def("get_progress", &ArticulationTask::GetProgress,
            "Fraction of the target joint's range opened (0 closed, 1 fully open).")
-      .def("is_success", &ArticulationTask::IsSuccess)
-      .def("is_failure", &ArticulationTask::IsFailure)
-      .def("is_truncated", &ArticulationTask::IsTruncated)
+      .def("is_success", &ArticulationTask::IsSuccess,
+           "True when progress reached options.success_fraction.")
+      .def("is_failure", &ArticulationTask::IsFailure,
+           "True when the joint moved the wrong way past its closed end by more than 2% of "
+           "the range.")
+      .def("is_truncated", &ArticulationTask::IsTruncated,
+           "True when more than options.max_seconds have passed since reset.")
       .def("get_elapsed", &ArticulationTask::GetElapsed, "Simulated seconds since reset.")
-      .def("get_tcp_pose", &ArticulationTask::GetTcpPose)
-      .def("get_tcp_velocity", &ArticulationTask::GetTcpVelocity)
-      .def("set_tcp_target", &ArticulationTask::SetTcpTarget, py::arg("pose"))
+      .def("get_tcp_pose", &ArticulationTask::GetTcpPose,
+           "World pose of the gripper's tool centre point (TCP).")
+      .def("get_tcp_velocity", &ArticulationTask::GetTcpVelocity,
+           "TCP twist (6,) in the world frame: linear (m/s) then angular (rad/s).")
+      .def("set_tcp_target", &ArticulationTask::SetTcpTarget, py::arg("pose"),
+           "Moves the hand towards a world pose by position control of the six arm joints.")
       .def(
           "set_tcp_velocity", [](ArticulationTask& t, const Twist& v) { t.SetTcpVelocity(v); },
-          py::arg("twist"))
-      .def("set_gripper", &ArticulationTask::SetGripper, py::arg("fraction"), "1 open, 0 closed.")
-      .def("get_gripper_opening", &ArticulationTask::GetGripperOpening)
-      .def("gripper_touches_target", &ArticulationTask::GripperTouchesTarget)
+          py::arg("twist"),
+          "Moves the hand with a world twist (6,), linear m/s then angular rad/s, held until "
+          "changed.")
+      .def("set_gripper", &ArticulationTask::SetGripper, py::arg("fraction"),
+           "Finger opening as a fraction: 1 fully open, 0 closed (clamped to [0, 1]).")
+      .def("get_gripper_opening", &ArticulationTask::GetGripperOpening,
+           "Current finger opening, 0 (closed) to 1 (open).")
+      .def("gripper_touches_target", &ArticulationTask::GripperTouchesTarget,
+           "True when a finger touches the target link (handle or panel).")
       .def("apply_action", &ArticulationTask::ApplyAction, py::arg("action"),
-           "7 values: TCP twist (vx, vy, vz, wx, wy, wz; world) and gripper in [-1, 1].")
+           "7 values: TCP twist (vx, vy, vz in m/s, wx, wy, wz in rad/s; world frame) and the "
+           "gripper command in [-1, 1] (-1 close, 1 open). Speeds are clamped to 1 m/s and 3 "
+           "rad/s; a NaN, infinite or wrongly sized action raises PartsimError and changes "
+           "nothing.")
       .def(
           "step", [](ArticulationTask& t) { WithoutGil(t.GetScene(), [&] { t.Step(); }); },
-          "Advances one control period.")
-      .def("take_pictures",
-           [](ArticulationTask& t) { WithoutGil(t.GetScene(), [&] { t.TakePictures(); }); })
-      .def("get_cameras", &ArticulationTask::GetCameras, ka)
-      .def("get_camera", &ArticulationTask::GetCamera, py::arg("name"), ka)
-      .def("get_raw_observation", &ArticulationTask::GetRawObservation)
-      .def("get_mobility_observation", &ArticulationTask::GetMobilityObservation)
-      .def("get_reward", &ArticulationTask::GetReward, "Dense reward of the last step.");
+          "Advances one control period: timestep-long physics steps for 1 / control_rate s; the "
+          "GIL is released.")
+      .def(
+          "take_pictures",
+          [](ArticulationTask& t) { WithoutGil(t.GetScene(), [&] { t.TakePictures(); }); },
+          "Renders the cameras (left, right, front) at the current state; the GIL is released.")
+      .def("get_cameras", &ArticulationTask::GetCameras, ka,
+           "The task's cameras (left, right, front; empty without options.cameras).")
+      .def("get_camera", &ArticulationTask::GetCamera, py::arg("name"), ka,
+           "The camera named `name` ('left', 'right' or 'front'); raises PartsimError when the "
+           "task has none of that name.")
+      .def("get_raw_observation", &ArticulationTask::GetRawObservation,
+           "float64 vector: the cabinet's qpos and qvel, then the TCP pose (p (3,) in m, q (4,) "
+           "w, x, y, z; world), the TCP twist (6,) and the gripper opening.")
+      .def("get_mobility_observation", &ArticulationTask::GetMobilityObservation,
+           "float64 vector: the target joint's axis origin (3,) and direction (3,) in the "
+           "world, the target part's average outward normal (3,), the joint's position and "
+           "velocity (2,), then the robot state as in get_raw_observation.")
+      .def("get_reward", &ArticulationTask::GetReward,
+           "Dense reward of the last step: 10 x progress gained, +1 per step at success, -0.1 "
+           "when a grasp was lost, minus 0.5 x the TCP's distance (m) to the handle until it is "
+           "grasped.");
 
   py::class_<SolverResult>(m, "SolverResult", "Outcome of a heuristic solver.")
-      .def_readonly("success", &SolverResult::success)
-      .def_readonly("progress", &SolverResult::progress)
-      .def_readonly("seconds", &SolverResult::seconds)
-      .def_readonly("stage", &SolverResult::stage)
-      .def_readonly("message", &SolverResult::message)
+      .def_readonly("success", &SolverResult::success, "True when the task succeeded.")
+      .def_readonly("progress", &SolverResult::progress,
+                    "Final fraction of the target joint's range opened.")
+      .def_readonly("seconds", &SolverResult::seconds, "Simulated time used, s.")
+      .def_readonly("stage", &SolverResult::stage,
+                    "Stage reached: 'perceive', 'grasp', 'pull', 'open' or 'done'.")
+      .def_readonly("message", &SolverResult::message, "Why it failed ('' on success).")
       .def("__repr__", [](const SolverResult& r) {
         return "<SolverResult success=" + std::string(r.success ? "True" : "False") +
                " progress=" + std::to_string(r.progress) + " stage='" + r.stage + "'>";
       });
   py::class_<SolverOptions>(m, "SolverOptions", "Options of the heuristic solvers.")
-      .def(py::init<>())
-      .def_readwrite("use_cameras", &SolverOptions::use_cameras)
-      .def_readwrite("frames_dir", &SolverOptions::frames_dir)
-      .def_readwrite("frame_every", &SolverOptions::frame_every);
+      .def(py::init<>(), "The defaults.")
+      .def_readwrite("use_cameras", &SolverOptions::use_cameras,
+                     "True (default): find the handle in the cameras' segmented point clouds; "
+                     "False: from the handle's mesh in the scene (ground truth).")
+      .def_readwrite("frames_dir", &SolverOptions::frames_dir,
+                     "Folder for frame_NNNNN.png colour frames of the recording camera ('video' "
+                     "if the task has one, else 'front'); '' (default) writes none.")
+      .def_readwrite("frame_every", &SolverOptions::frame_every,
+                     "Control steps between two written frames (default 10).");
   auto solver = [&m](const char* name, SolverResult (*f)(ArticulationTask&, const SolverOptions&),
                      const char* doc) {
     m.def(
@@ -127,9 +191,16 @@ void BindTasks(py::module_& m) {
         },
         py::arg("task"), py::arg("options") = SolverOptions(), doc);
   };
-  solver("solve_pull_drawer", &SolvePullDrawer, "The paper's drawer heuristic.");
-  solver("solve_open_door", &SolveOpenDoor, "The paper's door heuristic.");
-  solver("solve_task", &SolveTask, "The heuristic of the task's type.");
+  solver("solve_pull_drawer", &SolvePullDrawer,
+         "The paper's drawer heuristic: find the handle in the segmented point cloud, grasp it, "
+         "pull along the joint axis with a velocity controller. Returns a SolverResult; the GIL "
+         "is released.");
+  solver("solve_open_door", &SolveOpenDoor,
+         "The paper's door heuristic: grasp the handle, open a little, then follow the door by "
+         "visual servoing while turning about the hinge, re-grasping when the grip is lost. "
+         "Returns a SolverResult; the GIL is released.");
+  solver("solve_task", &SolveTask,
+         "solve_pull_drawer or solve_open_door, by the task's type. Returns a SolverResult.");
 }
 
 }  // namespace partsim::python
