@@ -45,11 +45,14 @@ class Box:
         self._rng = np.random.default_rng(seed)
 
     def seed(self, seed=None):
+        """Reseeds the generator that ``sample`` draws from (None: fresh entropy); returns
+        ``[seed]``."""
         self._rng = np.random.default_rng(seed)
         return [seed]
 
     @property
     def np_random(self):
+        """The ``numpy.random.Generator`` that ``sample`` draws from."""
         return self._rng
 
     def sample(self, mask=None):
@@ -70,6 +73,8 @@ class Box:
         return out.astype(self.dtype)
 
     def contains(self, x) -> bool:
+        """True when ``x`` (an array or anything ``numpy.asarray`` takes) has this shape, a
+        dtype that casts safely to this dtype, and every entry within ``[low, high]``."""
         if not isinstance(x, np.ndarray):
             try:
                 x = np.asarray(x, dtype=self.dtype)
@@ -108,15 +113,20 @@ class Dict:
         self.seed(seed)
 
     def seed(self, seed=None):
+        """Reseeds every sub-space from one ``numpy.random.SeedSequence(seed)`` (a child seed
+        each); returns ``[seed]``."""
         ss = np.random.SeedSequence(seed)
         for space, child in zip(self.spaces.values(), ss.spawn(len(self.spaces))):
             space.seed(int(child.generate_state(1)[0]))
         return [seed]
 
     def sample(self, mask=None):
+        """A dict with one sample of each sub-space (``mask`` is accepted and ignored)."""
         return {k: s.sample() for k, s in self.spaces.items()}
 
     def contains(self, x) -> bool:
+        """True when ``x`` is a dict with exactly these keys and each value lies in its
+        sub-space."""
         return (
             isinstance(x, dict)
             and x.keys() == self.spaces.keys()
@@ -136,12 +146,15 @@ class Dict:
         return len(self.spaces)
 
     def keys(self):
+        """The sub-spaces' names."""
         return self.spaces.keys()
 
     def values(self):
+        """The sub-spaces (``Box`` or ``Dict``)."""
         return self.spaces.values()
 
     def items(self):
+        """(name, sub-space) pairs."""
         return self.spaces.items()
 
     def __eq__(self, other):
@@ -284,10 +297,13 @@ class OpenCabinetEnv(_ClosedByContext):
 
     @property
     def np_random(self) -> np.random.Generator:
+        """The environment's ``numpy.random.Generator``: it draws each episode's object, target
+        and task seed; ``reset(seed=...)`` reseeds it."""
         return self._np_random
 
     @property
     def unwrapped(self):
+        """The environment itself (Gymnasium's ``Env.unwrapped``; there are no wrappers)."""
         return self
 
     @property
@@ -332,6 +348,13 @@ class OpenCabinetEnv(_ClosedByContext):
         return self._observation(), self._info()
 
     def step(self, action):
+        """Applies a (7,) action for one control period (1 / control_rate s) and returns
+        ``(obs, reward, terminated, truncated, info)``: the observation of ``obs_mode``, the
+        dense reward (float), ``terminated`` on success or failure, ``truncated`` after
+        ``max_episode_steps`` steps, and ``info`` with ``success``, ``progress`` (fraction of the
+        range opened), ``object`` (index or folder name), ``target`` (link name), ``touching``
+        and ``elapsed`` (simulated s). Raises ``RuntimeError`` before ``reset`` or after
+        ``close``, ``ValueError`` for a wrong shape or a non-finite entry."""
         self._check_open()
         if self._task is None:
             raise RuntimeError("step called before reset")
@@ -365,6 +388,8 @@ class OpenCabinetEnv(_ClosedByContext):
         return np.ascontiguousarray(self._task.get_camera("front").get_color_rgba8()[:, :, :3])
 
     def close(self):
+        """Frees the tasks and their scenes; later calls other than ``close`` raise
+        ``RuntimeError``."""
         self._tasks.clear()
         self._task = None
         self._closed = True
@@ -508,6 +533,12 @@ class VectorOpenCabinetEnv(_ClosedByContext):
         return _stack([r[0] for r in results]), self._infos([r[1] for r in results])
 
     def step(self, actions):
+        """Steps every sub-environment with its row of ``actions`` (num_envs, 7) and returns
+        batched ``(obs, rewards, terminations, truncations, infos)``: observations stacked
+        along a first axis of num_envs, rewards float64 (num_envs,), terminations and
+        truncations bool (num_envs,), infos a dict of arrays (each key ``k`` with a bool mask
+        ``_k``). A sub-environment whose episode ended is reset instead (next-step autoreset).
+        Raises ``ValueError`` for a wrong shape or non-finite actions."""
         self._check_open()
         actions = np.asarray(actions, dtype=np.float64)
         if actions.shape != (self.num_envs, 7):
@@ -535,6 +566,8 @@ class VectorOpenCabinetEnv(_ClosedByContext):
         )
 
     def close(self):
+        """Closes every sub-environment on its own thread and stops the threads; closing twice
+        does nothing."""
         if self._closed:
             return
         self._map(lambda i: self.envs[i].close())  # frees the GL objects on their thread
