@@ -15,6 +15,8 @@ PACKAGES=(
   libegl-dev libegl-mesa0 libgl1-mesa-dri libopengl-dev libembree-dev libpng-dev
   libbullet-extras-dev libjpeg-dev libompl-dev
   libwebsocketpp-dev libboost-dev
+  # MP4 videos of the demo and of VideoWriter (H.264 through Debian's libx264)
+  libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
 )
 # native ROS 1 (optional build; PARTSIM_NO_ROS1=1 leaves it out): roscpp, actionlib, the message
 # packages with their definitions and Debian's message generators; rospy, rostopic and
@@ -44,6 +46,10 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-# /usr/bin/python3 is Debian's interpreter: the one that sees python3-numpy and pybind11
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3
+# Configure once: afterwards `cmake --build` configures again by itself when a CMakeLists.txt,
+# a globbed folder or a ROS 1 message definition changes, so a build that is current costs a
+# second. /usr/bin/python3 is Debian's interpreter: the one that sees python3-numpy and pybind11.
+if [ ! -f build/CMakeCache.txt ] || [ ! -f build/Makefile ]; then
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3
+fi
 cmake --build build -j"${PARTSIM_JOBS:-2}"

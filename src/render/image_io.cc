@@ -195,20 +195,48 @@ PointCloud MakePointCloud(const Camera& camera, PointCloudFrame frame) {
   return MakePointCloud(picture, frame, X_WC);
 }
 
-std::vector<uint8_t> ToRgba8(const std::vector<float>& rgba) {
-  std::vector<uint8_t> out(rgba.size());
-  auto byte = [](float x) {
-    x = std::min(std::max(x, 0.0f), 1.0f);
-    return static_cast<uint8_t>(std::lround(x * 255.0f));
-  };
-  for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
-    for (size_t k = 0; k < 3; ++k) {
-      float x = std::min(std::max(rgba[i + k], 0.0f), 1.0f);
-      float s = x <= 0.0031308f ? 12.92f * x : 1.055f * std::pow(x, 1.0f / 2.4f) - 0.055f;
-      out[i + k] = byte(s);
+namespace {
+
+// sRGB encoding to 8 bits by table, the same bytes as lround(255 * encode(x)) without a pow per
+// value (it was most of the cost of writing a video frame): `first[b]` is the smallest linear
+// value that encodes to byte b, and `start[i]` the byte of i / kBuckets; a bucket spans less
+// than one byte of the curve, so at most one step up corrects the start.
+struct SrgbTable {
+  static constexpr int kBuckets = 4096;
+  float first[257];
+  uint8_t start[kBuckets + 1];
+  SrgbTable() {
+    first[0] = 0.0f;
+    for (int b = 1; b < 256; ++b) {
+      const double s = (b - 0.5) / 255.0;
+      first[b] = static_cast<float>(s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4));
     }
+    first[256] = 2.0f;  // above every clamped value
+    for (int i = 0, b = 0; i <= kBuckets; ++i) {
+      const float x = static_cast<float>(i) / kBuckets;
+      while (b < 255 && x >= first[b + 1]) ++b;
+      start[i] = static_cast<uint8_t>(b);
+    }
+  }
+  uint8_t Encode(float x) const {
+    if (!(x > 0.0f)) return 0;  // NaN too
+    if (x >= 1.0f) return 255;
+    int b = start[static_cast<int>(x * kBuckets)];
+    while (x >= first[b + 1]) ++b;
+    return static_cast<uint8_t>(b);
+  }
+};
+
+}  // namespace
+
+std::vector<uint8_t> ToRgba8(const std::vector<float>& rgba) {
+  static const SrgbTable table;
+  std::vector<uint8_t> out(rgba.size());
+  for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
+    for (size_t k = 0; k < 3; ++k) out[i + k] = table.Encode(rgba[i + k]);
     // alpha is coverage, not colour: no transfer curve
-    out[i + 3] = byte(rgba[i + 3]);
+    const float a = rgba[i + 3];
+    out[i + 3] = a > 0.0f ? static_cast<uint8_t>(std::lround(std::min(a, 1.0f) * 255.0f)) : 0;
   }
   return out;
 }

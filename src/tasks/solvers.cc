@@ -5,10 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <optional>
 
 #include "partsim/core/error.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/video.h"
 #include "partsim/tasks/tasks.h"
 #include "tasks/task_internal.h"
 
@@ -27,23 +30,57 @@ struct Perception {
 
 class Runner {
  public:
-  Runner(ArticulationTask& task, const SolverOptions& options) : task_(task), options_(options) {}
+  Runner(ArticulationTask& task, const SolverOptions& options) : task_(task), options_(options) {
+    if (options_.frame_every < 1)
+      throw Error("solver: frame_every must be at least 1, got " +
+                  std::to_string(options_.frame_every));
+    if (options_.frames_dir.empty() && options_.video_path.empty()) return;
+    // the recording camera: the task's video camera, else the front one
+    recorder_ = task_.impl().video_camera;
+    if (!recorder_) recorder_ = task_.GetCamera("front");
+    if (!options_.video_path.empty()) {
+      VideoOptions vo;
+      vo.fps = task_.GetOptions().control_rate / options_.frame_every;
+      video_ = std::make_unique<VideoWriter>(options_.video_path, recorder_->GetWidth(),
+                                             recorder_->GetHeight(), vo);
+      Record();  // the first frame: the scene before the solver moves
+    }
+  }
+
+  /// The outcome of the run, and the video finished (the destructor would finish it too,
+  /// without reporting errors).
+  SolverResult Result(const std::string& stage, const std::string& message) {
+    if (video_) video_->Close();
+    SolverResult r;
+    r.success = task_.IsSuccess();
+    r.progress = task_.GetProgress();
+    r.seconds = task_.GetElapsed();
+    r.stage = stage;
+    r.message = r.success ? "" : message;
+    return r;
+  }
 
   /// One control step, with frames written when asked.
   void Step() {
     task_.Step();
     ++steps_;
-    if (!options_.frames_dir.empty() && steps_ % std::max(1, options_.frame_every) == 0) {
-      task_.TakePictures();
-      char name[64];
-      std::snprintf(name, sizeof(name), "frame_%05d.png", frame_++);
-      Camera front = task_.GetCamera("front");
-      WriteColorPng((std::filesystem::path(options_.frames_dir) / name).string(),
-                    front.GetPictureData());
-    }
+    if (recorder_ && steps_ % options_.frame_every == 0) Record();
   }
 
   bool OutOfTime() const { return task_.IsTruncated(); }
+
+  /// Renders the recording camera and writes its frame to the PNG folder and the video.
+  void Record() {
+    task_.GetScene().UpdateRender();
+    recorder_->TakePicture(kColor);
+    const Picture& picture = recorder_->GetPictureData();
+    if (!options_.frames_dir.empty()) {
+      char name[64];
+      std::snprintf(name, sizeof(name), "frame_%05d.png", frame_++);
+      WriteColorPng((std::filesystem::path(options_.frames_dir) / name).string(), picture);
+    }
+    if (video_) video_->AddFrame(picture);
+  }
 
   /// Moves the TCP to `target` along a straight line at `speed` (m/s), then waits until it is
   /// within 5 mm and ~3 degrees, or `timeout` seconds pass. Returns whether it got there.
@@ -172,17 +209,9 @@ class Runner {
   SolverOptions options_;
   long steps_ = 0;
   int frame_ = 0;
+  std::optional<Camera> recorder_;  // the camera that frames and video record
+  std::unique_ptr<VideoWriter> video_;
 };
-
-SolverResult Finish(ArticulationTask& task, const std::string& stage, const std::string& message) {
-  SolverResult r;
-  r.success = task.IsSuccess();
-  r.progress = task.GetProgress();
-  r.seconds = task.GetElapsed();
-  r.stage = stage;
-  r.message = r.success ? "" : message;
-  return r;
-}
 
 /// The joint's opening direction: +1 if opening increases q.
 double OpeningSign(const Joint& j) {
@@ -207,7 +236,7 @@ SolverResult SolvePullDrawer(ArticulationTask& task, const SolverOptions& option
   for (int attempt = 0; attempt < 3 && !task.IsTruncated(); ++attempt) {
     HandleGrasp g;
     if (!run.FindGrasp(Eigen::Vector3d::UnitX(), true, &g, &msg))
-      return Finish(task, "perceive", msg);
+      return run.Result("perceive", msg);
     if (!run.Grasp(g, &msg)) continue;
     stage = "pull";
     Eigen::Matrix<double, 6, 1> twist;
@@ -233,7 +262,7 @@ SolverResult SolvePullDrawer(ArticulationTask& task, const SolverOptions& option
     run.MoveTo(back, 0.3, 0.5);
   }
   run.Wait(0.2);
-  return Finish(task, stage, msg);
+  return run.Result(stage, msg);
 }
 
 SolverResult SolveOpenDoor(ArticulationTask& task, const SolverOptions& options) {
@@ -272,7 +301,7 @@ SolverResult SolveOpenDoor(ArticulationTask& task, const SolverOptions& options)
   for (int attempt = 0; attempt < 3 && !task.IsTruncated(); ++attempt) {
     Eigen::Vector3d guess = Eigen::AngleAxisd(angle, axis) * n0;
     HandleGrasp g;
-    if (!run.FindGrasp(guess, false, &g, &msg)) return Finish(task, "perceive", msg);
+    if (!run.FindGrasp(guess, false, &g, &msg)) return run.Result("perceive", msg);
     if (!run.Grasp(g, &msg)) continue;
     stage = "open";
     // the grasp, rigidly attached to the door: turn it about the hinge
@@ -313,7 +342,7 @@ SolverResult SolveOpenDoor(ArticulationTask& task, const SolverOptions& options)
   }
   task.SetTcpVelocity(Eigen::Matrix<double, 6, 1>::Zero());
   run.Wait(0.2);
-  return Finish(task, stage, msg);
+  return run.Result(stage, msg);
 }
 
 SolverResult SolveTask(ArticulationTask& task, const SolverOptions& options) {

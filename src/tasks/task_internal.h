@@ -4,6 +4,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "partsim/assets/generator.h"
@@ -81,6 +82,7 @@ struct TaskImpl {
   std::vector<int> arm_dofs, finger_dofs, finger_links;
   int ee_link = -1;
   std::vector<Camera> cameras;
+  std::optional<Camera> video_camera;  // TaskOptions::video_width
   std::vector<char> initial_state;
   int substeps = 1;
   double cabinet_half_depth = 0, cabinet_half_width = 0, cabinet_height = 0;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "partsim/assets/generator.h"
 #include "partsim/tasks/tasks.h"
 
 namespace partsim::tools {
@@ -22,13 +23,17 @@ namespace {
 
 constexpr char kTasksUsage[] = R"(usage:
   partsim tasks demo [--task drawer|door] [--object N] [--seed S] [--out DIR] [--every K]
+                     [--video FILE | --no-video] [--frames] [--size WxH]
   partsim tasks evaluate [--task drawer|door] [--count N] [--seed S] [--jobs J]
                          [--no-cameras] [--csv FILE]
                          [--dataset ROOT [--ids A,B,...] [--targets all]]
 
-demo       generates a cabinet (StorageFurniture object N, default the first with a drawer or
-           door), runs the heuristic solver with the flying gripper, writes the front camera's
-           frames to DIR (default out/demo) every K control steps (default 5) and reports success.
+demo       generates a cabinet (StorageFurniture object N of 0..344, default the first with a
+           drawer or door), runs the heuristic solver with the flying gripper and reports
+           success. A camera with a three-quarter view records the episode, on a floor with
+           shadows, every K control steps (default 2: 25 frames per second of simulated time)
+           into an H.264 video, DIR/demo.mp4 (default out/demo) or FILE, at WxH pixels (default
+           640x480). --frames also writes the frames as DIR/frame_NNNNN.png.
 evaluate   runs the heuristic solver on the first N cabinets (default 20) that have a drawer
            (door), one target each drawn by the seed, and prints the success rate beside the
            SAPIEN paper's (95.3% drawer, 81.8% door). --no-cameras perceives the handle from the
@@ -61,7 +66,12 @@ struct TasksArgs {
   int count = 20;
   unsigned long long seed = 0;
   int jobs = 1;
-  int every = 5;
+  int every = 2;
+  std::string video;  // "" = <out>/demo.mp4
+  bool no_video = false;
+  bool frames = false;
+  int width = 640;
+  int height = 480;
   bool cameras = true;
   std::string out = "out/demo";
   std::string csv;
@@ -91,6 +101,12 @@ TasksArgs Parse(int argc, char** argv) {
       a.type = ParseTaskType(v);
     } else if (f == "--object") {
       a.object = static_cast<int>(ParseCount(f, value(), 0));
+      const int objects = PaperModelCount("StorageFurniture");
+      if (a.object >= objects)
+        throw TasksUsageError("partsim tasks: --object " + std::to_string(a.object) +
+                              " is out of range: the generated dataset has " +
+                              std::to_string(objects) + " StorageFurniture objects (0 to " +
+                              std::to_string(objects - 1) + ")");
     } else if (f == "--count") {
       a.count = static_cast<int>(ParseCount(f, value(), 1));
       a.count_given = true;
@@ -119,6 +135,23 @@ TasksArgs Parse(int argc, char** argv) {
       a.jobs = static_cast<int>(ParseCount(f, value(), 1));
     } else if (f == "--every") {
       a.every = static_cast<int>(ParseCount(f, value(), 1));
+    } else if (f == "--video") {
+      a.video = value();
+      if (a.video.empty()) throw TasksUsageError("partsim tasks: --video needs a file name");
+    } else if (f == "--no-video") {
+      a.no_video = true;
+    } else if (f == "--frames") {
+      a.frames = true;
+    } else if (f == "--size") {
+      std::string v = value();
+      const size_t x = v.find('x');
+      long long w = 0, h = 0;
+      if (x == std::string::npos || !ParseInteger(v.substr(0, x), 16, &w) ||
+          !ParseInteger(v.substr(x + 1), 16, &h) || w > 4096 || h > 4096)
+        throw TasksUsageError("partsim tasks: --size expects WxH with each in 16..4096, got '" + v +
+                              "'");
+      a.width = static_cast<int>(w);
+      a.height = static_cast<int>(h);
     } else if (f == "--out") {
       a.out = value();
     } else if (f == "--csv") {
@@ -131,6 +164,10 @@ TasksArgs Parse(int argc, char** argv) {
   }
   if (a.dataset.empty() && (!a.ids.empty() || a.all_targets))
     throw TasksUsageError("partsim tasks: --ids and --targets need --dataset");
+  if (a.command != "demo" && (!a.video.empty() || a.no_video || a.frames))
+    throw TasksUsageError("partsim tasks: --video, --no-video and --frames go with demo");
+  if (!a.video.empty() && a.no_video)
+    throw TasksUsageError("partsim tasks: --video and --no-video exclude each other");
   if (!a.dataset.empty() && a.command != "evaluate")
     throw TasksUsageError("partsim tasks: --dataset goes with evaluate");
   return a;
@@ -207,28 +244,44 @@ int RunDemo(const TasksArgs& a) {
   TaskOptions o;
   o.type = a.type;
   o.object_index = a.object >= 0 ? a.object : FindTaskObjects(a.type, 1).front();
+  const bool record = a.frames || !a.no_video;
+  if (record) {
+    o.video_width = a.width;
+    o.video_height = a.height;
+  }
+  const std::string video = a.no_video ? ""
+                            : !a.video.empty()
+                                ? a.video
+                                : (std::filesystem::path(a.out) / "demo.mp4").string();
+  ArticulationTask task(o);  // checks the object before anything is written
   std::filesystem::create_directories(a.out);
+  if (!video.empty() && std::filesystem::path(video).has_parent_path())
+    std::filesystem::create_directories(std::filesystem::path(video).parent_path());
   // the frames of an earlier demo in the same folder go first: none is left beside this run's
   ClearOwnedOutputs(a.out, {{"frame_", ".png"}});
-  ArticulationTask task(o);
   task.Reset(a.seed);
   std::printf("partsim tasks demo: %s task on StorageFurniture object %d, target %s\n",
               TaskTypeName(a.type), o.object_index, task.GetTargetLink().GetName().c_str());
   SolverOptions so;
-  so.frames_dir = a.out;
+  if (a.frames) so.frames_dir = a.out;
+  so.video_path = video;
   so.frame_every = a.every;
   auto t0 = std::chrono::steady_clock::now();
   SolverResult r = SolveTask(task, so);
   double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  int frames = 0;
-  for (const auto& e : std::filesystem::directory_iterator(a.out))
-    frames += e.path().extension() == ".png";
-  std::printf(
-      "  %s: opened %.0f%% of the range in %.1f s simulated (%.1f s wall); %d frames in "
-      "%s\n",
-      r.success ? "SUCCESS" : "FAILURE", 100.0 * r.progress, r.seconds, wall, frames,
-      a.out.c_str());
+  std::printf("  %s: opened %.0f%% of the range in %.1f s simulated (%.1f s wall)\n",
+              r.success ? "SUCCESS" : "FAILURE", 100.0 * r.progress, r.seconds, wall);
   if (!r.success) std::printf("  stage %s: %s\n", r.stage.c_str(), r.message.c_str());
+  if (a.frames) {
+    int frames = 0;
+    for (const auto& e : std::filesystem::directory_iterator(a.out))
+      frames +=
+          e.path().filename().string().rfind("frame_", 0) == 0 && e.path().extension() == ".png";
+    std::printf("  frames: %d PNG in %s\n", frames, a.out.c_str());
+  }
+  if (!video.empty())
+    std::printf("  video: %s (%dx%d, %.0f fps)\n", video.c_str(), a.width & ~1, a.height & ~1,
+                o.control_rate / a.every);
   return r.success ? 0 : 1;
 }
 

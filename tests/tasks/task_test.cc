@@ -60,6 +60,74 @@ TEST(TaskTest, RejectsObjectsWithoutTargetsAndBadOptions) {
   o.control_rate = 1000.0;  // above the physics rate
   EXPECT_THROW(ArticulationTask{o}, Error);
   EXPECT_THROW(ParseTaskType("window"), Error);
+  // the generated dataset has 345 StorageFurniture objects
+  for (int index : {-1, 345, 9999}) {
+    o = Options(TaskType::kPullDrawer);
+    o.object_index = index;
+    try {
+      ArticulationTask task(o);
+      FAIL() << "object_index " << index << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("out of range"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("345"), std::string::npos) << e.what();
+    }
+  }
+  o = Options(TaskType::kPullDrawer);
+  o.video_width = 64;  // without a height
+  EXPECT_THROW(ArticulationTask{o}, Error);
+  EXPECT_THROW(ArticulationTask(Options(TaskType::kPullDrawer)).GetVideoCamera(), Error);
+}
+
+// The video camera records the episode (PNG frames and an MP4) and changes nothing of it: its
+// floor has no collision shape and the perception cameras find the same handle.
+TEST(TaskTest, RecordsTheEpisodeWithoutChangingIt) {
+  ArticulationTask plain(Options(TaskType::kPullDrawer, true));
+  plain.Reset(3);
+  SolverResult a = SolvePullDrawer(plain);
+
+  TaskOptions o = Options(TaskType::kPullDrawer, true);
+  o.video_width = 160;
+  o.video_height = 120;
+  ArticulationTask recorded(o);
+  recorded.Reset(3);
+  Camera video = recorded.GetVideoCamera();
+  EXPECT_EQ(video.GetWidth(), 160);
+  EXPECT_EQ(recorded.GetCameras().size(), 3u);  // the perception cameras only
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / "partsim_task_video_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  SolverOptions so;
+  so.frames_dir = dir.string();
+  so.video_path = (dir / "episode.mp4").string();
+  so.frame_every = 10;
+  SolverResult b = SolvePullDrawer(recorded, so);
+  EXPECT_TRUE(b.success) << b.stage << ": " << b.message;
+  EXPECT_EQ(a.success, b.success);
+  EXPECT_DOUBLE_EQ(a.progress, b.progress);
+  EXPECT_DOUBLE_EQ(a.seconds, b.seconds);
+
+  // one frame before the first step, then one every 10 control steps
+  const long steps = std::lround(b.seconds * o.control_rate);
+  int pngs = 0;
+  for (const auto& e : fs::directory_iterator(dir)) pngs += e.path().extension() == ".png";
+  EXPECT_EQ(pngs, 1 + steps / 10);
+  std::ifstream mp4(dir / "episode.mp4", std::ios::binary);
+  ASSERT_TRUE(mp4.good());
+  char head[12] = {0};
+  mp4.read(head, 12);
+  EXPECT_EQ(std::string(head + 4, 4), "ftyp");  // an ISO media file
+  EXPECT_GT(fs::file_size(dir / "episode.mp4"), 1000u);
+  EXPECT_FALSE(fs::exists(dir / "episode.mp4.partial"));
+
+  // the camera sees the cabinet in the middle of the picture and the floor below it
+  video.TakePicture();
+  const Picture& p = video.GetPictureData();
+  auto entity = [&](int x, int y) { return p.segmentation[2 * (y * p.width + x) + 1]; };
+  EXPECT_NE(entity(80, 60), 0u);
+  EXPECT_NE(entity(80, 115), 0u);
+  EXPECT_NE(entity(80, 60), entity(80, 115));
+  fs::remove_all(dir);
 }
 
 TEST(TaskTest, ResetIsDeterministicAndClosed) {

@@ -48,6 +48,12 @@ struct TaskOptions {
   double max_seconds = 20.0;      ///< episode length before truncation (s)
   double success_fraction = 0.9;  ///< of the joint's range, for success
   bool init_on_handle = false;    ///< Reset() places the gripper, closed, on the handle
+  /// Both > 0: the scene also gets a camera "video" of this size (pixels) with a three-quarter
+  /// view of the cabinet, a floor that only cameras see (no contact: the dynamics are those of
+  /// a task without it) and shadows from the key light. For recording (GetVideoCamera); the
+  /// solvers do not perceive through it.
+  int video_width = 0;
+  int video_height = 0;
 };
 
 /// Candidate objects: the first `count` StorageFurniture indices (from 0) whose object has at
@@ -130,6 +136,9 @@ class ArticulationTask {
   void TakePictures();
   std::vector<Camera> GetCameras() const;
   Camera GetCamera(const std::string& name) const;
+  /// The "video" camera of TaskOptions::video_width; throws partsim::Error when the task has
+  /// none.
+  Camera GetVideoCamera() const;
   /// raw: qpos and qvel of the cabinet, then the TCP pose (p, wxyz), TCP twist and gripper
   /// opening.
   Eigen::VectorXd GetRawObservation() const;
@@ -163,7 +172,12 @@ struct SolverResult {
 struct SolverOptions {
   bool use_cameras = true;  ///< perceive the handle from the segmented point clouds (else the
                             ///< handle's mesh from the scene: ground-truth geometry)
-  std::string frames_dir;   ///< write the front camera's colour every `frame_every` steps
+  /// Write the recording camera's colour as frame_NNNNN.png every `frame_every` control steps:
+  /// the task's "video" camera when it has one (TaskOptions::video_width), else "front".
+  std::string frames_dir;
+  /// Write the same frames as an H.264 MP4 (VideoWriter) at control_rate / frame_every frames
+  /// per second, i.e. in real time; "" for none.
+  std::string video_path;
   int frame_every = 10;
 };
 
