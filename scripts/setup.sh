@@ -53,3 +53,10 @@ if [ ! -f build/CMakeCache.txt ] || [ ! -f build/Makefile ]; then
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3
 fi
 cmake --build build -j"${PARTSIM_JOBS:-2}"
+
+# the Debian package (build/partsim_<version>_<arch>.deb), again only when something in it changed
+deb=$(ls build/partsim_*.deb 2>/dev/null | head -n 1 || true)
+if [ -z "$deb" ] || [ -n "$(find build/partsim build/libpartsim.so* build/python/partsim include \
+    -newer "$deb" -print -quit 2>/dev/null)" ]; then
+  (cd build && cpack -G DEB >/dev/null) && echo "partsim setup: built $(ls build/partsim_*.deb)"
+fi

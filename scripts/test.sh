@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Installs, builds from scratch and runs the whole test suite: GoogleTest through CTest, pytest,
-# the source format check, and the URDF fuzzer under AddressSanitizer.
+# Installs, builds (from scratch on a clean checkout, else what changed) and runs the whole test
+# suite: GoogleTest through CTest, pytest, the source format check, the installed partsim (a
+# temporary prefix and the Debian package, each used from outside the tree) and the URDF fuzzer
+# under AddressSanitizer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -22,6 +24,23 @@ ctest --test-dir build --output-on-failure -j2
 
 echo "== Python tests (pytest)"
 PARTSIM_PYTHON_DIR="$PWD/build/python" /usr/bin/python3 -m pytest tests/python -q
+
+echo "== install: cmake --install into a temporary prefix, then the Debian package; each checked from outside the tree"
+prefix="$(mktemp -d)"
+cmake --install build --prefix "$prefix" >/dev/null
+bash scripts/install_smoke.sh "$prefix"
+rm -rf "$prefix"
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+if dpkg-query -W -f='${Status}' partsim 2>/dev/null | grep -q "install ok installed"; then
+  echo "partsim is installed from a package already: not replacing it; the .deb is not checked"
+else
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q ./build/partsim_*.deb
+  status=0
+  bash scripts/install_smoke.sh /usr || status=$?
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get remove -y -q partsim
+  [ "$status" -eq 0 ]
+fi
 
 echo "== URDF fuzzer (libFuzzer + AddressSanitizer)"
 bash scripts/run_fuzz.sh

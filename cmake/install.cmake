@@ -1,0 +1,78 @@
+# Installation and the Debian package.
+#
+# `cmake --install build --prefix PREFIX` installs:
+#   PREFIX/bin/partsim                            the command line
+#   PREFIX/lib/<multiarch>/libpartsim.so          the C++ library (everything of partsim_core)
+#   PREFIX/include/partsim/                       its headers (they need Eigen only)
+#   PREFIX/lib/<multiarch>/cmake/partsim/         find_package(partsim) -> partsim::partsim
+#   PREFIX/lib/python3/dist-packages/partsim/     the Python package (Debian's path for /usr)
+# `cpack -G DEB` in build/ makes partsim_<version>_<arch>.deb of the same files under /usr; its
+# dependencies are computed from the libraries the binaries link (dpkg-shlibdeps).
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+# libpartsim.so: the static core whole, for C++ programs that link partsim
+file(WRITE ${CMAKE_BINARY_DIR}/partsim_shared.cc
+     "// libpartsim.so holds the objects of partsim_core; this file only gives it a source.\n")
+add_library(partsim SHARED ${CMAKE_BINARY_DIR}/partsim_shared.cc)
+add_library(partsim::partsim ALIAS partsim)
+target_link_libraries(partsim PRIVATE "$<LINK_LIBRARY:WHOLE_ARCHIVE,partsim_core>")
+target_link_libraries(partsim PUBLIC Eigen3::Eigen Threads::Threads)
+target_include_directories(partsim PUBLIC $<BUILD_INTERFACE:${CMAKE_SOURCE_DIR}/include>
+                                          $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+set_target_properties(partsim PROPERTIES VERSION ${PROJECT_VERSION}
+                                         SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
+
+set(PARTSIM_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/partsim)
+set(PARTSIM_PYTHON_INSTALL_DIR lib/python3/dist-packages CACHE STRING
+    "Where the Python package goes, relative to the prefix (Debian's path under /usr)")
+
+install(TARGETS partsim EXPORT partsimTargets
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT partsim)
+install(DIRECTORY ${CMAKE_SOURCE_DIR}/include/partsim DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+        COMPONENT partsim)
+install(EXPORT partsimTargets NAMESPACE partsim:: DESTINATION ${PARTSIM_CMAKE_DIR}
+        COMPONENT partsim)
+configure_package_config_file(${CMAKE_SOURCE_DIR}/cmake/partsimConfig.cmake.in
+                              ${CMAKE_BINARY_DIR}/partsimConfig.cmake
+                              INSTALL_DESTINATION ${PARTSIM_CMAKE_DIR})
+write_basic_package_version_file(${CMAKE_BINARY_DIR}/partsimConfigVersion.cmake
+                                 COMPATIBILITY SameMinorVersion)
+install(FILES ${CMAKE_BINARY_DIR}/partsimConfig.cmake ${CMAKE_BINARY_DIR}/partsimConfigVersion.cmake
+        DESTINATION ${PARTSIM_CMAKE_DIR} COMPONENT partsim)
+
+if(TARGET partsim_cli)
+  install(TARGETS partsim_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT partsim)
+endif()
+if(TARGET partsim_py)
+  install(TARGETS partsim_py LIBRARY DESTINATION ${PARTSIM_PYTHON_INSTALL_DIR}/partsim
+          COMPONENT partsim)
+  install(DIRECTORY ${CMAKE_SOURCE_DIR}/python/partsim/
+          DESTINATION ${PARTSIM_PYTHON_INSTALL_DIR}/partsim COMPONENT partsim
+          PATTERN "__pycache__" EXCLUDE)
+endif()
+
+# the Debian package
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME partsim)
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGE_CONTACT "partsim developers <partsim@localhost>")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY
+    "simulation of robots that open doors, pull drawers and turn knobs, part by part")
+set(CPACK_PACKAGE_DESCRIPTION
+    "partsim simulates articulated objects and the robots that manipulate them (physics on \
+MuJoCo, rendering by rasterizer and path tracer, URDF and PartNet-Mobility assets, door and \
+drawer tasks), with a command line, a C++ library and a Python package.")
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SECTION science)
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+# what the libraries do not say: the Python package's interpreter and modules, the headers' one
+# dependency, and Mesa's EGL and CPU rasterizer behind libEGL (the renderer without a GPU)
+set(CPACK_DEBIAN_PACKAGE_DEPENDS
+    "python3 (>= 3.11), python3-numpy, libeigen3-dev, libegl-mesa0, libgl1-mesa-dri")
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "python3-pil")
+set(CPACK_PACKAGE_DIRECTORY ${CMAKE_BINARY_DIR})
+set(CPACK_OUTPUT_FILE_PREFIX ${CMAKE_BINARY_DIR})
+set(CPACK_STRIP_FILES ON)
+include(CPack)

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# Checks an installed partsim from outside the source tree, as a user meets it:
+#   bash scripts/install_smoke.sh PREFIX   after `cmake --install build --prefix PREFIX`
+#   bash scripts/install_smoke.sh /usr     after `apt install ./build/partsim_*.deb`
+# The command line from PATH, `import partsim` from any folder (and from PREFIX, not the build),
+# a C++ program built against find_package(partsim), and the demo's video.
+set -euo pipefail
+src="$(cd "$(dirname "$0")/.." && pwd)"
+prefix="$(cd "$1" && pwd)"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+export PATH="$prefix/bin:$PATH"
+if [ "$prefix" != "/usr" ]; then
+  export PYTHONPATH="$prefix/lib/python3/dist-packages"
+  export LD_LIBRARY_PATH="$prefix/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+fi
+
+echo "-- partsim on PATH: $(command -v partsim)"
+[ "$(command -v partsim)" = "$prefix/bin/partsim" ] || { echo "partsim is not $prefix/bin/partsim"; exit 1; }
+partsim --version
+
+echo "-- import partsim from $work"
+/usr/bin/python3 - "$prefix" <<'PY'
+import os, sys
+import partsim
+prefix = sys.argv[1]
+assert os.path.realpath(partsim.__file__).startswith(os.path.realpath(prefix) + "/"), partsim.__file__
+scene = partsim.Scene(timestep=1 / 500)
+scene.add_ground(0.0)
+b = scene.create_actor_builder()
+b.add_box_collision(half_size=[0.1, 0.1, 0.1])
+box = b.build(name="box")
+box.set_pose(partsim.Pose([0, 0, 0.5]))
+scene.step(1000)
+z = box.get_pose().p[2]
+assert abs(z - 0.1) < 0.01, z
+print("import partsim:", partsim.__file__, "- box at rest at z = %.3f m" % z)
+PY
+
+echo "-- a C++ program with find_package(partsim)"
+cmake -S "$src/examples/cpp/hello_partsim" -B "$work/hello" -DCMAKE_PREFIX_PATH="$prefix" \
+  -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$work/hello" >/dev/null
+"$work/hello/hello"
+
+echo "-- partsim tasks demo from $work"
+partsim tasks demo --size 320x240 --every 5 --out "$work/demo"
+[ -s "$work/demo/demo.mp4" ] || { echo "no video at $work/demo/demo.mp4"; exit 1; }
+echo "install smoke test: all passed ($prefix)"
