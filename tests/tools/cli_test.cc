@@ -550,12 +550,13 @@ TEST_F(CliTest, AssetsDecomposeWritesConvexPieces) {
 
 TEST_F(CliTest, TasksDemoOpensADrawerAndWritesFrames) {
   fs::path out = dir_ / "demo";
-  RunResult r = RunCli("tasks demo --task drawer --every 20 --out '" + out.string() + "'");
+  RunResult r = RunCli("tasks demo --task drawer --every 20 --frames --out '" + out.string() + "'");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(Contains(r.output, "SUCCESS")) << r.output;
   int frames = 0;
   for (const auto& e : fs::directory_iterator(out)) frames += e.path().extension() == ".png";
   EXPECT_GT(frames, 3) << r.output;
+  EXPECT_GT(fs::file_size(out / "demo.mp4"), 0u) << r.output;
 }
 
 TEST_F(CliTest, TasksRejectsBadArguments) {
