@@ -467,6 +467,9 @@ class ArticulationTask:
     def get_tcp_velocity(self) -> numpy.ndarray:
         """TCP twist (6,) in the world frame: linear (m/s) then angular (rad/s)."""
         ...
+    def get_video_camera(self) -> Camera:
+        """The 'video' camera of TaskOptions.video_width / video_height; raises PartsimError when the task has none."""
+        ...
     def gripper_touches_target(self) -> bool:
         """True when a finger touches the target link (handle or panel)."""
         ...
@@ -633,6 +636,9 @@ class Camera:
     @property
     def height(self) -> int:
         """Image height in pixels."""
+        ...
+    def look_at(self, eye: numpy.ndarray, target: numpy.ndarray, up: numpy.ndarray = ...) -> None:
+        """Places the camera at `eye` (3,) looking at `target` (3,), in metres, with its z (up in the picture) as close to `up` (3,) as possible: world frame for a free camera, the mount's frame for a mounted one (set_local_pose(Pose.look_at(eye, target, up))). Raises PartsimError naming the camera when eye and target coincide, up is zero or a value is not finite."""
         ...
     @property
     def name(self) -> str:
@@ -2422,6 +2428,10 @@ class Pose:
     def is_valid(self) -> bool:
         """True when p and q are finite and q has unit norm (within 1e-3)."""
         ...
+    @staticmethod
+    def look_at(eye: numpy.ndarray, target: numpy.ndarray, up: numpy.ndarray = ...) -> Pose:
+        """The pose at `eye` (3,) whose x axis points at `target` (3,) and whose z is as close to `up` (3,) as possible, all in metres in one frame: a camera pose in partsim's (and SAPIEN's) camera convention, x forward, y left, z up. Raises PartsimError when eye and target coincide, up is zero or a value is not finite."""
+        ...
     @property
     def p(self) -> numpy.ndarray:
         """Position (3,), metres."""
@@ -2959,6 +2969,12 @@ class SolverOptions:
         ...
     @use_cameras.setter
     def use_cameras(self, value: bool) -> None: ...
+    @property
+    def video_path(self) -> str:
+        """An H.264 MP4 of the same frames as frames_dir, at control_rate / frame_every frames per second (real time); '' (default) writes none."""
+        ...
+    @video_path.setter
+    def video_path(self, value: str) -> None: ...
 
 
 class SolverResult:
@@ -3081,6 +3097,18 @@ class TaskOptions:
         ...
     @type.setter
     def type(self, value: TaskType) -> None: ...
+    @property
+    def video_height(self) -> int:
+        """Height in pixels of the 'video' camera (see video_width); 0 for none."""
+        ...
+    @video_height.setter
+    def video_height(self, value: int) -> None: ...
+    @property
+    def video_width(self) -> int:
+        """With video_height, both > 0: a 'video' camera of this many pixels across with a three-quarter view, a floor only cameras see and shadows, for recording (get_video_camera, SolverOptions.video_path); 0 (default) for none. The episode's dynamics do not change."""
+        ...
+    @video_width.setter
+    def video_width(self, value: int) -> None: ...
 
 
 class TaskType:
@@ -3205,6 +3233,40 @@ class UrdfLoader:
         ...
     @strict.setter
     def strict(self, value: bool) -> None: ...
+
+
+class VideoWriter:
+    """An MP4 video (H.264, yuv420p) written frame by frame; it goes to PATH.partial and is renamed to PATH by close(), so PATH is whole or absent. Also a context manager that closes on exit. An odd width or height loses its last column or row."""
+    def __enter__(self) -> VideoWriter:
+        """Returns the writer itself."""
+        ...
+    def __exit__(self, *args) -> None:
+        """Closes the video (also when the block raised)."""
+        ...
+    def __init__(self, path: str, width: int, height: int, fps: float = ..., quality: int = ..., background: numpy.ndarray = ...) -> None:
+        """Opens PATH for frames of width x height pixels at `fps` frames per second; `quality` is H.264's constant rate factor (0 lossless .. 51 worst, default 20); `background` (3,) linear RGB under transparent pixels. Raises PartsimError naming the path on bad arguments or when the file cannot be written."""
+        ...
+    def add_frame(self, frame: numpy.ndarray) -> None:
+        """Appends a frame: uint8 (h, w, 3) RGB or (h, w, 4) RGBA, sRGB-encoded as Camera.get_color_rgba8() returns it, of the video's size."""
+        ...
+    def add_picture(self, camera: Camera) -> None:
+        """Appends the Color of the camera's last picture (its size must be the video's)."""
+        ...
+    def close(self) -> None:
+        """Finishes the file and renames it into place; further frames raise, a second close does nothing."""
+        ...
+    @property
+    def codec(self) -> str:
+        """The encoder: 'libx264', or 'mpeg4' where H.264 is missing."""
+        ...
+    @property
+    def frame_count(self) -> int:
+        """Frames added so far."""
+        ...
+    @property
+    def path(self) -> str:
+        """The video's final path."""
+        ...
 
 
 class VisualShape:

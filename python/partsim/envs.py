@@ -20,6 +20,7 @@ from __future__ import annotations
 import concurrent.futures
 import numbers
 import os
+import warnings
 from typing import Any
 
 import numpy as np
@@ -380,6 +381,7 @@ class OpenCabinetEnv(_ClosedByContext):
         """The front camera's colour as (h, w, 3) uint8 (render_mode 'rgb_array')."""
         self._check_open()
         if self.render_mode != "rgb_array":
+            _warn_no_render_mode(type(self).__name__)
             return None
         if self._task is None:
             raise RuntimeError("render called before reset")
@@ -471,6 +473,16 @@ def _stack(items):
     return np.stack(items)
 
 
+def _warn_no_render_mode(cls_name):
+    warnings.warn(
+        f"{cls_name}.render() returns None: the environment was made without a render mode; "
+        f"make it with render_mode=\"rgb_array\" to get frames, e.g. "
+        f"{cls_name}(..., render_mode=\"rgb_array\")",
+        UserWarning,
+        stacklevel=3,
+    )
+
+
 class VectorOpenCabinetEnv(_ClosedByContext):
     """``num_envs`` copies of :class:`OpenCabinetEnv` stepped together on ``workers`` threads
     (default: one per copy; the simulation releases the GIL, so the copies run in parallel on
@@ -494,6 +506,7 @@ class VectorOpenCabinetEnv(_ClosedByContext):
         self.envs = [OpenCabinetEnv(**kwargs) for _ in range(self.num_envs)]
         self.single_action_space = self.envs[0].action_space
         self.single_observation_space = self.envs[0].observation_space
+        self.render_mode = self.envs[0].render_mode
         self.action_space = _batch_space(self.single_action_space, self.num_envs)
         self.observation_space = _batch_space(self.single_observation_space, self.num_envs)
         workers = min(int(workers or self.num_envs), self.num_envs)
@@ -564,6 +577,18 @@ class VectorOpenCabinetEnv(_ClosedByContext):
             truncated,
             self._infos([r[4] for r in results]),
         )
+
+    def render(self):
+        """The front camera's colour of every sub-environment, as a tuple of ``num_envs``
+        (h, w, 3) uint8 arrays (render_mode ``"rgb_array"``, given to the constructor with the
+        other keyword arguments); each is rendered on its sub-environment's own thread. Without
+        a render mode it warns and returns None, as a single environment does. Raises
+        ``RuntimeError`` before ``reset``."""
+        self._check_open()
+        if self.render_mode != "rgb_array":
+            _warn_no_render_mode(type(self).__name__)
+            return None
+        return tuple(self._map(lambda i: self.envs[i].render()))
 
     def close(self):
         """Closes every sub-environment on its own thread and stops the threads; closing twice

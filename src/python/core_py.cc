@@ -6,6 +6,7 @@
 #include "partsim/core/error.h"
 #include "partsim/core/log.h"
 #include "partsim/core/pose.h"
+#include "partsim/render/camera_math.h"
 
 namespace partsim::python {
 
@@ -45,6 +46,13 @@ void BindCore(py::module_& m) {
       .def("inv", &Pose::Inverse, "Inverse: X_BA from X_AB.")
       .def("transform", &Pose::Transform, py::arg("x"), "Maps a point (3,) expressed in B to A.")
       .def("to_transformation_matrix", &Pose::ToMatrix, "4x4 homogeneous matrix.")
+      .def_static("look_at", &CameraLookAt, py::arg("eye"), py::arg("target"),
+                  py::arg("up") = Eigen::Vector3d::UnitZ().eval(),
+                  "The pose at `eye` (3,) whose x axis points at `target` (3,) and whose z is "
+                  "as close to `up` (3,) as possible, all in metres in one frame: a camera pose "
+                  "in partsim's (and SAPIEN's) camera convention, x forward, y left, z up. "
+                  "Raises PartsimError when eye and target coincide, up is zero or a value is "
+                  "not finite.")
       .def("is_valid", &Pose::IsValid,
            "True when p and q are finite and q has unit norm (within 1e-3).")
       .def("__repr__", &Pose::ToString)

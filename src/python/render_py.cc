@@ -17,10 +17,12 @@
 #include <vector>
 
 #include "bindings.h"
+#include "partsim/core/error.h"
 #include "partsim/physics/scene.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/video.h"
 
 namespace partsim::python {
 namespace {
@@ -205,6 +207,13 @@ void BindCamera(py::module_& m) {
           "world pose; False keeps its local pose, now in the new parent's frame.")
       .def("set_local_pose", &Camera::SetLocalPose, py::arg("pose"),
            "World pose of a free camera, or pose in the mount's frame of a mounted one.")
+      .def("look_at", &Camera::LookAt, py::arg("eye"), py::arg("target"),
+           py::arg("up") = Eigen::Vector3d::UnitZ().eval(),
+           "Places the camera at `eye` (3,) looking at `target` (3,), in metres, with its z (up "
+           "in the picture) as close to `up` (3,) as possible: world frame for a free camera, "
+           "the mount's frame for a mounted one (set_local_pose(Pose.look_at(eye, target, "
+           "up))). Raises PartsimError naming the camera when eye and target coincide, up is "
+           "zero or a value is not finite.")
       .def(
           "take_picture",
           [](Camera& self, const std::optional<std::vector<std::string>>& outputs) {
@@ -385,6 +394,60 @@ void BindImageIo(py::module_& m) {
       py::arg("path"), py::arg("array"), "NumPy .npy of a float32 or uint32 array.");
 }
 
+void BindVideo(py::module_& m) {
+  py::class_<VideoWriter>(
+      m, "VideoWriter",
+      "An MP4 video (H.264, yuv420p) written frame by frame; it goes to PATH.partial and is "
+      "renamed to PATH by close(), so PATH is whole or absent. Also a context manager that "
+      "closes on exit. An odd width or height loses its last column or row.")
+      .def(py::init([](const std::string& path, int width, int height, double fps, int quality,
+                       const Eigen::Vector3f& background) {
+             VideoOptions o;
+             o.fps = fps;
+             o.quality = quality;
+             o.background = background;
+             return std::make_unique<VideoWriter>(path, width, height, o);
+           }),
+           py::arg("path"), py::arg("width"), py::arg("height"), py::arg("fps") = 25.0,
+           py::arg("quality") = 20, py::arg("background") = Eigen::Vector3f(0.80f, 0.84f, 0.90f),
+           "Opens PATH for frames of width x height pixels at `fps` frames per second; "
+           "`quality` is H.264's constant rate factor (0 lossless .. 51 worst, default 20); "
+           "`background` (3,) linear RGB under transparent pixels. Raises PartsimError naming "
+           "the path on bad arguments or when the file cannot be written.")
+      .def(
+          "add_frame",
+          [](VideoWriter& self, const CArray<uint8_t>& frame) {
+            if (frame.ndim() != 3 || (frame.shape(2) != 3 && frame.shape(2) != 4))
+              throw Error("video '" + self.Path() +
+                          "': add_frame expects a uint8 array of shape (h, w, 3) or (h, w, 4)");
+            self.CheckFrameSize(static_cast<int>(frame.shape(1)), static_cast<int>(frame.shape(0)));
+            const int channels = static_cast<int>(frame.shape(2));
+            py::gil_scoped_release release;
+            self.AddFrame(frame.data(), channels);
+          },
+          py::arg("frame"),
+          "Appends a frame: uint8 (h, w, 3) RGB or (h, w, 4) RGBA, sRGB-encoded as "
+          "Camera.get_color_rgba8() returns it, of the video's size.")
+      .def(
+          "add_picture",
+          [](VideoWriter& self, const Camera& camera) { self.AddFrame(camera.GetPictureData()); },
+          py::arg("camera"),
+          "Appends the Color of the camera's last picture (its size must be the video's).")
+      .def("close", &VideoWriter::Close, py::call_guard<py::gil_scoped_release>(),
+           "Finishes the file and renames it into place; further frames raise, a second close "
+           "does nothing.")
+      .def_property_readonly("frame_count", &VideoWriter::FrameCount, "Frames added so far.")
+      .def_property_readonly("codec", &VideoWriter::Codec,
+                             "The encoder: 'libx264', or 'mpeg4' where H.264 is missing.")
+      .def_property_readonly("path", &VideoWriter::Path, "The video's final path.")
+      .def(
+          "__enter__", [](VideoWriter& self) -> VideoWriter& { return self; },
+          py::return_value_policy::reference, "Returns the writer itself.")
+      .def(
+          "__exit__", [](VideoWriter& self, py::args) { self.Close(); },
+          "Closes the video (also when the block raised).");
+}
+
 }  // namespace
 
 void BindRender(py::module_& m) {
@@ -392,6 +455,7 @@ void BindRender(py::module_& m) {
   BindCamera(m);
   BindSceneRender(m);
   BindImageIo(m);
+  BindVideo(m);
 }
 
 }  // namespace partsim::python

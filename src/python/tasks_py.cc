@@ -54,7 +54,14 @@ void BindTasks(py::module_& m) {
                      "Fraction of the target joint's range that counts as success (default "
                      "0.9).")
       .def_readwrite("init_on_handle", &TaskOptions::init_on_handle,
-                     "reset() places the gripper, closed, on the handle (default False).");
+                     "reset() places the gripper, closed, on the handle (default False).")
+      .def_readwrite("video_width", &TaskOptions::video_width,
+                     "With video_height, both > 0: a 'video' camera of this many pixels across "
+                     "with a three-quarter view, a floor only cameras see and shadows, for "
+                     "recording (get_video_camera, SolverOptions.video_path); 0 (default) for "
+                     "none. The episode's dynamics do not change.")
+      .def_readwrite("video_height", &TaskOptions::video_height,
+                     "Height in pixels of the 'video' camera (see video_width); 0 for none.");
 
   m.def("find_task_objects", &FindTaskObjects, py::arg("type"), py::arg("count"),
         py::arg("dataset_seed") = 0,
@@ -145,6 +152,9 @@ void BindTasks(py::module_& m) {
           "Renders the cameras (left, right, front) at the current state; the GIL is released.")
       .def("get_cameras", &ArticulationTask::GetCameras, ka,
            "The task's cameras (left, right, front; empty without options.cameras).")
+      .def("get_video_camera", &ArticulationTask::GetVideoCamera, ka,
+           "The 'video' camera of TaskOptions.video_width / video_height; raises PartsimError "
+           "when the task has none.")
       .def("get_camera", &ArticulationTask::GetCamera, py::arg("name"), ka,
            "The camera named `name` ('left', 'right' or 'front'); raises PartsimError when the "
            "task has none of that name.")
@@ -180,6 +190,9 @@ void BindTasks(py::module_& m) {
       .def_readwrite("frames_dir", &SolverOptions::frames_dir,
                      "Folder for frame_NNNNN.png colour frames of the recording camera ('video' "
                      "if the task has one, else 'front'); '' (default) writes none.")
+      .def_readwrite("video_path", &SolverOptions::video_path,
+                     "An H.264 MP4 of the same frames as frames_dir, at control_rate / "
+                     "frame_every frames per second (real time); '' (default) writes none.")
       .def_readwrite("frame_every", &SolverOptions::frame_every,
                      "Control steps between two written frames (default 10).");
   auto solver = [&m](const char* name, SolverResult (*f)(ArticulationTask&, const SolverOptions&),

@@ -165,6 +165,17 @@ Eigen::Matrix4d Camera::GetProjectionMatrix() const {
 
 Pose Camera::GetPose() const { return Entry(scene_, id_).X_WC; }
 
+void Camera::LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                    const Eigen::Vector3d& up) {
+  Pose pose;
+  try {
+    pose = CameraLookAt(eye, target, up);
+  } catch (const Error& e) {
+    throw Error("camera '" + GetName() + "': " + e.what());
+  }
+  SetLocalPose(pose);
+}
+
 void Camera::SetLocalPose(const Pose& pose) {
   SceneImpl::CameraEntry& c = Entry(scene_, id_);
   if (!pose.IsValid())

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "partsim/core/error.h"
+
 namespace partsim {
 
 Eigen::Matrix3d RotationCameraToGl() {
@@ -64,10 +66,27 @@ CameraParams MakeCameraParams(int width, int height, const Eigen::Matrix3d& K, d
   return c;
 }
 
-Pose CameraLookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-  Eigen::Vector3d x = (target - eye).normalized();
-  Eigen::Vector3d y = Eigen::Vector3d::UnitZ().cross(x);
-  if (y.norm() < 1e-9) y = Eigen::Vector3d::UnitY();
+Pose CameraLookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                  const Eigen::Vector3d& up) {
+  if (!eye.allFinite() || !target.allFinite() || !up.allFinite())
+    throw Error("look_at: eye, target and up must be finite");
+  const Eigen::Vector3d forward = target - eye;
+  if (!(forward.norm() > 1e-9))
+    throw Error("look_at: eye and target are the same point; the view direction is undefined");
+  if (!(up.norm() > 1e-9)) throw Error("look_at: up must not be the zero vector");
+  const Eigen::Vector3d x = forward.normalized();
+  Eigen::Vector3d y = up.normalized().cross(x);
+  if (y.norm() < 1e-9) {
+    // looking along up: y is the first of the world's y, x, z not close to the view, made
+    // orthogonal to it (looking straight down with z up: y is the world's y)
+    for (int k : {1, 0, 2}) {
+      const Eigen::Vector3d c = Eigen::Vector3d::Unit(k);
+      if (std::abs(c.dot(x)) < 0.9) {
+        y = c - c.dot(x) * x;
+        break;
+      }
+    }
+  }
   y.normalize();
   Eigen::Matrix3d R;
   R << x, y, x.cross(y);

@@ -205,13 +205,18 @@ void VideoWriter::AddFrame(const uint8_t* pixels, int channels) {
   ++s.frames;
 }
 
+void VideoWriter::CheckFrameSize(int width, int height) const {
+  const Impl& s = *impl_;
+  if (width != s.width || height != s.height)
+    s.Fail("frame is " + std::to_string(width) + " x " + std::to_string(height) + ", the video " +
+           std::to_string(s.width) + " x " + std::to_string(s.height));
+}
+
 void VideoWriter::AddFrame(const Picture& picture) {
   Impl& s = *impl_;
   if (!(picture.outputs & kColor) || picture.color.empty())
     s.Fail("the picture has no Color output");
-  if (picture.width != s.width || picture.height != s.height)
-    s.Fail("picture is " + std::to_string(picture.width) + " x " + std::to_string(picture.height) +
-           ", the video " + std::to_string(s.width) + " x " + std::to_string(s.height));
+  CheckFrameSize(picture.width, picture.height);
   std::vector<uint8_t> rgba = ToRgba8(picture.color);
   AddFrame(rgba.data(), 4);
 }

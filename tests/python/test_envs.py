@@ -246,7 +246,9 @@ def test_render():
 
 def test_render_mode_none_and_bad_arguments(env):
     env.reset(seed=SEED)
-    assert env.render_mode is None and env.render() is None
+    # None, with a warning that says how to get frames
+    with pytest.warns(UserWarning, match='render_mode="rgb_array"'):
+        assert env.render_mode is None and env.render() is None
     with pytest.raises(ValueError):
         make(render_mode="human")
     with pytest.raises(ValueError):
@@ -526,3 +528,27 @@ def test_env_on_a_partnet_mobility_folder(tmp_path):
         by_index.close()
     with pytest.raises(ValueError, match="not a PartNet-Mobility folder"):
         make(objects=[str(tmp_path / "nothing")])
+
+
+def test_vector_env_render():
+    n = 2
+    vec = envs.VectorOpenCabinetEnv(
+        n, render_mode="rgb_array", camera_size=SMALL, init_on_handle=False, workers=2
+    )
+    assert vec.render_mode == "rgb_array"
+    with pytest.raises(RuntimeError):
+        vec.render()  # before reset
+    vec.reset(seed=SEED)
+    frames = vec.render()
+    w, h = SMALL
+    assert isinstance(frames, tuple) and len(frames) == n
+    for i, f in enumerate(frames):
+        assert f.shape == (h, w, 3) and f.dtype == np.uint8 and f.max() > 0
+        # the frame of sub-environment i is what that environment renders itself
+        assert np.array_equal(f, vec.envs[i].render())
+    vec.close()
+    plain = envs.VectorOpenCabinetEnv(1, init_on_handle=False)
+    plain.reset(seed=SEED)
+    with pytest.warns(UserWarning, match="VectorOpenCabinetEnv"):
+        assert plain.render() is None
+    plain.close()

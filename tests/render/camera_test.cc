@@ -346,3 +346,63 @@ TEST_F(CameraTest, CloneKeepsCameras) {
 
 }  // namespace
 }  // namespace partsim
+
+namespace partsim {
+namespace {
+
+// LookAt: the view axis goes through the target, z follows `up`, and a mounted camera takes
+// eye and target in its mount's frame.
+TEST_F(CameraTest, LookAtPointsTheCameraAtTheTarget) {
+  Camera cam = scene_.AddCamera("c", 64, 48, 1.0, 0.01, 10.0);
+  const Eigen::Vector3d eye(1.0, -2.0, 1.5), target(0.2, 0.3, 0.4);
+  cam.LookAt(eye, target);
+  Pose X = cam.GetPose();
+  EXPECT_LT((X.p - eye).norm(), 1e-12);
+  const Eigen::Matrix3d R = X.q.toRotationMatrix();
+  EXPECT_LT((R.col(0) - (target - eye).normalized()).norm(), 1e-12);
+  EXPECT_NEAR(R.col(1).z(), 0.0, 1e-12);  // no roll: y horizontal
+  EXPECT_GT(R.col(2).z(), 0.0);           // z up
+  ExpectPoseNear(X, LookAt(eye, target));
+  // the target projects onto the principal point
+  Eigen::Vector3d t_C = X.q.inverse() * (target - X.p);
+  EXPECT_NEAR(t_C.y(), 0.0, 1e-12);
+  EXPECT_NEAR(t_C.z(), 0.0, 1e-12);
+
+  // another up: z as close to world x as possible
+  cam.LookAt(Eigen::Vector3d(0, 0, 3), Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX());
+  Eigen::Matrix3d Rx = cam.GetPose().q.toRotationMatrix();
+  EXPECT_LT((Rx.col(0) - Eigen::Vector3d(0, 0, -1)).norm(), 1e-12);
+  EXPECT_LT((Rx.col(2) - Eigen::Vector3d::UnitX()).norm(), 1e-12);
+  // straight down with z up: y is the world's y (as before up was an argument)
+  cam.LookAt(Eigen::Vector3d(0, 0, 3), Eigen::Vector3d::Zero());
+  Eigen::Matrix3d Rd = cam.GetPose().q.toRotationMatrix();
+  EXPECT_LT((Rd.col(1) - Eigen::Vector3d::UnitY()).norm(), 1e-12);
+  EXPECT_NEAR(Rd.determinant(), 1.0, 1e-12);
+
+  // mounted: in the mount's frame
+  Actor crate = AddCrate(scene_, Eigen::Vector3d(3, 0, 1));
+  Camera wrist = scene_.AddMountedCamera("m", crate, Pose(), 16, 16, 1.0, 0.01, 5.0);
+  wrist.LookAt(Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d::Zero());
+  ExpectPoseNear(wrist.GetLocalPose(), LookAt(Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d::Zero()));
+  ExpectPoseNear(wrist.GetPose(), crate.GetPose() * wrist.GetLocalPose());
+
+  // bad input names the camera and what is wrong, and leaves the pose as it was
+  Pose before = cam.GetLocalPose();
+  auto message = [&](const Eigen::Vector3d& e, const Eigen::Vector3d& t, const Eigen::Vector3d& u) {
+    try {
+      cam.LookAt(e, t, u);
+    } catch (const Error& err) {
+      return std::string(err.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_NE(message(eye, eye, Eigen::Vector3d::UnitZ()).find("same point"), std::string::npos);
+  EXPECT_NE(message(eye, target, Eigen::Vector3d::Zero()).find("up"), std::string::npos);
+  std::string m = message(Eigen::Vector3d(kNaN, 0, 0), target, Eigen::Vector3d::UnitZ());
+  EXPECT_NE(m.find("camera 'c'"), std::string::npos) << m;
+  EXPECT_NE(m.find("finite"), std::string::npos) << m;
+  ExpectPoseNear(cam.GetLocalPose(), before);
+}
+
+}  // namespace
+}  // namespace partsim

@@ -56,6 +56,12 @@ class Camera {
   Pose GetPose() const;
   /// For a free camera, its world pose; for a mounted one, its pose in the mount's frame.
   void SetLocalPose(const Pose& pose);
+  /// Points the camera from `eye` at `target` with its z as close to `up` as possible
+  /// (CameraLookAt), all in the world frame for a free camera and in the mount's frame for a
+  /// mounted one: SetLocalPose(CameraLookAt(eye, target, up)). Throws partsim::Error naming the
+  /// camera when eye and target coincide, up is zero or a value is not finite.
+  void LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+              const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ());
   Pose GetLocalPose() const;
   /// Mounts the camera on an actor or a link of its scene, or frees it (ClearParent). With
   /// `keep_pose` the camera stays where it is in the world (its local pose is recomputed);

@@ -19,8 +19,11 @@ Eigen::Matrix3d RotationCameraToGl();
 Eigen::Matrix3d RotationCameraToCv();
 
 /// Camera pose X_WC (x forward, y left, z up) at `eye` looking at `target`, with z as close to
-/// the world's up as possible (looking straight up or down: y is the world's y).
-Pose CameraLookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target);
+/// `up` as possible (looking along `up`: y is taken from the world axis least aligned with the
+/// view). Throws partsim::Error when an argument is not finite, eye and target coincide or up
+/// is zero.
+Pose CameraLookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                  const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ());
 
 /// K for a vertical field of view (rad) with square pixels and a centred principal point
 /// (cx = (width - 1) / 2, cy = (height - 1) / 2).

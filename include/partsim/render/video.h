@@ -40,6 +40,8 @@ class VideoWriter {
   /// Appends a frame of 8-bit sRGB pixels, top row first: `channels` 3 (RGB) or 4 (RGBA,
   /// composited over the background), width x height x channels bytes.
   void AddFrame(const uint8_t* pixels, int channels);
+  /// Throws partsim::Error unless a frame of width x height fits this video.
+  void CheckFrameSize(int width, int height) const;
   /// Appends the picture's Color output (its size must be the video's).
   void AddFrame(const Picture& picture);
   /// Flushes the encoder, writes the index and renames the file into place. Further frames
