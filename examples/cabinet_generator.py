@@ -27,18 +27,6 @@ import numpy as np
 import partsim
 
 
-def look_at(eye, target, up=(0.0, 0.0, 1.0)):
-    """The pose of a camera at `eye` looking at `target`. A partsim camera looks along its x
-    axis, with y to its left and z up."""
-    eye, target, up = (np.asarray(v, dtype=float) for v in (eye, target, up))
-    forward = (target - eye) / np.linalg.norm(target - eye)
-    left = np.cross(up, forward)
-    left /= np.linalg.norm(left)
-    m = np.eye(4)
-    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = forward, left, np.cross(forward, left), eye
-    return partsim.Pose.from_transformation_matrix(m)
-
-
 def find_cli():
     """The partsim command: $PARTSIM_CLI, <build>/partsim beside <build>/python/partsim, or PATH."""
     if os.environ.get("PARTSIM_CLI"):
@@ -98,7 +86,7 @@ def main():
     size = max(float(np.max(np.asarray(hi) - np.asarray(lo))), 0.1)
     centre = (origins.min(axis=0) + origins.max(axis=0)) / 2
     camera = scene.add_camera("front", 640, 480, fovy=0.8, near=0.02, far=50)
-    camera.set_pose(look_at(centre + np.array([-1.6, -1.0, 0.8]) * max(size, 0.5), centre))
+    camera.look_at(centre + np.array([-1.6, -1.0, 0.8]) * max(size, 0.5), centre)
     picture(scene, camera, os.path.join(args.out, "rest.png"))
 
     # drive every movable part to 70% of its range (0.7 rad where a hinge has no limit); the

@@ -16,18 +16,6 @@ import numpy as np
 import partsim
 
 
-def look_at(eye, target, up=(0.0, 0.0, 1.0)):
-    """The pose of a camera at `eye` looking at `target`. A partsim camera looks along its x
-    axis, with y to its left and z up."""
-    eye, target, up = (np.asarray(v, dtype=float) for v in (eye, target, up))
-    forward = (target - eye) / np.linalg.norm(target - eye)
-    left = np.cross(up, forward)
-    left /= np.linalg.norm(left)
-    m = np.eye(4)
-    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = forward, left, np.cross(forward, left), eye
-    return partsim.Pose.from_transformation_matrix(m)
-
-
 def main():
     parser = argparse.ArgumentParser(description="A first scene: actors, a step, a picture.")
     parser.add_argument("--out", default=os.path.join("out", "hello_scene"),
@@ -70,7 +58,7 @@ def main():
     scene.add_directional_light([0.3, 0.2, -1], [1, 1, 1], shadow=True)
     scene.set_ambient_light([0.3, 0.3, 0.3])
     camera = scene.add_camera("front", 640, 480, fovy=0.8, near=0.05, far=20)
-    camera.set_pose(look_at([1.2, -0.7, 0.7], [0, 0, 0.1]))
+    camera.look_at([1.2, -0.7, 0.7], [0, 0, 0.1])
     scene.update_render()
     camera.take_picture()
     path = os.path.join(args.out, "hello_scene.png")

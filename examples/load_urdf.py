@@ -27,18 +27,6 @@ DEFAULT_URDF = os.path.join(HERE, "..", "tests", "data", "arm", "arm_description
                             "panda.urdf")
 
 
-def look_at(eye, target, up=(0.0, 0.0, 1.0)):
-    """The pose of a camera at `eye` looking at `target`. A partsim camera looks along its x
-    axis, with y to its left and z up."""
-    eye, target, up = (np.asarray(v, dtype=float) for v in (eye, target, up))
-    forward = (target - eye) / np.linalg.norm(target - eye)
-    left = np.cross(up, forward)
-    left /= np.linalg.norm(left)
-    m = np.eye(4)
-    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = forward, left, np.cross(forward, left), eye
-    return partsim.Pose.from_transformation_matrix(m)
-
-
 def finite(x):
     """JSON has no infinity: unlimited bounds become None."""
     return float(x) if np.isfinite(x) else None
@@ -108,7 +96,7 @@ def main():
     scene.add_directional_light([0.4, 0.3, -1], [1, 1, 1], shadow=True)
     scene.set_ambient_light([0.3, 0.3, 0.3])
     camera = scene.add_camera("front", 640, 480, fovy=0.8, near=0.02, far=100)
-    camera.set_pose(look_at(centre + np.array([1.0, -0.8, 0.6]) * 1.6 * size, centre))
+    camera.look_at(centre + np.array([1.0, -0.8, 0.6]) * 1.6 * size, centre)
     scene.update_render()
     camera.take_picture()
     path = os.path.join(args.out, f"{robot.get_name()}.png")

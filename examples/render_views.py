@@ -29,18 +29,6 @@ import numpy as np
 import partsim
 
 
-def look_at(eye, target, up=(0.0, 0.0, 1.0)):
-    """The pose of a camera at `eye` looking at `target`. A partsim camera looks along its x
-    axis, with y to its left and z up."""
-    eye, target, up = (np.asarray(v, dtype=float) for v in (eye, target, up))
-    forward = (target - eye) / np.linalg.norm(target - eye)
-    left = np.cross(up, forward)
-    left /= np.linalg.norm(left)
-    m = np.eye(4)
-    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = forward, left, np.cross(forward, left), eye
-    return partsim.Pose.from_transformation_matrix(m)
-
-
 def find_cli():
     """The partsim command: $PARTSIM_CLI, <build>/partsim beside <build>/python/partsim, or PATH."""
     if os.environ.get("PARTSIM_CLI"):
@@ -90,7 +78,7 @@ def main():
     scene.add_directional_light([0.5, 0.4, -1], [1, 1, 1], shadow=True)
     scene.set_ambient_light([0.3, 0.3, 0.3])
     camera = scene.add_camera("front", args.width, args.height, fovy=0.8, near=0.05, far=20)
-    camera.set_pose(look_at(centre + np.array([-2.0, -1.2, 0.9]), centre))
+    camera.look_at(centre + np.array([-2.0, -1.2, 0.9]), centre)
     scene.update_render()
     camera.take_picture()
 
