@@ -1,16 +1,14 @@
 // `partsim assets generate`: writes procedural articulated objects of the PartNet-Mobility
 // categories as dataset folders, with progress on stderr.
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <exception>
-#include <sstream>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "../core/progress.h"
+#include "arg_parser.h"
 #include "commands.h"
 #include "partsim/assets/convex_decomposition.h"
 #include "partsim/assets/generator.h"
@@ -46,18 +44,6 @@ decompose    splits a non-convex mesh into convex OBJ pieces with a URDF <collis
              reports coverage and excess (`decompose --help` for more).
 )";
 
-struct AssetsUsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-long long ParseInt(const std::string& flag, const std::string& v, long long lo) {
-  long long n = 0;
-  if (!ParseInteger(v, lo, &n))
-    throw AssetsUsageError("partsim assets: " + flag +
-                           " expects an integer >= " + std::to_string(lo) + ", got '" + v + "'");
-  return n;
-}
-
 std::string Clock(double s) {
   char buf[32];
   int t = static_cast<int>(s + 0.5);
@@ -68,66 +54,33 @@ std::string Clock(double s) {
 int Generate(const std::vector<std::string>& args) {
   GeneratorOptions opt;
   bool have_out = false;
-  for (size_t i = 0; i < args.size(); ++i) {
-    std::string flag = args[i], value;
-    bool inline_value = false;
-    if (size_t eq = flag.find('='); eq != std::string::npos && flag.rfind("--", 0) == 0) {
-      value = flag.substr(eq + 1);
-      flag = flag.substr(0, eq);
-      inline_value = true;
-    }
-    auto next = [&]() {
-      if (inline_value) return value;
-      if (i + 1 >= args.size())
-        throw AssetsUsageError("partsim assets: " + flag + " needs a value");
-      return args[++i];
-    };
-    if (flag == "--out") {
-      opt.out_dir = next();
-      have_out = true;
-    } else if (flag == "--categories") {
-      std::string list = next();
-      opt.categories.clear();
-      if (list != "all") {
-        std::stringstream in(list);
-        std::string c;
-        while (std::getline(in, c, ',')) {
-          if (c.empty())
-            throw AssetsUsageError("partsim assets: empty name in --categories '" + list + "'");
-          opt.categories.push_back(c);
-        }
-      }
-    } else if (flag == "--per-category") {
-      std::string v = next();
-      opt.per_category = v == "paper" ? 0 : static_cast<int>(ParseInt(flag, v, 1));
-    } else if (flag == "--seed") {
-      std::string v = next();
-      char* end = nullptr;
-      errno = 0;
-      unsigned long long s = std::strtoull(v.c_str(), &end, 10);
-      if (v.empty() || v[0] == '-' || *end != '\0' || errno == ERANGE) {
-        throw AssetsUsageError("partsim assets: --seed expects an unsigned integer, got '" + v +
-                               "'");
-      }
-      opt.seed = s;
-    } else if (flag == "--jobs") {
-      opt.jobs = static_cast<int>(ParseInt(flag, next(), 1));
-    } else if (flag == "--by-category" && !inline_value) {
-      opt.by_category = true;
-    } else if (flag == "--overwrite" && !inline_value) {
-      opt.overwrite = true;
-    } else {
-      throw AssetsUsageError("partsim assets generate: unknown argument '" + args[i] + "'");
-    }
-  }
-  if (!have_out) throw AssetsUsageError("partsim assets generate: --out DIR is required");
+  ArgParser p("partsim assets generate");
+  p.Option("--out", [&](const FlagValue& v) {
+    opt.out_dir = v.Text();
+    have_out = true;
+  });
+  p.Option("--categories", [&](const FlagValue& v) {
+    opt.categories.clear();
+    if (v.Text() != "all") opt.categories = v.Names();
+  });
+  p.Option("--per-category", [&](const FlagValue& v) {
+    opt.per_category =
+        v.Text() == "paper" ? 0 : static_cast<int>(v.Integer(1, std::numeric_limits<int>::max()));
+  });
+  p.Option("--seed", [&](const FlagValue& v) { opt.seed = v.Unsigned(); });
+  p.Option("--jobs", [&](const FlagValue& v) {
+    opt.jobs = static_cast<int>(v.Integer(1, std::numeric_limits<int>::max()));
+  });
+  p.Switch("--by-category", [&] { opt.by_category = true; });
+  p.Switch("--overwrite", [&] { opt.overwrite = true; });
+  p.Parse(args);
+  if (!have_out) p.Fail("--out DIR is required");
   // unknown categories are a bad command line, refused before anything is written
   const std::vector<std::string> known = GeneratorCategories();
   for (const std::string& c : opt.categories) {
     if (std::find(known.begin(), known.end(), c) == known.end())
-      throw AssetsUsageError("partsim assets generate: unknown category '" + c +
-                             "' in --categories" + DidYouMean(c, known) +
-                             " (partsim assets categories lists them)");
+      p.Fail("unknown category '" + c + "' in --categories" + DidYouMean(c, known) +
+             " (partsim assets categories lists them)");
   }
 
   auto start = std::chrono::steady_clock::now();
@@ -164,29 +117,21 @@ int RunAssetsCommand(int argc, char** argv) {
   if (argc > 0 && std::string(argv[0]) == "check") return RunQualityCommand(argc - 1, argv + 1);
   if (argc > 0 && std::string(argv[0]) == "decompose") return RunDecomposeCommand(argc, argv);
   std::vector<std::string> args(argv, argv + argc);
-  try {
+  return RunWithExitCode("partsim assets", "", [&] {
     if (args.empty())
-      throw AssetsUsageError(std::string("partsim assets: missing sub-command\n") + kAssetsUsage);
-    for (const std::string& a : args) {
-      if (a == "--help" || a == "-h") {
-        std::printf("%s", kAssetsUsage);
-        return 0;
-      }
+      throw UsageError(std::string("partsim assets: missing sub-command\n") + kAssetsUsage);
+    if (ArgParser::AsksForHelp(args)) {
+      std::printf("%s", kAssetsUsage);
+      return 0;
     }
     std::string sub = args[0];
     args.erase(args.begin());
     if (sub == "generate") return Generate(args);
     if (sub == "categories" && args.empty()) return ListCategories();
-    throw AssetsUsageError("partsim assets: unknown sub-command '" + sub + "'" +
-                           DidYouMean(sub, {"generate", "categories", "check", "decompose"}) +
-                           " (expected generate, categories, check or decompose)");
-  } catch (const AssetsUsageError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "partsim assets: %s\n", e.what());
-    return 1;
-  }
+    throw UsageError("partsim assets: unknown sub-command '" + sub + "'" +
+                     DidYouMean(sub, {"generate", "categories", "check", "decompose"}) +
+                     " (expected generate, categories, check or decompose)");
+  });
 }
 
 }  // namespace partsim::tools

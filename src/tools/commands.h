@@ -1,4 +1,4 @@
-// Sub-commands of the `partsim` program that live in their own files.
+// The sub-commands of the `partsim` program, one file each, and what several of them share.
 #pragma once
 
 #include <string>
@@ -7,26 +7,18 @@
 
 namespace partsim::tools {
 
-/// Reads a whole decimal integer >= `lo` from `text` into `out`; false if `text` is not one (or
-/// overflows).
-bool ParseInteger(const std::string& text, long long lo, long long* out);
+/// `partsim info ...`: the links, joints, mass and dof of an object (`args`: the arguments
+/// after "info"). Returns the exit code (0 success, 1 failure, 2 bad command line).
+int RunInfoCommand(const std::vector<std::string>& args);
 
-/// The entry of `candidates` closest to `word` by edit distance (insertions, deletions,
-/// substitutions; letters compared case-insensitively) when it is near enough to be a typo of it:
-/// at most a third of the longer word's letters differ, and at least one is the same. "" when
-/// none is, or when `word` is one of `candidates`.
-std::string ClosestMatch(const std::string& word, const std::vector<std::string>& candidates);
+/// `partsim simulate ...`: steps an object and writes its joint trajectory (arguments after
+/// "simulate"). Returns the exit code (0 success, 1 failure, 2 bad command line).
+int RunSimulateCommand(const std::vector<std::string>& args);
 
-/// " (did you mean 'X'?)" with X = ClosestMatch(word, candidates), or "" when there is none: to
-/// append to a usage error that names `word`.
-std::string DidYouMean(const std::string& word, const std::vector<std::string>& candidates);
-
-/// Removes the files of `dir` that an earlier run of the same command wrote: names starting with
-/// one of `prefixes` and ending with the matching entry of `suffixes` ("color_" + ".png"), so
-/// that a run with fewer views or frames leaves no stale ones beside its own. Other files stay.
-/// Returns how many were removed.
-int ClearOwnedOutputs(const std::string& dir,
-                      const std::vector<std::pair<std::string, std::string>>& names);
+/// `partsim render ...`: images, depth, normals, segmentation and point clouds of an object from
+/// views around it (arguments after "render"). Returns the exit code (0 success, 1 failure, 2 bad
+/// command line).
+int RunRenderCommand(const std::vector<std::string>& args);
 
 /// `partsim assets ...`: generate procedural PartNet-Mobility objects. `argv` holds the
 /// arguments after "assets". Returns the exit code (0 success, 1 failure, 2 bad command line).
@@ -39,5 +31,12 @@ int RunTasksCommand(int argc, char** argv);
 /// `partsim serve ...`: a scene stepped in real time behind a rosbridge v2 WebSocket server
 /// (arguments after "serve"). Returns the exit code (0 success, 1 failure, 2 bad command line).
 int RunServeCommand(int argc, char** argv);
+
+/// Removes the files of `dir` that an earlier run of the same command wrote: names starting with
+/// one of `prefixes` and ending with the matching entry of `suffixes` ("color_" + ".png"), so
+/// that a run with fewer views or frames leaves no stale ones beside its own. Other files stay.
+/// Returns how many were removed.
+int ClearOwnedOutputs(const std::string& dir,
+                      const std::vector<std::pair<std::string, std::string>>& names);
 
 }  // namespace partsim::tools

@@ -11,8 +11,10 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
+#include "arg_parser.h"
 #include "commands.h"
 #include "partsim/assets/default_objects.h"
 #include "partsim/assets/scene_file.h"
@@ -71,19 +73,6 @@ With no SCENE, a built-in cabinet stands in front of the robot.
   --ros1-wall-time       with --ros1: leave /use_sim_time alone
 )";
 
-struct ServeUsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-double ParsePositive(const std::string& flag, const std::string& v, bool allow_zero = false) {
-  char* end = nullptr;
-  double d = std::strtod(v.c_str(), &end);
-  if (v.empty() || *end != '\0' || !(allow_zero ? d >= 0 : d > 0) || d > 1e9)
-    throw ServeUsageError("partsim serve: " + flag + " expects a " +
-                          (allow_zero ? "non-negative" : "positive") + " number, got '" + v + "'");
-  return d;
-}
-
 std::atomic<bool> g_stop{false};
 void OnSignal(int) { g_stop = true; }
 
@@ -100,84 +89,39 @@ int RunServeCommand(int argc, char** argv) {
   bool fast = false, ros1 = false, ros1_sim_time = true;
   int cam_w = 640, cam_h = 480;
   double camera_rate = 10;
-  try {
-    for (int i = 0; i < argc; ++i) {
-      std::string a = argv[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw ServeUsageError("partsim serve: " + a + " needs a value");
-        return argv[++i];
-      };
-      if (a == "-h" || a == "--help") {
-        std::fputs(kServeUsage, stdout);
-        return 0;
-      } else if (a == "--port") {
-        const std::string v = value();
-        long long p = 0;
-        if (!ParseInteger(v, 0, &p) || p > 65535)
-          throw ServeUsageError(
-              "partsim serve: --port expects an integer from 0 to 65535 (0 picks a free port), "
-              "got '" +
-              v + "'");
-        port = static_cast<int>(p);
-      } else if (a == "--rate") {
-        rate = ParsePositive(a, value());
-      } else if (a == "--realtime-factor") {
-        factor = ParsePositive(a, value());
-      } else if (a == "--fast") {
-        fast = true;
-      } else if (a == "--duration") {
-        duration = ParsePositive(a, value());
-      } else if (a == "--camera") {
-        std::string v = value();
-        int w = 0, h = 0;
-        char x = 0, extra = 0;
-        if (std::sscanf(v.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 ||
-            h < 1 || w > 8192 || h > 8192)
-          throw ServeUsageError("partsim serve: --camera expects WxH (e.g. 640x480), got '" + v +
-                                "'");
-        cam_w = w;
-        cam_h = h;
-      } else if (a == "--camera-rate") {
-        camera_rate = ParsePositive(a, value(), true);
-      } else if (a == "--ros1") {
-        ros1 = true;
-      } else if (a == "--ros1-wall-time") {
-        ros1_sim_time = false;
-      } else if (a == "--address") {
-        address = value();
-      } else if (a == "--token") {
-        token = value();
-        if (token.empty())
-          throw ServeUsageError("partsim serve: --token expects a non-empty token");
-      } else if (a == "--allow-origin") {
-        origins.push_back(value());
-      } else if (a == "--max-clients") {
-        const double n = ParsePositive(a, value());
-        if (n != std::floor(n) || n > 100000)
-          throw ServeUsageError("partsim serve: --max-clients expects an integer from 1 to 100000");
-        max_clients = static_cast<size_t>(n);
-      } else if (a == "--robot") {
-        robot_kind = value();
-        if (robot_kind != "gripper" && robot_kind != "panda")
-          throw ServeUsageError("partsim serve: --robot expects gripper or panda, got '" +
-                                robot_kind + "'" + DidYouMean(robot_kind, {"gripper", "panda"}));
-      } else if (!a.empty() && a[0] == '-') {
-        throw ServeUsageError(
-            "partsim serve: unknown option '" + a + "'" +
-            DidYouMean(a,
-                       {"--port", "--rate", "--realtime-factor", "--fast", "--robot", "--address",
-                        "--duration", "--camera", "--camera-rate", "--token", "--allow-origin",
-                        "--max-clients", "--ros1", "--ros1-wall-time", "--help"}));
-      } else if (scene_file.empty()) {
-        scene_file = a;
-      } else {
-        throw ServeUsageError("partsim serve: unexpected extra argument '" + a + "'");
-      }
-    }
-  } catch (const ServeUsageError& e) {
-    std::fprintf(stderr, "%s\nsee partsim serve --help\n", e.what());
-    return 2;
+  const std::vector<std::string> args(argv, argv + argc);
+  if (ArgParser::AsksForHelp(args)) {
+    std::fputs(kServeUsage, stdout);
+    return 0;
   }
+  const int parsed = RunWithExitCode("partsim serve", "see partsim serve --help\n", [&] {
+    ArgParser p("partsim serve");
+    p.Positional([&](const FlagValue& v) {
+      if (!scene_file.empty()) v.Fail("unexpected extra argument '" + v.Text() + "'");
+      scene_file = v.Text();
+    });
+    p.Option("--port", [&](const FlagValue& v) {
+      port = static_cast<int>(v.Integer(0, 65535, "(0 picks a free port)"));
+    });
+    p.Option("--rate", [&](const FlagValue& v) { rate = v.Number(0, false, 1e9); });
+    p.Option("--realtime-factor", [&](const FlagValue& v) { factor = v.Number(0, false, 1e9); });
+    p.Switch("--fast", [&] { fast = true; });
+    p.Option("--robot", [&](const FlagValue& v) { robot_kind = v.Choice({"gripper", "panda"}); });
+    p.Option("--address", [&](const FlagValue& v) { address = v.Text(); });
+    p.Option("--duration", [&](const FlagValue& v) { duration = v.Number(0, false, 1e9); });
+    p.Option("--camera", [&](const FlagValue& v) { std::tie(cam_w, cam_h) = v.Size(1, 8192); });
+    p.Option("--camera-rate", [&](const FlagValue& v) { camera_rate = v.Number(0, true, 1e9); });
+    p.Option("--token", [&](const FlagValue& v) { token = v.NonEmpty("a non-empty token"); });
+    p.Option("--allow-origin", [&](const FlagValue& v) { origins.push_back(v.Text()); });
+    p.Option("--max-clients",
+             [&](const FlagValue& v) { max_clients = static_cast<size_t>(v.Integer(1, 100000)); });
+    p.Switch("--ros1", [&] { ros1 = true; });
+    p.Switch("--ros1-wall-time", [&] { ros1_sim_time = false; });
+    p.Switch("--help", [] {});  // answered above; declared to be suggested
+    p.Parse(args);
+    return 0;
+  });
+  if (parsed != 0) return parsed;
 #ifndef PARTSIM_WITH_ROS1
   if (ros1) {
     std::fprintf(stderr,

@@ -2,18 +2,19 @@
 // generated cabinets.
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
+#include "arg_parser.h"
 #include "commands.h"
 #include "partsim/assets/generator.h"
 #include "partsim/tasks/tasks.h"
@@ -47,18 +48,6 @@ evaluate   runs the heuristic solver on the first N cabinets (default 20) that h
   --jobs J             episodes in parallel (default 1)
 )";
 
-struct TasksUsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-long long ParseCount(const std::string& flag, const std::string& v, long long lo) {
-  long long n = 0;
-  if (!ParseInteger(v, lo, &n))
-    throw TasksUsageError("partsim tasks: " + flag +
-                          " expects an integer >= " + std::to_string(lo) + ", got '" + v + "'");
-  return n;
-}
-
 struct TasksArgs {
   std::string command;
   TaskType type = TaskType::kPullDrawer;
@@ -81,95 +70,57 @@ struct TasksArgs {
   bool count_given = false;
 };
 
-TasksArgs Parse(int argc, char** argv) {
+TasksArgs Parse(const std::vector<std::string>& args) {
   TasksArgs a;
-  if (argc < 1) throw TasksUsageError("partsim tasks: expected demo or evaluate");
-  a.command = argv[0];
+  ArgParser p("partsim tasks");
+  if (args.empty()) p.Fail("expected demo or evaluate");
+  a.command = args[0];
   if (a.command != "demo" && a.command != "evaluate")
-    throw TasksUsageError("partsim tasks: unknown command '" + a.command +
-                          "' (expected demo or evaluate)");
-  for (int i = 1; i < argc; ++i) {
-    std::string f = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) throw TasksUsageError("partsim tasks: " + f + " needs a value");
-      return argv[++i];
-    };
-    if (f == "--task") {
-      std::string v = value();
-      if (v != "drawer" && v != "door")
-        throw TasksUsageError("partsim tasks: --task expects drawer or door, got '" + v + "'");
-      a.type = ParseTaskType(v);
-    } else if (f == "--object") {
-      a.object = static_cast<int>(ParseCount(f, value(), 0));
-      const int objects = PaperModelCount("StorageFurniture");
-      if (a.object >= objects)
-        throw TasksUsageError("partsim tasks: --object " + std::to_string(a.object) +
-                              " is out of range: the generated dataset has " +
-                              std::to_string(objects) + " StorageFurniture objects (0 to " +
-                              std::to_string(objects - 1) + ")");
-    } else if (f == "--count") {
-      a.count = static_cast<int>(ParseCount(f, value(), 1));
-      a.count_given = true;
-    } else if (f == "--dataset") {
-      a.dataset = value();
-    } else if (f == "--ids") {
-      std::string v = value(), id;
-      for (size_t k = 0; k <= v.size(); ++k) {
-        if (k == v.size() || v[k] == ',') {
-          if (id.empty())
-            throw TasksUsageError("partsim tasks: --ids has an empty id in '" + v + "'");
-          a.ids.push_back(id);
-          id.clear();
-        } else {
-          id += v[k];
-        }
-      }
-    } else if (f == "--targets") {
-      std::string v = value();
-      if (v != "all" && v != "one")
-        throw TasksUsageError("partsim tasks: --targets expects all or one, got '" + v + "'");
-      a.all_targets = v == "all";
-    } else if (f == "--seed") {
-      a.seed = static_cast<unsigned long long>(ParseCount(f, value(), 0));
-    } else if (f == "--jobs") {
-      a.jobs = static_cast<int>(ParseCount(f, value(), 1));
-    } else if (f == "--every") {
-      a.every = static_cast<int>(ParseCount(f, value(), 1));
-    } else if (f == "--video") {
-      a.video = value();
-      if (a.video.empty()) throw TasksUsageError("partsim tasks: --video needs a file name");
-    } else if (f == "--no-video") {
-      a.no_video = true;
-    } else if (f == "--frames") {
-      a.frames = true;
-    } else if (f == "--size") {
-      std::string v = value();
-      const size_t x = v.find('x');
-      long long w = 0, h = 0;
-      if (x == std::string::npos || !ParseInteger(v.substr(0, x), 16, &w) ||
-          !ParseInteger(v.substr(x + 1), 16, &h) || w > 4096 || h > 4096)
-        throw TasksUsageError("partsim tasks: --size expects WxH with each in 16..4096, got '" + v +
-                              "'");
-      a.width = static_cast<int>(w);
-      a.height = static_cast<int>(h);
-    } else if (f == "--out") {
-      a.out = value();
-    } else if (f == "--csv") {
-      a.csv = value();
-    } else if (f == "--no-cameras") {
-      a.cameras = false;
-    } else {
-      throw TasksUsageError("partsim tasks: unknown option '" + f + "'");
-    }
-  }
+    p.Fail("unknown command '" + a.command + "'" + DidYouMean(a.command, {"demo", "evaluate"}) +
+           " (expected demo or evaluate)");
+  p.Option("--task", [&](const FlagValue& v) {
+    a.type = ParseTaskType(v.Choice({"drawer", "door"}));
+  });
+  p.Option("--object", [&](const FlagValue& v) {
+    const int objects = PaperModelCount("StorageFurniture");
+    a.object = static_cast<int>(v.Integer(0, std::numeric_limits<int>::max()));
+    if (a.object >= objects)
+      v.Fail("--object " + std::to_string(a.object) +
+             " is out of range: the generated dataset has " + std::to_string(objects) +
+             " StorageFurniture objects (0 to " + std::to_string(objects - 1) + ")");
+  });
+  p.Option("--count", [&](const FlagValue& v) {
+    a.count = static_cast<int>(v.Integer(1, std::numeric_limits<int>::max()));
+    a.count_given = true;
+  });
+  p.Option("--dataset", [&](const FlagValue& v) { a.dataset = v.Text(); });
+  p.Option("--ids", [&](const FlagValue& v) {
+    for (const std::string& id : v.Names()) a.ids.push_back(id);
+  });
+  p.Option("--targets", [&](const FlagValue& v) {
+    a.all_targets = v.Choice({"all", "one"}) == "all";
+  });
+  p.Option("--seed", [&](const FlagValue& v) { a.seed = v.Unsigned(); });
+  p.Option("--jobs", [&](const FlagValue& v) {
+    a.jobs = static_cast<int>(v.Integer(1, std::numeric_limits<int>::max()));
+  });
+  p.Option("--every", [&](const FlagValue& v) {
+    a.every = static_cast<int>(v.Integer(1, std::numeric_limits<int>::max()));
+  });
+  p.Option("--video", [&](const FlagValue& v) { a.video = v.NonEmpty("a file name"); });
+  p.Switch("--no-video", [&] { a.no_video = true; });
+  p.Switch("--frames", [&] { a.frames = true; });
+  p.Option("--size", [&](const FlagValue& v) { std::tie(a.width, a.height) = v.Size(16, 4096); });
+  p.Option("--out", [&](const FlagValue& v) { a.out = v.Text(); });
+  p.Option("--csv", [&](const FlagValue& v) { a.csv = v.Text(); });
+  p.Switch("--no-cameras", [&] { a.cameras = false; });
+  p.Parse(std::vector<std::string>(args.begin() + 1, args.end()));
   if (a.dataset.empty() && (!a.ids.empty() || a.all_targets))
-    throw TasksUsageError("partsim tasks: --ids and --targets need --dataset");
+    p.Fail("--ids and --targets need --dataset");
   if (a.command != "demo" && (!a.video.empty() || a.no_video || a.frames))
-    throw TasksUsageError("partsim tasks: --video, --no-video and --frames go with demo");
-  if (!a.video.empty() && a.no_video)
-    throw TasksUsageError("partsim tasks: --video and --no-video exclude each other");
-  if (!a.dataset.empty() && a.command != "evaluate")
-    throw TasksUsageError("partsim tasks: --dataset goes with evaluate");
+    p.Fail("--video, --no-video and --frames go with demo");
+  if (!a.video.empty() && a.no_video) p.Fail("--video and --no-video exclude each other");
+  if (!a.dataset.empty() && a.command != "evaluate") p.Fail("--dataset goes with evaluate");
   return a;
 }
 
@@ -355,23 +306,15 @@ int RunEvaluate(const TasksArgs& a) {
 }  // namespace
 
 int RunTasksCommand(int argc, char** argv) {
-  for (int i = 0; i < argc; ++i) {
-    std::string s = argv[i];
-    if (s == "--help" || s == "-h") {
-      std::printf("%s", kTasksUsage);
-      return 0;
-    }
+  const std::vector<std::string> args(argv, argv + argc);
+  if (ArgParser::AsksForHelp(args)) {
+    std::printf("%s", kTasksUsage);
+    return 0;
   }
-  try {
-    TasksArgs a = Parse(argc, argv);
+  return RunWithExitCode("partsim tasks", kTasksUsage, [&] {
+    TasksArgs a = Parse(args);
     return a.command == "demo" ? RunDemo(a) : RunEvaluate(a);
-  } catch (const TasksUsageError& e) {
-    std::fprintf(stderr, "%s\n%s", e.what(), kTasksUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "partsim tasks: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 }  // namespace partsim::tools
