@@ -5,7 +5,6 @@
 #include <string>
 
 #include "partsim/render/backend.h"
-#include "render/picture_internal.h"
 
 namespace partsim {
 namespace {
@@ -15,8 +14,9 @@ class NullBackend : public RenderBackend {
   std::string Name() const override { return "null"; }
   std::string Device() const override { return "none (null backend: renders nothing)"; }
 
-  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
-              unsigned outputs = kAllOutputs) override {
+ protected:
+  void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
+                unsigned outputs) override {
     size_t n = static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height);
     out->width = camera.width;
     out->height = camera.height;
@@ -27,7 +27,6 @@ class NullBackend : public RenderBackend {
     }
     out->segmentation.resize(2 * n);
     std::fill(out->segmentation.begin(), out->segmentation.end(), 0u);
-    internal::KeepOutputs(outputs, out);
   }
 };
 

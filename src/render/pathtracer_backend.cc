@@ -47,7 +47,6 @@
 #include "partsim/core/error.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera_math.h"
-#include "render/picture_internal.h"
 #include "render/pt_sampling.h"
 #include "render/pt_texture.h"
 
@@ -142,9 +141,11 @@ class PathTracerBackend : public RenderBackend {
            std::to_string(options_.max_depth) + ")";
   }
 
-  // every output comes from the same primary paths: all are traced, those not asked for dropped
-  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
-              unsigned outputs = kAllOutputs) override {
+ protected:
+  // every output comes from the same primary paths: all are traced, and Render drops those not
+  // asked for
+  void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
+                unsigned outputs) override {
     SyncGeometry(world);
     SyncShading(world);
     lights_ = &world.lights;
@@ -182,7 +183,6 @@ class PathTracerBackend : public RenderBackend {
     for (int i = 1; i < num_threads; ++i) pool.emplace_back(worker);
     worker();
     for (auto& t : pool) t.join();
-    internal::KeepOutputs(outputs, out);
   }
 
  private:

@@ -377,8 +377,10 @@ class RasterBackend final : public RenderBackend {
 
   std::string Name() const override { return "rasterizer"; }
   std::string Device() const override { return context_->Renderer(); }
-  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
-              unsigned outputs = kAllOutputs) override {
+
+ protected:
+  void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
+                unsigned outputs) override {
     internal::CurrentContextScope current(*context_);
     EnsureTargets(camera.width, camera.height);
     SyncResources(world);

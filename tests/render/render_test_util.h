@@ -87,9 +87,13 @@ class PlaneBackend : public RenderBackend {
   explicit PlaneBackend(double depth = 2.0, float color = 0.5f) : depth_(depth), color_(color) {}
   std::string Name() const override { return "test-plane"; }
   std::string Device() const override { return "test"; }
-  // fills every output whatever `outputs` asks for (Camera::TakePicture drops the others)
-  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
-              unsigned outputs = kAllOutputs) override {
+  int renders = 0;
+  unsigned last_outputs = 0;  ///< `outputs` of the last Render
+
+ protected:
+  // fills every output whatever `outputs` asks for (RenderBackend::Render drops the others)
+  void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
+                unsigned outputs) override {
     ++renders;
     last_outputs = outputs;
     int w = camera.width, h = camera.height;
@@ -121,8 +125,6 @@ class PlaneBackend : public RenderBackend {
       }
     }
   }
-  int renders = 0;
-  unsigned last_outputs = 0;  ///< `outputs` of the last Render
 
  private:
   double depth_;

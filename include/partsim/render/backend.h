@@ -1,6 +1,7 @@
 // The renderer's backend interface. A backend turns a RenderWorld (what is visible, where, under
 // which lights) and a camera into a Picture. The rasterizer (EGL/OpenGL), the path tracer (Embree)
-// and a null backend implement it; Camera::TakePicture validates its arguments and calls one.
+// and a null backend implement it behind RenderBackend::Render, which checks the arguments for all
+// of them.
 #pragma once
 
 #include <Eigen/Core>
@@ -90,7 +91,8 @@ struct Picture {
   std::vector<uint32_t> segmentation;  ///< h x w x 2: visual id, entity id; 0 = background
 };
 
-/// A rendering backend.
+/// A rendering backend. Render is not virtual: it checks its arguments once for every backend,
+/// then calls the backend's DoRender, which can rely on them.
 class RenderBackend {
  public:
   virtual ~RenderBackend() = default;
@@ -100,10 +102,22 @@ class RenderBackend {
   virtual std::string Device() const = 0;
   /// Fills the outputs of `out` named by `outputs` (PictureOutput bits, sized width x height),
   /// leaves the others empty (size 0) and sets out->outputs. Asking for less lets a backend do
-  /// less: the rasterizer renders Color and Position alone in one forward pass. Arguments were
-  /// validated by the caller.
-  virtual void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
-                      unsigned outputs = kAllOutputs) = 0;
+  /// less: the rasterizer renders Color and Position alone in one forward pass. Throws
+  /// partsim::Error naming the argument when `out` is null, `outputs` names no output or unknown
+  /// bits, or `camera` is unusable: width or height outside [1, kMaxPictureSize] pixels, K not
+  /// finite or a focal length <= 0, near not finite and > 0, far not finite and > near, X_WC not
+  /// finite with a unit quaternion, view or projection not finite.
+  void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
+              unsigned outputs = kAllOutputs);
+
+  /// Largest width or height of a picture (pixels).
+  static constexpr int kMaxPictureSize = 16384;
+
+ protected:
+  /// The backend's work for Render, on checked arguments: fills the outputs of `out` named by
+  /// `outputs` (it may fill others too; Render empties them afterwards).
+  virtual void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
+                        unsigned outputs) = 0;
 };
 
 /// Fills nothing but the background (for tests that need no pixels).

@@ -1,0 +1,59 @@
+// RenderBackend::Render: the argument checks every backend shares, then the backend's DoRender.
+#include "partsim/render/backend.h"
+
+#include <cmath>
+#include <string>
+
+#include "core/number_text.h"
+#include "partsim/core/error.h"
+#include "render/picture_internal.h"
+
+namespace partsim {
+
+namespace {
+
+[[noreturn]] void Fail(const RenderBackend& backend, const std::string& message) {
+  throw Error("render backend '" + backend.Name() + "': " + message);
+}
+
+// throws naming the backend and the argument when `camera` cannot be rendered
+void CheckCamera(const RenderBackend& backend, const CameraParams& camera) {
+  const int max = RenderBackend::kMaxPictureSize;
+  if (camera.width < 1 || camera.width > max)
+    Fail(backend, "camera.width must be in [1, " + std::to_string(max) + "] pixels, got " +
+                      std::to_string(camera.width));
+  if (camera.height < 1 || camera.height > max)
+    Fail(backend, "camera.height must be in [1, " + std::to_string(max) + "] pixels, got " +
+                      std::to_string(camera.height));
+  if (!camera.K.allFinite() || !(camera.K(0, 0) > 0) || !(camera.K(1, 1) > 0))
+    Fail(backend, "camera.K must be finite with focal lengths > 0, got fx = " +
+                      internal::Num(camera.K(0, 0)) + ", fy = " + internal::Num(camera.K(1, 1)));
+  if (!std::isfinite(camera.near) || !(camera.near > 0))
+    Fail(backend, "camera.near must be finite and > 0 (m), got " + internal::Num(camera.near));
+  if (!std::isfinite(camera.far) || !(camera.far > camera.near))
+    Fail(backend, "camera.far must be finite and > near (" + internal::Num(camera.near) +
+                      " m), got " + internal::Num(camera.far));
+  if (!camera.X_WC.IsValid())
+    Fail(backend, "camera.X_WC must hold finite numbers and a unit quaternion, got " +
+                      camera.X_WC.ToString());
+  if (!camera.view.allFinite() || !camera.projection.allFinite())
+    Fail(backend, "camera.view and camera.projection must be finite");
+}
+
+}  // namespace
+
+void RenderBackend::Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
+                           unsigned outputs) {
+  if (out == nullptr) Fail(*this, "out (the picture to fill) is null");
+  if (outputs == 0 || (outputs & ~unsigned{kAllOutputs}) != 0)
+    Fail(*this,
+         "outputs must name at least one of Color, Albedo, Normal, Position, "
+         "Segmentation (PictureOutput bits 1 to 31), got " +
+             std::to_string(outputs));
+  CheckCamera(*this, camera);
+  DoRender(world, camera, out, outputs);
+  // outputs not asked for are dropped whatever the backend filled
+  internal::KeepOutputs(outputs, out);
+}
+
+}  // namespace partsim
