@@ -34,6 +34,7 @@
 #include "render/depth_to_position.h"
 #include "render/gl_util.h"
 #include "render/picture_internal.h"
+#include "render/shaders_embedded.h"
 
 namespace partsim {
 namespace {
@@ -41,218 +42,16 @@ namespace {
 constexpr int kMaxLights = 32;
 constexpr int kMaxShadows = 4;
 
-// ---------------------------------------------------------------------------------------------
-// built-in shaders (shaders/README.md documents what custom ones must declare)
-
-const char* kGbufferVertex = R"(#version 450 core
-layout(location = 0) in vec3 a_position;  // visual frame (m)
-layout(location = 1) in vec3 a_normal;    // visual frame
-layout(location = 2) in vec2 a_uv;
-uniform mat4 u_model_view;     // visual -> OpenGL camera frame
-uniform mat3 u_normal_matrix;  // inverse transpose of u_model_view's 3x3
-uniform mat4 u_projection;     // OpenGL camera frame -> clip (rows flipped: row 0 at the top)
-out vec3 v_position;           // OpenGL camera frame (m)
-out vec3 v_normal;             // OpenGL camera frame
-out vec2 v_uv;
-void main() {
-  vec4 p = u_model_view * vec4(a_position, 1.0);
-  v_position = p.xyz;
-  v_normal = u_normal_matrix * a_normal;
-  v_uv = a_uv;
-  gl_Position = u_projection * p;
-}
-)";
-
-// the surface a fragment sees, as the G-buffer pass stores it and the forward pass shades it:
-// the inputs of both built-in fragment shaders ("#version 450 core" goes before it)
-const char* kSurface = R"(
-in vec3 v_position;
-in vec3 v_normal;
-in vec2 v_uv;
-uniform vec4 u_base_color;   // linear RGBA
-uniform float u_roughness;
-uniform float u_metallic;
-uniform bool u_has_texture;
-uniform sampler2D u_diffuse;  // sRGB texture, sampled as linear
-vec4 SurfaceAlbedo() {
-  vec4 albedo = u_base_color;
-  if (u_has_texture) albedo *= texture(u_diffuse, v_uv);
-  return albedo;
-}
-vec3 SurfaceNormal() {
-  vec3 n = normalize(v_normal);
-  return gl_FrontFacing ? n : -n;  // two-sided: thin surfaces seen from behind
-}
-)";
-
-// the built-in G-buffer pass: kSurface, then this
-const char* kGbufferMain = R"(
-uniform uvec2 u_ids;          // visual id, entity id
-layout(location = 0) out vec4 o_albedo;
-layout(location = 1) out vec4 o_normal;
-layout(location = 2) out vec4 o_position;
-layout(location = 3) out uvec4 o_segmentation;
-layout(location = 4) out vec4 o_material;
-void main() {
-  o_albedo = SurfaceAlbedo();
-  o_normal = vec4(SurfaceNormal(), 0.0);
-  o_position = vec4(v_position, -v_position.z);
-  o_segmentation = uvec4(u_ids, 0u, 0u);
-  o_material = vec4(u_roughness, u_metallic, 0.0, 1.0);
-}
-)";
-
-const char* kFullscreenVertex = R"(#version 450 core
-void main() {
-  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-)";
-
-// the shading shared by the lighting pass and the forward pass; "#version 450 core" and
-// "#define LIGHTS ..." go before it: one Light(index, type, shadow layer) call per light with
-// literal arguments, so that the compiler drops the branches a light does not need (software
-// rasterizers run both sides of a branch)
-const char* kShading = R"(
-#define MAX_LIGHTS 32
-#define MAX_SHADOWS 4
-uniform sampler2DArrayShadow u_shadow_maps;
-uniform vec3 u_ambient;
-uniform int u_num_lights;
-uniform int u_light_type[MAX_LIGHTS];        // 0 directional, 1 point, 2 spot
-uniform vec3 u_light_color[MAX_LIGHTS];
-uniform vec3 u_light_position[MAX_LIGHTS];   // OpenGL camera frame (m)
-uniform vec3 u_light_direction[MAX_LIGHTS];  // OpenGL camera frame, where the light travels
-uniform vec2 u_light_cos_cone[MAX_LIGHTS];   // spot: cos(inner), cos(outer)
-uniform int u_light_shadow[MAX_LIGHTS];      // shadow map layer, -1 for none
-uniform mat4 u_shadow_matrix[MAX_SHADOWS];   // OpenGL camera frame -> shadow map [0,1]^3
-uniform vec2 u_shadow_texel[MAX_SHADOWS];    // texel size (m) = x + y * distance to the light
-
-const float PI = 3.14159265358979;
-
-// the surface being shaded
-vec3 p, n, v, f0, albedo;
-float n_v, metallic, on_a, on_b, alpha2, k;
-
-float Shadow(int layer, float dist) {
-  vec2 texel = u_shadow_texel[layer];
-  float world_texel = texel.x + texel.y * dist;
-  vec4 s = u_shadow_matrix[layer] * vec4(p + n * (1.5 * world_texel), 1.0);
-  s.xyz /= s.w;
-  if (s.x <= 0.0 || s.x >= 1.0 || s.y <= 0.0 || s.y >= 1.0 || s.z >= 1.0) return 1.0;
-  vec2 step = 1.0 / vec2(textureSize(u_shadow_maps, 0).xy);
-  float lit = 0.0;
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx)
-      lit += texture(u_shadow_maps, vec4(s.xy + vec2(dx, dy) * step, float(layer), s.z));
-  return lit / 9.0;
-}
-
-// light i of `type` (0 directional, 1 point, 2 spot), shadowed by map `layer` (-1: none)
-vec3 Light(int i, int type, int layer) {
-  vec3 l;
-  float attenuation = 1.0;
-  float dist = 0.0;
-  if (type == 0) {
-    l = -u_light_direction[i];
-  } else {
-    vec3 d = u_light_position[i] - p;
-    dist = length(d);
-    l = d / max(dist, 1e-6);
-    attenuation = 1.0 / max(dist * dist, 1e-6);
-    if (type == 2) {
-      float c = dot(-l, u_light_direction[i]);
-      attenuation *= smoothstep(u_light_cos_cone[i].y, u_light_cos_cone[i].x, c);
-    }
-  }
-  float n_l = dot(n, l);
-  if (n_l <= 0.0) return vec3(0.0);
-  if (layer >= 0) attenuation *= Shadow(layer, dist);
-  // Oren-Nayar diffuse (sigma = roughness), GGX specular (alpha = roughness^2, Smith-Schlick G,
-  // Schlick Fresnel)
-  vec3 h = normalize(l + v);
-  float n_h = max(dot(n, h), 0.0);
-  float v_h = max(dot(v, h), 0.0);
-  vec3 f = f0 + (1.0 - f0) * pow(1.0 - v_h, 5.0);
-  float dd = n_h * n_h * (alpha2 - 1.0) + 1.0;
-  float d_ggx = alpha2 / (PI * dd * dd);
-  float g = (n_l / (n_l * (1.0 - k) + k)) * (n_v / (n_v * (1.0 - k) + k));
-  vec3 specular = f * (d_ggx * g / (4.0 * n_l * n_v));
-  float s = dot(l, v) - n_l * n_v;
-  float on = on_a + (s > 0.0 ? on_b * s / max(n_l, n_v) : 0.0);
-  vec3 diffuse = (1.0 - f) * (1.0 - metallic) * albedo / PI * on;
-  // as in the path tracer: a light's colour is the irradiance at normal incidence
-  // (directional) or the intensity (point and spot, divided by the squared distance)
-  return (diffuse + specular) * (n_l * attenuation) * u_light_color[i];
-}
-
-// lit colour of a surface point: albedo (linear RGB), unit normal and position (OpenGL camera
-// frame), roughness and metallic as the G-buffer stores them
-vec3 Shade(vec3 surface_albedo, vec3 normal, vec3 position, float surface_roughness,
-           float surface_metallic) {
-  albedo = surface_albedo;
-  n = normal;
-  float roughness = clamp(surface_roughness, 0.05, 1.0);
-  metallic = clamp(surface_metallic, 0.0, 1.0);
-  p = position;
-  v = normalize(-p);
-  n_v = max(dot(n, v), 1e-4);
-  float sigma2 = roughness * roughness;
-  on_a = 1.0 - 0.5 * sigma2 / (sigma2 + 0.33);
-  on_b = 0.45 * sigma2 / (sigma2 + 0.09);
-  float alpha = roughness * roughness;
-  alpha2 = alpha * alpha;
-  k = alpha * 0.5;
-  f0 = mix(vec3(0.04), albedo, metallic);
-  // ambient: a uniform environment of radiance u_ambient, unoccluded
-  vec3 color = albedo * u_ambient * (1.0 - metallic) + f0 * u_ambient * metallic;
-  LIGHTS
-  return clamp(color, 0.0, 1.0);
-}
-)";
-
-// the built-in lighting pass: kShading, then this
-const char* kLightingMain = R"(
-uniform sampler2D u_albedo;
-uniform sampler2D u_normal;
-uniform sampler2D u_position;
-uniform usampler2D u_segmentation;
-uniform sampler2D u_material;
-layout(location = 0) out vec4 o_color;
-void main() {
-  ivec2 px = ivec2(gl_FragCoord.xy);
-  vec4 position = texelFetch(u_position, px, 0);
-  if (position.w <= 0.0) {  // background
-    o_color = vec4(0.0);
-    return;
-  }
-  vec4 material = texelFetch(u_material, px, 0);
-  o_color = vec4(Shade(texelFetch(u_albedo, px, 0).rgb, normalize(texelFetch(u_normal, px, 0).xyz),
-                       position.xyz, material.x, material.y),
-                 1.0);
-}
-)";
-
-// the forward pass's fragment shader (after kGbufferVertex): kShading, kSurface, then this.
-// The material inputs are those the G-buffer pass writes, roughness and metallic rounded to 8
-// bits as its RGBA8 target stores them, so that both paths shade the same numbers.
-const char* kForwardMain = R"(
-layout(location = 0) out vec4 o_color;
-float Unorm8(float x) { return round(clamp(x, 0.0, 1.0) * 255.0) / 255.0; }
-void main() {
-  o_color = vec4(Shade(SurfaceAlbedo().rgb, SurfaceNormal(), v_position, Unorm8(u_roughness),
-                       Unorm8(u_metallic)),
-                 1.0);
-}
-)";
-
-const char* kShadowVertex = R"(#version 450 core
-layout(location = 0) in vec3 a_position;
-uniform mat4 u_mvp;
-void main() { gl_Position = u_mvp * vec4(a_position, 1.0); }
-)";
-
-// ---------------------------------------------------------------------------------------------
+// built-in shaders: shaders/*.glsl, embedded at build time (shaders/README.md documents what
+// custom ones must declare)
+using internal::kForwardMainGlsl;
+using internal::kFullscreenVertexGlsl;
+using internal::kGbufferMainGlsl;
+using internal::kGbufferVertexGlsl;
+using internal::kLightingMainGlsl;
+using internal::kShadingGlsl;
+using internal::kShadowVertexGlsl;
+using internal::kSurfaceGlsl;
 
 struct GpuMesh {
   std::weak_ptr<const MeshData> owner;  // guards against a new mesh at a freed mesh's address
@@ -434,14 +233,14 @@ class RasterBackend final : public RenderBackend {
     bool custom_fs = !options_.gbuffer_fragment_shader.empty();
     bool custom_ls = !options_.lighting_fragment_shader.empty();
     gbuffer_program_ = internal::BuildProgram(
-        "gbuffer", custom_vs ? options_.gbuffer_vertex_shader : kGbufferVertex,
+        "gbuffer", custom_vs ? options_.gbuffer_vertex_shader : kGbufferVertexGlsl,
         custom_vs ? "custom RasterOptions::gbuffer_vertex_shader" : "built-in",
         custom_fs ? options_.gbuffer_fragment_shader
-                  : std::string("#version 450 core\n") + kSurface + kGbufferMain,
+                  : std::string("#version 450 core\n") + kSurfaceGlsl + kGbufferMainGlsl,
         custom_fs ? "custom RasterOptions::gbuffer_fragment_shader" : "built-in");
     // the built-in lighting pass is compiled for each set of lights; this one has none
     LightingProgram(custom_ls ? "" : "#define LIGHTS\n");
-    shadow_program_ = internal::BuildProgram("shadow", kShadowVertex, "built-in", "", "none");
+    shadow_program_ = internal::BuildProgram("shadow", kShadowVertexGlsl, "built-in", "", "none");
 
     gl_ = GbufferUniforms(gbuffer_program_);
     shadow_mvp_ = glGetUniformLocation(shadow_program_, "u_mvp");
@@ -500,10 +299,10 @@ class RasterBackend final : public RenderBackend {
     auto it = forward_.find(defines);
     if (it != forward_.end()) return it->second;
     Forward out;
-    out.program = internal::BuildProgram(
-        "forward", kGbufferVertex, "built-in",
-        std::string("#version 450 core\n") + defines + kShading + kSurface + kForwardMain,
-        "built-in");
+    out.program = internal::BuildProgram("forward", kGbufferVertexGlsl, "built-in",
+                                         std::string("#version 450 core\n") + defines +
+                                             kShadingGlsl + kSurfaceGlsl + kForwardMainGlsl,
+                                         "built-in");
     out.gbuffer = GbufferUniforms(out.program);
     out.lighting = LightingUniforms(out.program);
     return forward_.emplace(defines, out).first->second;
@@ -522,9 +321,9 @@ class RasterBackend final : public RenderBackend {
     if (it != lighting_.end()) return it->second;
     Lighting out;
     out.program = internal::BuildProgram(
-        "lighting", kFullscreenVertex, "built-in",
+        "lighting", kFullscreenVertexGlsl, "built-in",
         custom ? options_.lighting_fragment_shader
-               : std::string("#version 450 core\n") + defines + kShading + kLightingMain,
+               : std::string("#version 450 core\n") + defines + kShadingGlsl + kLightingMainGlsl,
         custom ? "custom RasterOptions::lighting_fragment_shader" : "built-in");
     out.loc = LightingUniforms(out.program);
     return lighting_.emplace(key, out).first->second;
