@@ -18,6 +18,7 @@
 #include "core/progress.h"
 #include "partsim/assets/generator.h"
 #include "partsim/assets/quality.h"
+#include "partsim/render/visibility.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -111,6 +112,9 @@ int RunQualityCommand(int argc, char** argv) {
     return 1;
   }
 
+  // the visibility check renders: the finder comes from the render layer
+  if (options.check_visibility)
+    options.hidden_parts = HiddenMovingLinksFinder(options.render_backend, options.image_size);
   // check on a few threads; each object has its own scene
   std::vector<ObjectQualityReport> reports(folders.size());
   std::atomic<size_t> next{0}, done{0};

@@ -423,22 +423,13 @@ std::unique_ptr<Scene> Scene::Clone() const {
   c.next_visual_id = impl().next_visual_id;
   c.contact_capacity = impl().contact_capacity;
   c.stack_capacity = impl().stack_capacity;
-  c.lights = impl().lights;
-  c.ambient = impl().ambient;
-  for (const auto& cam : impl().cameras) {
-    internal::SceneImpl::CameraEntry copy_cam{cam.id,   cam.name, cam.width,     cam.height,
-                                              cam.fx,   cam.fy,   cam.cx,        cam.cy,
-                                              cam.near, cam.far,  cam.local_pose};
-    copy_cam.mount_actor = cam.mount_actor;
-    copy_cam.mount_articulation = cam.mount_articulation;
-    copy_cam.mount_link = cam.mount_link;
-    copy_cam.X_WC = cam.X_WC;
-    c.cameras.push_back(std::move(copy_cam));
-  }
   c.dirty = true;
   c.EnsureCompiled();
   copy->Unpack(Pack());
   c.warnings = impl().warnings;
+  // the observers' state (cameras, lights) after the bodies it may refer to
+  for (const auto& [key, attachment] : impl().attachments)
+    c.attachments[key] = attachment->CloneFor(*copy);
   return copy;
 }
 

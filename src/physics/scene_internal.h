@@ -12,8 +12,8 @@
 #include <thread>
 #include <vector>
 
+#include "partsim/physics/observer.h"
 #include "partsim/physics/scene.h"
-#include "partsim/render/backend.h"
 
 namespace partsim {
 namespace internal {
@@ -89,22 +89,6 @@ struct SceneImpl {
     uint32_t render_id_base = 0;           ///< link i has entity id render_id_base + i
     std::vector<uint32_t> visual_id_base;  ///< per link: visual j has id base + j
   };
-  /// A camera: free (mount_actor < 0 and mount_articulation < 0) or mounted.
-  struct CameraEntry {
-    int id;
-    std::string name;
-    int width, height;
-    double fx, fy, cx, cy, near, far;
-    Pose local_pose;
-    int mount_actor = -1;
-    int mount_articulation = -1;
-    int mount_link = -1;
-    Pose X_WC;  ///< world pose at the last UpdateRender
-    /// The last picture; shared with the numpy views Python holds, so that TakePicture renders
-    /// into a new one while an older one is still viewed.
-    std::shared_ptr<Picture> picture;
-    Pose picture_X_WC;  ///< the camera pose the picture was taken from
-  };
   std::vector<ActorEntry> actors;
   std::vector<ArticulationEntry> articulations;
 
@@ -114,8 +98,8 @@ struct SceneImpl {
   int use_depth = 0;  ///< nested Uses of the holding thread (guarded by use_mutex)
   /// Throws partsim::Error when a thread other than the caller holds the scene.
   void CheckUser() const;
-  /// ids of actors, articulations, links and cameras, scene-wide; 0 is no entity (background
-  /// in segmentation pictures)
+  /// ids of actors, articulations, links and cameras (NewEntityId), scene-wide; 0 is no entity
+  /// (background in segmentation pictures)
   int next_id = 1;
   /// Contacts MuJoCo's buffers hold (nconmax): grown by Step when a step fills them, kept
   /// across recompiles and clones; the compiler never goes below kBaseContacts.
@@ -133,27 +117,11 @@ struct SceneImpl {
   }
   uint32_t next_visual_id = 1;
 
-  // rendering
-  std::vector<CameraEntry> cameras;
-  std::vector<LightDesc> lights;
-  Eigen::Vector3f ambient = Eigen::Vector3f::Constant(0.1f);
-  std::unique_ptr<RenderBackend> render_backend;
-  RenderWorld render_world;
-  uint64_t description_version = 0;  ///< bumped whenever actors or articulations change
-  /// Where each render_world instance comes from (src/render/scene_render.cc): an actor, or a
-  /// link of an articulation, and the visual's pose in that body.
-  struct RenderSource {
-    int actor_id = -1;
-    int articulation_id = -1;
-    int link_index = -1;
-    Pose X_BV;
-  };
-  std::vector<RenderSource> render_sources;  ///< one per render_world.instances entry
-  bool render_world_built = false;           ///< UpdateRender has run at least once
-  uint64_t render_world_description = 0;     ///< description_version the instances follow
-  /// Meshes of primitive visuals by their parameters, kept across rebuilds so that the same
-  /// primitive keeps the same pointer (backends cache their buffers by pointer).
-  std::map<std::string, std::shared_ptr<const MeshData>> primitive_meshes;
+  /// bumped whenever actors or articulations change (GetDescriptionVersion)
+  uint64_t description_version = 0;
+  /// State of the subsystems that observe the scene (the renderer's cameras, lights and
+  /// backend), by key; physics only owns and clones them (partsim/physics/observer.h).
+  std::map<std::string, std::unique_ptr<SceneAttachment>> attachments;
 
   // model
   mjModel* m = nullptr;

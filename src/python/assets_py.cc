@@ -7,6 +7,7 @@
 #include "partsim/assets/mesh.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/assets/quality.h"
+#include "partsim/render/visibility.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/physics/scene.h"
 
@@ -255,8 +256,17 @@ void BindAssets(py::module_& m) {
       .def("passed", &ObjectQualityReport::Passed,
            "True when there is at least one check and every check passed.")
       .def("__str__", &ObjectQualityReport::ToString);
-  m.def("check_partnet_object", &CheckPartNetObject, py::arg("folder"),
-        py::arg("options") = QualityOptions(), py::call_guard<py::gil_scoped_release>(),
+  m.def(
+      "check_partnet_object",
+      [](const std::string& folder, QualityOptions options) {
+        // the visibility check renders through the render layer's finder
+        if (options.check_visibility && !options.hidden_parts)
+          options.hidden_parts =
+              HiddenMovingLinksFinder(options.render_backend, options.image_size);
+        return CheckPartNetObject(folder, options);
+      },
+      py::arg("folder"), py::arg("options") = QualityOptions(),
+      py::call_guard<py::gil_scoped_release>(),
         "Runs the quality checks (load, labels, rest, range, visible) on one folder and "
         "returns an ObjectQualityReport; never raises for a bad object (the failure is in the "
         "report). Releases the GIL.");

@@ -6,7 +6,7 @@
 
 #include "partsim/physics/scene.h"
 #include "partsim/render/backend.h"
-#include "physics/scene_internal.h"
+#include "render/render_state.h"
 
 namespace partsim {
 
@@ -22,13 +22,14 @@ void Scene::SetRenderBackend(const std::string& name) {
     throw Error("set_render_backend: unknown backend '" + name +
                 "' (expected rasterizer, pathtracer or null)");
   }
-  impl().render_backend = std::move(backend);
+  internal::RenderOf(*this).render_backend = std::move(backend);
 }
 
 RenderBackend& Scene::GetRenderBackend() {
   // the rasterizer is the default, created on first use
-  if (!impl().render_backend) impl().render_backend = MakeRasterBackend();
-  return *impl().render_backend;
+  internal::RenderState& s = internal::RenderOf(*this);
+  if (!s.render_backend) s.render_backend = MakeRasterBackend();
+  return *s.render_backend;
 }
 
 }  // namespace partsim

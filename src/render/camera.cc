@@ -11,20 +11,21 @@
 
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
-#include "physics/scene_internal.h"
 #include "render/picture_internal.h"
+#include "render/render_state.h"
 
 namespace partsim {
 
-using internal::SceneImpl;
+using internal::CameraEntry;
+using internal::RenderOf;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-SceneImpl::CameraEntry& Entry(Scene* scene, int id) {
+CameraEntry& Entry(Scene* scene, int id) {
   if (!scene) throw Error("empty camera handle: it does not belong to a scene");
-  for (auto& c : scene->impl().cameras)
+  for (auto& c : RenderOf(*scene).cameras)
     if (c.id == id) return c;
   throw Error("camera " + std::to_string(id) + " does not exist (it was removed)");
 }
@@ -35,14 +36,14 @@ std::string Num(double v) {
   return buf;
 }
 
-const Picture& PictureOf(const SceneImpl::CameraEntry& c) {
+const Picture& PictureOf(const CameraEntry& c) {
   if (!c.picture)
     throw Error("camera '" + c.name + "': no picture yet (call take_picture() first)");
   return *c.picture;
 }
 
 // the last picture, checked to hold output `bit` (named `name`)
-const Picture& PictureWith(const SceneImpl::CameraEntry& c, unsigned bit, const char* name) {
+const Picture& PictureWith(const CameraEntry& c, unsigned bit, const char* name) {
   const Picture& p = PictureOf(c);
   if (!(p.outputs & bit))
     throw Error("camera '" + c.name + "': picture '" + name +
@@ -86,7 +87,7 @@ double Camera::GetNear() const { return Entry(scene_, id_).near; }
 double Camera::GetFar() const { return Entry(scene_, id_).far; }
 
 void Camera::SetNearFar(double near, double far) {
-  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  CameraEntry& c = Entry(scene_, id_);
   if (!std::isfinite(near) || near <= 0)
     throw Error("camera '" + c.name + "': near must be finite and > 0, got " + Num(near));
   if (!std::isfinite(far) || far <= near)
@@ -97,7 +98,7 @@ void Camera::SetNearFar(double near, double far) {
 }
 
 void Camera::SetFovy(double fovy) {
-  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  CameraEntry& c = Entry(scene_, id_);
   if (!std::isfinite(fovy) || fovy <= 0 || fovy >= kPi)
     throw Error("camera '" + c.name + "': fovy must be in (0, pi) radians, got " + Num(fovy));
   Eigen::Matrix3d K = IntrinsicsFromFovy(c.width, c.height, fovy);
@@ -108,17 +109,17 @@ void Camera::SetFovy(double fovy) {
 }
 
 double Camera::GetFovy() const {
-  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  const CameraEntry& c = Entry(scene_, id_);
   return 2 * std::atan(0.5 * c.height / c.fy);
 }
 
 double Camera::GetFovx() const {
-  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  const CameraEntry& c = Entry(scene_, id_);
   return 2 * std::atan(0.5 * c.width / c.fx);
 }
 
 void Camera::SetIntrinsics(double fx, double fy, double cx, double cy) {
-  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  CameraEntry& c = Entry(scene_, id_);
   std::string what = "camera '" + c.name + "': ";
   if (!std::isfinite(fx) || fx <= 0)
     throw Error(what + "fx must be finite and > 0, got " + Num(fx));
@@ -133,7 +134,7 @@ void Camera::SetIntrinsics(double fx, double fy, double cx, double cy) {
 }
 
 Eigen::Matrix3d Camera::GetIntrinsicMatrix() const {
-  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  const CameraEntry& c = Entry(scene_, id_);
   Eigen::Matrix3d K;
   K << c.fx, 0, c.cx,  //
       0, c.fy, c.cy,   //
@@ -159,7 +160,7 @@ Eigen::Matrix4d Camera::GetModelMatrix() const {
 }
 
 Eigen::Matrix4d Camera::GetProjectionMatrix() const {
-  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  const CameraEntry& c = Entry(scene_, id_);
   return ProjectionFromIntrinsics(GetIntrinsicMatrix(), c.width, c.height, c.near, c.far);
 }
 
@@ -177,7 +178,7 @@ void Camera::LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
 }
 
 void Camera::SetLocalPose(const Pose& pose) {
-  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  CameraEntry& c = Entry(scene_, id_);
   if (!pose.IsValid())
     throw Error("camera '" + c.name +
                 "': pose must hold finite numbers and a unit quaternion, got " + pose.ToString());
@@ -195,7 +196,7 @@ Pose Camera::GetLocalPose() const { return Entry(scene_, id_).local_pose; }
 namespace {
 
 // remounts camera `c` on a parent now at X_WP (identity for the world)
-void Remount(SceneImpl::CameraEntry& c, const Pose& X_WP, bool keep_pose) {
+void Remount(CameraEntry& c, const Pose& X_WP, bool keep_pose) {
   if (keep_pose) {
     c.local_pose = X_WP.Inverse() * c.X_WC;
   } else {
@@ -207,20 +208,20 @@ void Remount(SceneImpl::CameraEntry& c, const Pose& X_WP, bool keep_pose) {
 }  // namespace
 
 void Camera::SetParent(const Actor& parent, bool keep_pose) {
-  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  CameraEntry& c = Entry(scene_, id_);
   if (parent.GetScene() != scene_)
     throw Error("camera '" + c.name + "': set_parent: the actor belongs to another scene");
-  scene_->impl().GetActor(parent.GetId());  // throws when removed
-  Remount(c, parent.GetPose(), keep_pose);
+  Remount(c, parent.GetPose(), keep_pose);  // GetPose throws when the actor was removed
   c.mount_actor = parent.GetId();
 }
 
 void Camera::SetParent(const Link& parent, bool keep_pose) {
-  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  CameraEntry& c = Entry(scene_, id_);
   if (parent.GetScene() != scene_)
     throw Error("camera '" + c.name + "': set_parent: the link belongs to another scene");
-  const auto& art = scene_->impl().GetArticulation(parent.GetArticulationId());
-  if (parent.GetIndex() < 0 || parent.GetIndex() >= static_cast<int>(art.desc.links.size()))
+  // throws when the articulation was removed
+  const size_t links = Articulation(scene_, parent.GetArticulationId()).GetLinks().size();
+  if (parent.GetIndex() < 0 || parent.GetIndex() >= static_cast<int>(links))
     throw Error("camera '" + c.name + "': set_parent: link index " +
                 std::to_string(parent.GetIndex()) + " out of range");
   Remount(c, parent.GetPose(), keep_pose);
@@ -231,12 +232,12 @@ void Camera::SetParent(const Link& parent, bool keep_pose) {
 void Camera::ClearParent(bool keep_pose) { Remount(Entry(scene_, id_), Pose(), keep_pose); }
 
 void Camera::TakePicture(unsigned outputs) {
-  SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  CameraEntry& c = Entry(scene_, id_);
   if (outputs == 0 || (outputs & ~unsigned{kAllOutputs}) != 0)
     throw Error("camera '" + c.name + "': take_picture outputs must name at least one of " +
                 "Color, Albedo, Normal, Position, Segmentation (PictureOutput bits 1 to 31), got " +
                 std::to_string(outputs));
-  SceneImpl& s = scene_->impl();
+  internal::RenderState& s = RenderOf(*scene_);
   // the first picture of a scene needs a render world: build it now
   if (!s.render_world_built) scene_->UpdateRender();
   RenderBackend& backend = scene_->GetRenderBackend();
@@ -275,13 +276,13 @@ void Camera::TakePicture(unsigned outputs) {
 const Picture& Camera::GetPictureData() const { return PictureOf(Entry(scene_, id_)); }
 
 std::shared_ptr<const Picture> Camera::GetSharedPicture() const {
-  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  const CameraEntry& c = Entry(scene_, id_);
   PictureOf(c);
   return c.picture;
 }
 
 const std::vector<float>& Camera::GetFloatPicture(const std::string& name) const {
-  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  const CameraEntry& c = Entry(scene_, id_);
   if (!IsFloatPictureName(name))
     throw Error("camera '" + c.name + "': unknown picture name '" + name +
                 "' (float pictures: Color, Albedo, Normal, Position; uint32: Segmentation)");
@@ -293,7 +294,7 @@ const std::vector<float>& Camera::GetFloatPicture(const std::string& name) const
 }
 
 const std::vector<uint32_t>& Camera::GetUintPicture(const std::string& name) const {
-  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  const CameraEntry& c = Entry(scene_, id_);
   if (name != "Segmentation")
     throw Error("camera '" + c.name + "': unknown picture name '" + name +
                 "' (uint32 pictures: Segmentation; float: Color, Albedo, Normal, Position)");
@@ -309,7 +310,7 @@ std::vector<float> Camera::GetDepth() const {
 }
 
 CameraParams Camera::GetParams() const {
-  const SceneImpl::CameraEntry& c = Entry(scene_, id_);
+  const CameraEntry& c = Entry(scene_, id_);
   return MakeCameraParams(c.width, c.height, GetIntrinsicMatrix(), c.near, c.far, c.X_WC);
 }
 

@@ -16,7 +16,7 @@
 #include "partsim/core/error.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
-#include "physics/scene_internal.h"
+#include "render/render_state.h"
 
 namespace partsim {
 namespace {
@@ -190,7 +190,7 @@ PointCloud MakePointCloud(const Picture& picture, PointCloudFrame frame, const P
 PointCloud MakePointCloud(const Camera& camera, PointCloudFrame frame) {
   const Picture& picture = camera.GetPictureData();
   Pose X_WC;
-  for (const auto& c : camera.GetScene()->impl().cameras)
+  for (const auto& c : internal::RenderOf(*camera.GetScene()).cameras)
     if (c.id == camera.GetId()) X_WC = c.picture_X_WC;
   return MakePointCloud(picture, frame, X_WC);
 }

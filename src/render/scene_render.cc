@@ -9,14 +9,17 @@
 #include <utility>
 #include <vector>
 
+#include "partsim/physics/observer.h"
 #include "partsim/physics/scene.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
-#include "physics/scene_internal.h"
+#include "render/render_state.h"
 
 namespace partsim {
 
-using internal::SceneImpl;
+using internal::CameraEntry;
+using internal::RenderSource;
+using internal::RenderState;
 
 namespace {
 
@@ -66,10 +69,10 @@ Eigen::Vector3d CheckDirection(const std::string& what, const Eigen::Vector3d& d
   return d.normalized();
 }
 
-SceneImpl::CameraEntry MakeEntry(int id, const std::string& name, int width, int height,
-                                 double fovy, double near, double far) {
+CameraEntry MakeEntry(int id, const std::string& name, int width, int height, double fovy,
+                      double near, double far) {
   double f = 0.5 * height / std::tan(0.5 * fovy);
-  SceneImpl::CameraEntry c{};
+  CameraEntry c{};
   c.id = id;
   c.name = name;
   c.width = width;
@@ -107,30 +110,49 @@ bool SameGeometry(const std::vector<RenderInstance>& a, const std::vector<Render
 }
 
 // World pose of a camera's mount; false when the mount no longer exists.
-bool MountPose(Scene* scene, const SceneImpl::CameraEntry& c, Pose* X_WM) {
-  SceneImpl& s = scene->impl();
+bool MountPose(Scene* scene, const CameraEntry& c, Pose* X_WM) {
   if (c.mount_actor >= 0) {
-    for (const auto& a : s.actors)
-      if (a.id == c.mount_actor) {
-        *X_WM = Actor(scene, a.id).GetPose();
-        return true;
-      }
-    return false;
+    if (!HasActor(*scene, c.mount_actor)) return false;
+    *X_WM = Actor(scene, c.mount_actor).GetPose();
+    return true;
   }
-  for (const auto& a : s.articulations)
-    if (a.id == c.mount_articulation) {
-      if (c.mount_link >= static_cast<int>(a.desc.links.size())) return false;
-      *X_WM = Link(scene, a.id, c.mount_link).GetPose();
-      return true;
-    }
-  return false;
+  if (!HasArticulation(*scene, c.mount_articulation)) return false;
+  if (c.mount_link >= static_cast<int>(Articulation(scene, c.mount_articulation).GetLinks().size()))
+    return false;
+  *X_WM = Link(scene, c.mount_articulation, c.mount_link).GetPose();
+  return true;
 }
 
-bool IsMounted(const SceneImpl::CameraEntry& c) {
-  return c.mount_actor >= 0 || c.mount_articulation >= 0;
-}
+bool IsMounted(const CameraEntry& c) { return c.mount_actor >= 0 || c.mount_articulation >= 0; }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// the render state attached to each scene
+
+namespace internal {
+
+std::unique_ptr<SceneAttachment> RenderState::CloneFor(Scene&) const {
+  auto copy = std::make_unique<RenderState>();
+  copy->lights = lights;
+  copy->ambient = ambient;
+  for (const CameraEntry& cam : cameras) {
+    CameraEntry c = cam;
+    c.picture.reset();
+    c.picture_X_WC = Pose();
+    copy->cameras.push_back(std::move(c));
+  }
+  return copy;
+}
+
+RenderState& RenderOf(const Scene& scene) {
+  return static_cast<RenderState&>(
+      GetAttachment(scene, "render", [] { return std::make_unique<RenderState>(); }));
+}
+
+}  // namespace internal
+
+using internal::RenderOf;
 
 // ---------------------------------------------------------------------------------------------
 // cameras
@@ -138,9 +160,8 @@ bool IsMounted(const SceneImpl::CameraEntry& c) {
 Camera Scene::AddCamera(const std::string& name, int width, int height, double fovy, double near,
                         double far) {
   CheckCameraArgs("add_camera '" + name + "'", width, height, fovy, near, far);
-  Impl& s = impl();
-  int id = s.next_id++;
-  s.cameras.push_back(MakeEntry(id, name, width, height, fovy, near, far));
+  int id = NewEntityId(*this);
+  RenderOf(*this).cameras.push_back(MakeEntry(id, name, width, height, fovy, near, far));
   return Camera(this, id);
 }
 
@@ -150,12 +171,11 @@ Camera Scene::AddMountedCamera(const std::string& name, const Actor& mount, cons
   CheckCameraArgs(what, width, height, fovy, near, far);
   CheckPose(what + ": local_pose", local_pose);
   if (mount.GetScene() != this) throw Error(what + ": the mount actor belongs to another scene");
-  Impl& s = impl();
-  s.GetActor(mount.GetId());  // throws when removed
-  // the pose is known at once, before the first UpdateRender
+  // the pose is known at once, before the first UpdateRender (GetPose throws when removed)
   Pose X_WC = mount.GetPose() * local_pose;
-  int id = s.next_id++;
-  SceneImpl::CameraEntry c = MakeEntry(id, name, width, height, fovy, near, far);
+  RenderState& s = RenderOf(*this);
+  int id = NewEntityId(*this);
+  CameraEntry c = MakeEntry(id, name, width, height, fovy, near, far);
   c.local_pose = local_pose;
   c.mount_actor = mount.GetId();
   c.X_WC = X_WC;
@@ -169,13 +189,14 @@ Camera Scene::AddMountedCamera(const std::string& name, const Link& mount, const
   CheckCameraArgs(what, width, height, fovy, near, far);
   CheckPose(what + ": local_pose", local_pose);
   if (mount.GetScene() != this) throw Error(what + ": the mount link belongs to another scene");
-  Impl& s = impl();
-  const auto& art = s.GetArticulation(mount.GetArticulationId());
-  if (mount.GetIndex() < 0 || mount.GetIndex() >= static_cast<int>(art.desc.links.size()))
+  // throws when the articulation was removed
+  const size_t links = Articulation(this, mount.GetArticulationId()).GetLinks().size();
+  if (mount.GetIndex() < 0 || mount.GetIndex() >= static_cast<int>(links))
     throw Error(what + ": link index " + std::to_string(mount.GetIndex()) + " out of range");
   Pose X_WC = mount.GetPose() * local_pose;
-  int id = s.next_id++;
-  SceneImpl::CameraEntry c = MakeEntry(id, name, width, height, fovy, near, far);
+  RenderState& s = RenderOf(*this);
+  int id = NewEntityId(*this);
+  CameraEntry c = MakeEntry(id, name, width, height, fovy, near, far);
   c.local_pose = local_pose;
   c.mount_articulation = mount.GetArticulationId();
   c.mount_link = mount.GetIndex();
@@ -185,7 +206,7 @@ Camera Scene::AddMountedCamera(const std::string& name, const Link& mount, const
 }
 
 void Scene::RemoveCamera(const Camera& camera) {
-  Impl& s = impl();
+  RenderState& s = RenderOf(*this);
   for (auto it = s.cameras.begin(); it != s.cameras.end(); ++it)
     if (it->id == camera.GetId() && camera.GetScene() == this) {
       s.cameras.erase(it);
@@ -197,7 +218,7 @@ void Scene::RemoveCamera(const Camera& camera) {
 
 std::vector<Camera> Scene::GetCameras() const {
   std::vector<Camera> out;
-  for (const auto& c : impl().cameras) out.emplace_back(const_cast<Scene*>(this), c.id);
+  for (const auto& c : RenderOf(*this).cameras) out.emplace_back(const_cast<Scene*>(this), c.id);
   return out;
 }
 
@@ -212,8 +233,8 @@ void Scene::AddDirectionalLight(const Eigen::Vector3d& direction, const Eigen::V
   CheckColor("add_directional_light", color);
   l.color = color;
   l.shadow = shadow;
-  l.name = "directional_" + std::to_string(impl().lights.size());
-  impl().lights.push_back(l);
+  l.name = "directional_" + std::to_string(RenderOf(*this).lights.size());
+  RenderOf(*this).lights.push_back(l);
 }
 
 void Scene::AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f& color) {
@@ -224,8 +245,8 @@ void Scene::AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f
   l.type = LightType::kPoint;
   l.position = position;
   l.color = color;
-  l.name = "point_" + std::to_string(impl().lights.size());
-  impl().lights.push_back(l);
+  l.name = "point_" + std::to_string(RenderOf(*this).lights.size());
+  RenderOf(*this).lights.push_back(l);
 }
 
 void Scene::AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d& direction,
@@ -248,40 +269,39 @@ void Scene::AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d&
   l.outer_angle = outer_angle;
   l.color = color;
   l.shadow = shadow;
-  l.name = "spot_" + std::to_string(impl().lights.size());
-  impl().lights.push_back(l);
+  l.name = "spot_" + std::to_string(RenderOf(*this).lights.size());
+  RenderOf(*this).lights.push_back(l);
 }
 
 void Scene::SetAmbientLight(const Eigen::Vector3f& color) {
   CheckColor("set_ambient_light", color);
-  impl().ambient = color;
+  RenderOf(*this).ambient = color;
 }
 
-const std::vector<LightDesc>& Scene::GetLights() const { return impl().lights; }
+const std::vector<LightDesc>& Scene::GetLights() const { return RenderOf(*this).lights; }
 
 // ---------------------------------------------------------------------------------------------
 // backend (by name: backend_registry.cc)
 
 void Scene::SetRenderBackend(std::unique_ptr<RenderBackend> backend) {
   if (!backend) throw Error("set_render_backend: backend is null");
-  impl().render_backend = std::move(backend);
+  RenderOf(*this).render_backend = std::move(backend);
 }
 
 // ---------------------------------------------------------------------------------------------
 // render world
 
 void Scene::UpdateRender() {
-  Impl& s = impl();
-  s.EnsureCompiled();
+  RenderState& s = RenderOf(*this);
+  const uint64_t version = GetDescriptionVersion(*this);  // compiles pending additions
   RenderWorld& world = s.render_world;
 
   // rebuild the instances when actors or articulations changed
-  if (!s.render_world_built || s.render_world_description != s.description_version) {
+  if (!s.render_world_built || s.render_world_description != version) {
     std::map<std::string, std::shared_ptr<const MeshData>> cache;
     std::vector<RenderInstance> instances;
-    std::vector<SceneImpl::RenderSource> sources;
-    auto add = [&](const VisualShape& v, uint32_t visual_id, uint32_t entity_id,
-                   SceneImpl::RenderSource src) {
+    std::vector<RenderSource> sources;
+    auto add = [&](const VisualShape& v, uint32_t visual_id, uint32_t entity_id, RenderSource src) {
       RenderInstance inst;
       if (v.type == ShapeType::kConvexMesh) {
         if (!v.mesh) return;
@@ -302,23 +322,13 @@ void Scene::UpdateRender() {
       instances.push_back(std::move(inst));
       sources.push_back(src);
     };
-    for (const auto& a : s.actors) {
-      for (size_t j = 0; j < a.desc.visuals.size(); ++j) {
-        SceneImpl::RenderSource src;
-        src.actor_id = a.id;
-        add(a.desc.visuals[j], a.visual_id_base + static_cast<uint32_t>(j), a.render_id, src);
-      }
-    }
-    for (const auto& a : s.articulations) {
-      for (size_t i = 0; i < a.desc.links.size(); ++i) {
-        const LinkDesc& l = a.desc.links[i];
-        for (size_t j = 0; j < l.visuals.size(); ++j) {
-          SceneImpl::RenderSource src;
-          src.articulation_id = a.id;
-          src.link_index = static_cast<int>(i);
-          add(l.visuals[j], a.visual_id_base[i] + static_cast<uint32_t>(j),
-              a.render_id_base + static_cast<uint32_t>(i), src);
-        }
+    for (const VisualBody& b : GetVisualBodies(*this)) {
+      for (size_t j = 0; j < b.visuals.size(); ++j) {
+        RenderSource src;
+        src.actor_id = b.actor_id;
+        src.articulation_id = b.articulation_id;
+        src.link_index = b.link_index;
+        add(b.visuals[j], b.visual_id_base + static_cast<uint32_t>(j), b.entity_id, src);
       }
     }
     // the version changes exactly when meshes, materials or ids change
@@ -327,7 +337,7 @@ void Scene::UpdateRender() {
     world.instances = std::move(instances);
     s.render_sources = std::move(sources);
     s.primitive_meshes = std::move(cache);
-    s.render_world_description = s.description_version;
+    s.render_world_description = version;
     s.render_world_built = true;
   }
 
@@ -335,7 +345,7 @@ void Scene::UpdateRender() {
   Pose X_WB;
   std::tuple<int, int, int> last_body(-2, -2, -2);
   for (size_t k = 0; k < world.instances.size(); ++k) {
-    const SceneImpl::RenderSource& src = s.render_sources[k];
+    const RenderSource& src = s.render_sources[k];
     std::tuple<int, int, int> body(src.actor_id, src.articulation_id, src.link_index);
     if (body != last_body) {
       X_WB = src.actor_id >= 0 ? Actor(this, src.actor_id).GetPose()
@@ -363,47 +373,33 @@ void Scene::UpdateRender() {
   }
 }
 
-const RenderWorld& Scene::GetRenderWorld() const { return impl().render_world; }
+const RenderWorld& Scene::GetRenderWorld() const { return RenderOf(*this).render_world; }
 
 std::vector<RenderEntityInfo> Scene::GetRenderEntities() const {
   std::vector<RenderEntityInfo> out;
-  for (const auto& a : impl().actors) {
+  for (const VisualBody& b : GetVisualBodies(*this)) {
     RenderEntityInfo e;
-    e.id = a.render_id;
-    e.is_link = false;
-    e.name = a.desc.name;
-    e.actor_id = a.id;
-    e.semantic_label = a.desc.semantic_label;
-    out.push_back(std::move(e));
-  }
-  for (const auto& a : impl().articulations) {
-    for (size_t i = 0; i < a.desc.links.size(); ++i) {
-      RenderEntityInfo e;
-      e.id = a.render_id_base + static_cast<uint32_t>(i);
-      e.is_link = true;
-      e.name = a.desc.links[i].name;
-      e.articulation_id = a.id;
-      e.link_index = static_cast<int>(i);
-      e.articulation_name = a.desc.name;
-      e.semantic_label = a.desc.links[i].semantic_label;
-      out.push_back(std::move(e));
+    e.id = b.entity_id;
+    e.is_link = b.actor_id < 0;
+    e.name = b.name;
+    if (e.is_link) {
+      e.articulation_id = b.articulation_id;
+      e.link_index = b.link_index;
+      e.articulation_name = b.articulation_name;
+    } else {
+      e.actor_id = b.actor_id;
     }
+    e.semantic_label = b.semantic_label;
+    out.push_back(std::move(e));
   }
   return out;
 }
 
 std::vector<RenderVisualInfo> Scene::GetRenderVisuals() const {
   std::vector<RenderVisualInfo> out;
-  for (const auto& a : impl().actors)
-    for (size_t j = 0; j < a.desc.visuals.size(); ++j)
-      out.push_back(
-          {a.visual_id_base + static_cast<uint32_t>(j), a.render_id, a.desc.visuals[j].name});
-  for (const auto& a : impl().articulations)
-    for (size_t i = 0; i < a.desc.links.size(); ++i)
-      for (size_t j = 0; j < a.desc.links[i].visuals.size(); ++j)
-        out.push_back({a.visual_id_base[i] + static_cast<uint32_t>(j),
-                       a.render_id_base + static_cast<uint32_t>(i),
-                       a.desc.links[i].visuals[j].name});
+  for (const VisualBody& b : GetVisualBodies(*this))
+    for (size_t j = 0; j < b.visuals.size(); ++j)
+      out.push_back({b.visual_id_base + static_cast<uint32_t>(j), b.entity_id, b.visuals[j].name});
   return out;
 }
 

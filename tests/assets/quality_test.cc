@@ -4,6 +4,8 @@
 
 #include "assets/partnet_test_folder.h"
 #include "partsim/assets/generator.h"
+#include "partsim/core/error.h"
+#include "partsim/render/visibility.h"
 
 namespace partsim {
 namespace {
@@ -13,6 +15,12 @@ using testing::Folder;
 using testing::Write;
 namespace fs = std::filesystem;
 
+// CheckPartNetObject with the render layer's visibility check, as the command line runs it
+ObjectQualityReport Check(const std::string& folder, QualityOptions o = QualityOptions()) {
+  o.hidden_parts = HiddenMovingLinksFinder(o.render_backend, o.image_size);
+  return CheckPartNetObject(folder, o);
+}
+
 const QualityCheck* Find(const ObjectQualityReport& r, const std::string& name) {
   for (const QualityCheck& c : r.checks)
     if (c.name == name) return &c;
@@ -21,7 +29,7 @@ const QualityCheck* Find(const ObjectQualityReport& r, const std::string& name) 
 
 TEST(QualityTest, AGoodObjectPassesEveryCheck) {
   Folder f("quality_good");
-  ObjectQualityReport r = CheckPartNetObject(f.Path());
+  ObjectQualityReport r = Check(f.Path());
   EXPECT_TRUE(r.Passed()) << r.ToString();
   EXPECT_EQ(r.category, "StorageFurniture");
   EXPECT_EQ(r.movable_parts, 2);
@@ -42,7 +50,7 @@ TEST(QualityTest, APartThatJamsFailsTheRangeCheck) {
   f.WriteAll();
   // in the door's frame, at the hinge: body (0, -0.2, 0.27) is (0.3, -0.4, 0.06)
   Write(f.dir / "textured_objs/original-5.obj", BoxObj({0.3, -0.4, 0.06}, {0.2, 0.05, 0.02}));
-  ObjectQualityReport r = CheckPartNetObject(f.Path());
+  ObjectQualityReport r = Check(f.Path());
   EXPECT_FALSE(r.Passed());
   const QualityCheck* range = Find(r, "range");
   ASSERT_NE(range, nullptr);
@@ -64,7 +72,7 @@ TEST(QualityTest, AHiddenPartFailsTheVisibilityCheck) {
   Write(f.dir / "textured_objs/original-6.obj", BoxObj({0, 0, 0.1}, {0.7, 0.8, 0.7}));
   QualityOptions o;
   o.image_size = 48;
-  ObjectQualityReport r = CheckPartNetObject(f.Path(), o);
+  ObjectQualityReport r = Check(f.Path(), o);
   const QualityCheck* visible = Find(r, "visible");
   ASSERT_NE(visible, nullptr) << r.ToString();
   EXPECT_FALSE(visible->passed) << r.ToString();
@@ -77,7 +85,7 @@ TEST(QualityTest, AStiffHingeThatAStrongerDriveOpensPassesWithTheForceItNeeded) 
   f.urdf.replace(f.urdf.find("<limit lower=\"-1.5707963267948966\""), 0,
                  "<dynamics friction=\"3\"/>");
   f.WriteAll();
-  ObjectQualityReport r = CheckPartNetObject(f.Path());
+  ObjectQualityReport r = Check(f.Path());
   const QualityCheck* range = Find(r, "range");
   ASSERT_NE(range, nullptr) << r.ToString();
   EXPECT_TRUE(range->passed) << r.ToString();
@@ -89,7 +97,7 @@ TEST(QualityTest, AnInconsistentFolderFailsTheLabelsCheckWithTheReason) {
   Folder f("quality_bad");
   f.semantics = "link_0 slider rotation_door\nlink_1 slider drawer\nlink_2 heavy furniture_body\n";
   f.WriteAll();
-  ObjectQualityReport r = CheckPartNetObject(f.Path());
+  ObjectQualityReport r = Check(f.Path());
   EXPECT_FALSE(r.Passed());
   const QualityCheck* labels = Find(r, "labels");
   ASSERT_NE(labels, nullptr) << r.ToString();
@@ -102,7 +110,7 @@ TEST(QualityTest, AnInconsistentFolderFailsTheLabelsCheckWithTheReason) {
   // a folder that cannot be read fails to load, with the reason
   Folder g("quality_unreadable");
   Write(g.dir / "mobility_v2.json", "[");
-  r = CheckPartNetObject(g.Path());
+  r = Check(g.Path());
   ASSERT_FALSE(r.checks.empty());
   EXPECT_EQ(r.checks[0].name, "load");
   EXPECT_NE(r.checks[0].detail.find("mobility_v2.json"), std::string::npos);
@@ -116,7 +124,7 @@ TEST(QualityTest, AGeneratedObjectOfEveryCategoryPassesEveryCheck) {
   for (const std::string& category : GeneratorCategories()) {
     fs::path dir = root / category;
     WriteObject(GenerateObject(category, 0, 2026), dir.string());
-    ObjectQualityReport r = CheckPartNetObject(dir.string());
+    ObjectQualityReport r = Check(dir.string());
     EXPECT_EQ(r.category, category);
     if (!r.Passed()) failures.push_back(r.ToString());
     stats.Add(r.category, r.movable_parts);
@@ -145,6 +153,30 @@ TEST(QualityTest, StatisticsTableMatchesThePapersTotals) {
   std::string table = stats.ToTable();
   EXPECT_NE(table.find("Door"), std::string::npos);
   EXPECT_NE(table.find("2346"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace partsim
+
+namespace partsim {
+namespace {
+
+// The assets layer does not render: without a finder the visibility check is refused, and with
+// check_visibility off the other checks run without one.
+TEST(QualityTest, TheVisibilityCheckNeedsTheRenderLayersFinder) {
+  Folder f("quality_no_finder");
+  f.WriteAll();
+  QualityOptions o;
+  try {
+    CheckPartNetObject(f.Path(), o);
+    FAIL() << "a visibility check without a finder was run";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("hidden_parts"), std::string::npos) << e.what();
+  }
+  o.check_visibility = false;
+  ObjectQualityReport r = CheckPartNetObject(f.Path(), o);
+  EXPECT_TRUE(r.Passed()) << r.ToString();
+  EXPECT_EQ(Find(r, "visible"), nullptr);
 }
 
 }  // namespace

@@ -1,9 +1,12 @@
 // Quality checks of articulated objects in PartNet-Mobility folders, and dataset statistics.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
+
+#include "partsim/physics/scene.h"
 
 namespace partsim {
 
@@ -16,6 +19,12 @@ struct QualityOptions {
   bool check_visibility = true;  ///< render segmentation from several viewpoints
   std::string render_backend = "rasterizer";
   int image_size = 96;  ///< pixels per side of the visibility views
+  /// The renderer behind the visibility check: the names of the object's moving links that no
+  /// view shows (it may throw partsim::Error, which fails the check). The assets layer does not
+  /// render; set it to HiddenMovingLinksFinder(render_backend, image_size) of
+  /// partsim/render/visibility.h (the command line and Python do). Needed when
+  /// check_visibility is set: CheckPartNetObject throws partsim::Error without it.
+  std::function<std::vector<std::string>(Scene&, const Articulation&)> hidden_parts;
 };
 
 /// The outcome of one check.
