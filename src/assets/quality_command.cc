@@ -18,8 +18,8 @@
 #include "core/progress.h"
 #include "partsim/assets/generator.h"
 #include "partsim/assets/quality.h"
-#include "partsim/render/visibility.h"
 #include "partsim/core/error.h"
+#include "partsim/render/visibility.h"
 
 namespace partsim {
 
