@@ -890,7 +890,7 @@ class ControlLoop:
 
 
 class Controller:
-    """Base class of the controllers: a controller of some joints of one articulation. Bad input (wrong sizes, NaN) raises PartsimError and changes nothing; an unreachable target sets status FAILED."""
+    """Base class of the controllers: a controller of some joints of one articulation. Bad input (wrong sizes, NaN, a setting out of range, named with its value) raises PartsimError and changes nothing; an unreachable target sets status FAILED."""
     def get_dofs(self) -> typing.List[int]:
         """Indices of the controlled joints' dofs in the articulation's qpos."""
         ...
@@ -1035,25 +1035,25 @@ class EndEffectorController(Controller):
     def ik(self, value: IkOptions) -> None: ...
     @property
     def max_angular_speed(self) -> float:
-        """Pose targets are turned to no faster than this, rad/s (default 1.5)."""
+        """Pose targets are turned to no faster than this, rad/s, > 0 (default 1.5)."""
         ...
     @max_angular_speed.setter
     def max_angular_speed(self, value: float) -> None: ...
     @property
     def max_linear_speed(self) -> float:
-        """Pose targets are approached no faster than this, m/s (default 0.5)."""
+        """Pose targets are approached no faster than this, m/s, > 0 (default 0.5); checked with the other settings when a target is set and at each update."""
         ...
     @max_linear_speed.setter
     def max_linear_speed(self, value: float) -> None: ...
     @property
     def position_tolerance(self) -> float:
-        """Position tolerance of the measured frame for REACHED, m (default 2e-3)."""
+        """Position tolerance of the measured frame for REACHED, m, > 0 (default 2e-3)."""
         ...
     @position_tolerance.setter
     def position_tolerance(self, value: float) -> None: ...
     @property
     def rotation_tolerance(self) -> float:
-        """Rotation tolerance of the measured frame for REACHED, rad (default 1.5e-2)."""
+        """Rotation tolerance of the measured frame for REACHED, rad, > 0 (default 1.5e-2)."""
         ...
     @rotation_tolerance.setter
     def rotation_tolerance(self, value: float) -> None: ...
@@ -1424,25 +1424,25 @@ class Joint:
 
 
 class JointControllerOptions:
-    """Common settings of the joint controllers."""
+    """Common settings of the joint controllers; a controller made with one out of range raises PartsimError naming it and its value."""
     def __init__(self) -> None:
         """The defaults."""
         ...
     @property
     def control_rate(self) -> float:
-        """Update rate in Hz (default 100): the controller updates every round(1 / (rate * timestep)) physics steps."""
+        """Update rate in Hz, finite and > 0 (default 100): the controller updates every round(1 / (rate * timestep)) physics steps."""
         ...
     @control_rate.setter
     def control_rate(self, value: float) -> None: ...
     @property
     def damping(self) -> float:
-        """PD damping written to the joints' drives, N s/m or N m s/rad (default 1e3)."""
+        """PD damping written to the joints' drives, N s/m or N m s/rad, finite and >= 0 (default 1e3)."""
         ...
     @damping.setter
     def damping(self, value: float) -> None: ...
     @property
     def force_limit(self) -> float:
-        """Per-joint force limit, N or N m (default inf); also clamps efforts."""
+        """Per-joint force limit, N or N m, > 0 (default inf); also clamps efforts."""
         ...
     @force_limit.setter
     def force_limit(self, value: float) -> None: ...
@@ -1454,25 +1454,25 @@ class JointControllerOptions:
     def gravity_compensation(self, value: bool) -> None: ...
     @property
     def position_tolerance(self) -> float:
-        """Position tolerance for REACHED, rad or m (default 1e-2)."""
+        """Position tolerance for REACHED, rad or m, > 0 (default 1e-2)."""
         ...
     @position_tolerance.setter
     def position_tolerance(self, value: float) -> None: ...
     @property
     def stiffness(self) -> float:
-        """PD stiffness written to the joints' drives, N/m or N m/rad (default 1e4)."""
+        """PD stiffness written to the joints' drives, N/m or N m/rad, finite and >= 0 (default 1e4)."""
         ...
     @stiffness.setter
     def stiffness(self, value: float) -> None: ...
     @property
     def timeout(self) -> float:
-        """Seconds without reaching the target before FAILED (default 5)."""
+        """Seconds without reaching the target before FAILED, > 0 (default 5)."""
         ...
     @timeout.setter
     def timeout(self, value: float) -> None: ...
     @property
     def velocity_tolerance(self) -> float:
-        """Velocity tolerance for REACHED, rad/s or m/s (default 5e-2)."""
+        """Velocity tolerance for REACHED, rad/s or m/s, > 0 (default 5e-2)."""
         ...
     @velocity_tolerance.setter
     def velocity_tolerance(self, value: float) -> None: ...
@@ -1651,7 +1651,7 @@ class JointTrajectoryController(Controller):
         ...
     @property
     def path_tolerance(self) -> float:
-        """Largest tracking error before FAILED, rad or m (default 0.1)."""
+        """Largest tracking error before FAILED, rad or m, > 0 (default 0.1); checked by set_trajectory and at each update."""
         ...
     @path_tolerance.setter
     def path_tolerance(self, value: float) -> None: ...

@@ -9,6 +9,7 @@
 
 #include "bindings.h"
 #include "partsim/robot/controllers.h"
+#include "partsim/robot/imu.h"
 #include "partsim/robot/kinematics.h"
 #include "partsim/robot/trajectory.h"
 
@@ -145,26 +146,31 @@ void BindControl(py::module_& m) {
       });
 
   py::class_<JointControllerOptions>(m, "JointControllerOptions",
-                                     "Common settings of the joint controllers.")
+                                     "Common settings of the joint controllers; a controller "
+                                     "made with one out of range raises PartsimError naming "
+                                     "it and its value.")
       .def(py::init<>(), "The defaults.")
-      .def_readwrite("control_rate", &JointControllerOptions::control_rate,
-                     "Update rate in Hz (default 100): the controller updates every "
-                     "round(1 / (rate * timestep)) physics steps.")
+      .def_readwrite(
+          "control_rate", &JointControllerOptions::control_rate,
+          "Update rate in Hz, finite and > 0 (default 100): the controller updates every "
+          "round(1 / (rate * timestep)) physics steps.")
       .def_readwrite("gravity_compensation", &JointControllerOptions::gravity_compensation,
                      "Add the passive force (gravity, Coriolis) as qf (default True).")
       .def_readwrite("stiffness", &JointControllerOptions::stiffness,
-                     "PD stiffness written to the joints' drives, N/m or N m/rad (default 1e4).")
-      .def_readwrite("damping", &JointControllerOptions::damping,
-                     "PD damping written to the joints' drives, N s/m or N m s/rad (default "
-                     "1e3).")
+                     "PD stiffness written to the joints' drives, N/m or N m/rad, finite and >= 0 "
+                     "(default 1e4).")
+      .def_readwrite(
+          "damping", &JointControllerOptions::damping,
+          "PD damping written to the joints' drives, N s/m or N m s/rad, finite and >= 0 "
+          "(default 1e3).")
       .def_readwrite("force_limit", &JointControllerOptions::force_limit,
-                     "Per-joint force limit, N or N m (default inf); also clamps efforts.")
+                     "Per-joint force limit, N or N m, > 0 (default inf); also clamps efforts.")
       .def_readwrite("position_tolerance", &JointControllerOptions::position_tolerance,
-                     "Position tolerance for REACHED, rad or m (default 1e-2).")
+                     "Position tolerance for REACHED, rad or m, > 0 (default 1e-2).")
       .def_readwrite("velocity_tolerance", &JointControllerOptions::velocity_tolerance,
-                     "Velocity tolerance for REACHED, rad/s or m/s (default 5e-2).")
+                     "Velocity tolerance for REACHED, rad/s or m/s, > 0 (default 5e-2).")
       .def_readwrite("timeout", &JointControllerOptions::timeout,
-                     "Seconds without reaching the target before FAILED (default 5).");
+                     "Seconds without reaching the target before FAILED, > 0 (default 5).");
 
   using Names = std::vector<std::string>;
   const auto keep_robot = py::keep_alive<1, 2>();
@@ -172,9 +178,10 @@ void BindControl(py::module_& m) {
                                                       "Base class of the controllers: a "
                                                       "controller of some joints of one "
                                                       "articulation. Bad input (wrong sizes, "
-                                                      "NaN) raises PartsimError and changes "
-                                                      "nothing; an unreachable target sets "
-                                                      "status FAILED.")
+                                                      "NaN, a setting out of range, named "
+                                                      "with its value) raises PartsimError and "
+                                                      "changes nothing; an unreachable target "
+                                                      "sets status FAILED.")
       .def("get_name", &Controller::GetName, "The controller's name ('' unless set).")
       .def("set_name", &Controller::SetName, py::arg("name"), "Names the controller.")
       .def("num_joints", &Controller::NumJoints, "Number of controlled joints (one dof each).")
@@ -230,8 +237,10 @@ void BindControl(py::module_& m) {
       .def(py::init<const Articulation&, const Names&, const JointControllerOptions&>(),
            py::arg("robot"), py::arg("joints") = Names(),
            py::arg("options") = JointControllerOptions(), keep_robot)
-      .def_readwrite("path_tolerance", &JointTrajectoryController::path_tolerance,
-                     "Largest tracking error before FAILED, rad or m (default 0.1).")
+      .def_readwrite(
+          "path_tolerance", &JointTrajectoryController::path_tolerance,
+          "Largest tracking error before FAILED, rad or m, > 0 (default 0.1); checked by "
+          "set_trajectory and at each update.")
       .def("set_trajectory", &JointTrajectoryController::SetTrajectory, py::arg("trajectory"),
            "Follows a JointTrajectory whose times count from now; FAILED (nothing moves) when "
            "a waypoint lies outside the joint limits.")
@@ -256,13 +265,14 @@ void BindControl(py::module_& m) {
            py::arg("options") = JointControllerOptions(), keep_robot)
       .def_readwrite("ik", &EndEffectorController::ik, "IkOptions used for pose targets.")
       .def_readwrite("max_linear_speed", &EndEffectorController::max_linear_speed,
-                     "Pose targets are approached no faster than this, m/s (default 0.5).")
+                     "Pose targets are approached no faster than this, m/s, > 0 (default 0.5); "
+                     "checked with the other settings when a target is set and at each update.")
       .def_readwrite("max_angular_speed", &EndEffectorController::max_angular_speed,
-                     "Pose targets are turned to no faster than this, rad/s (default 1.5).")
+                     "Pose targets are turned to no faster than this, rad/s, > 0 (default 1.5).")
       .def_readwrite("position_tolerance", &EndEffectorController::position_tolerance,
-                     "Position tolerance of the measured frame for REACHED, m (default 2e-3).")
+                     "Position tolerance of the measured frame for REACHED, m, > 0 (default 2e-3).")
       .def_readwrite("rotation_tolerance", &EndEffectorController::rotation_tolerance,
-                     "Rotation tolerance of the measured frame for REACHED, rad (default "
+                     "Rotation tolerance of the measured frame for REACHED, rad, > 0 (default "
                      "1.5e-2).")
       .def("set_target_pose", &EndEffectorController::SetTargetPose, py::arg("target"),
            py::arg("frame") = ControlFrame::kWorld,

@@ -45,7 +45,32 @@ bool Done(ControllerState s) {
          s == ControllerState::kIdle;
 }
 
+// Checks of one setting: each throws naming `who`, the setting and its value. NaN fails all.
+void CheckPositive(const std::string& who, const char* setting, double value) {
+  if (!(value > 0)) throw Error(who + ": " + setting + " must be > 0, got " + Num(value));
+}
+
+void CheckFinitePositive(const std::string& who, const char* setting, double value) {
+  if (!(value > 0) || !std::isfinite(value))
+    throw Error(who + ": " + setting + " must be finite and > 0, got " + Num(value));
+}
+
+void CheckFiniteNonNegative(const std::string& who, const char* setting, double value) {
+  if (!(value >= 0) || !std::isfinite(value))
+    throw Error(who + ": " + setting + " must be finite and >= 0, got " + Num(value));
+}
+
 }  // namespace
+
+void JointControllerOptions::Validate(const std::string& who) const {
+  CheckFinitePositive(who, "control_rate", control_rate);
+  CheckFiniteNonNegative(who, "stiffness", stiffness);
+  CheckFiniteNonNegative(who, "damping", damping);
+  CheckPositive(who, "force_limit", force_limit);
+  CheckPositive(who, "position_tolerance", position_tolerance);
+  CheckPositive(who, "velocity_tolerance", velocity_tolerance);
+  CheckPositive(who, "timeout", timeout);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Controller
@@ -56,14 +81,7 @@ Controller::Controller(const Articulation& robot, const std::vector<std::string>
   const std::string who = "controller of '" + robot.GetName() + "'";
   if (robot.IsKinematic())
     throw Error(who + ": the articulation is kinematic; controllers drive dynamic ones");
-  if (!(options.control_rate > 0) || !std::isfinite(options.control_rate))
-    throw Error(who + ": control_rate must be finite and > 0");
-  if (!(options.stiffness >= 0) || !(options.damping >= 0) || !(options.force_limit > 0) ||
-      !std::isfinite(options.stiffness) || !std::isfinite(options.damping))
-    throw Error(who + ": stiffness and damping must be finite and >= 0, force_limit > 0");
-  if (!(options.position_tolerance > 0) || !(options.velocity_tolerance > 0) ||
-      !(options.timeout > 0))
-    throw Error(who + ": tolerances and timeout must be > 0");
+  options.Validate(who + ": options");
   if (joints.empty()) {
     for (const Joint& j : robot.GetActiveJoints()) {
       dofs_.push_back(j.GetDofIndex());
@@ -99,6 +117,8 @@ Eigen::VectorXd Controller::GetQvel() const {
   for (int i = 0; i < NumJoints(); ++i) out[i] = all[dofs_[i]];
   return out;
 }
+
+void Controller::CheckSettings() const { options_.Validate(name_ + ": options"); }
 
 void Controller::CheckVector(const Eigen::VectorXd& v, const char* what) const {
   if (v.size() != NumJoints())
@@ -308,7 +328,7 @@ void JointTrajectoryController::SetTrajectory(const JointTrajectory& trajectory)
   } catch (const Error& e) {
     throw Error(name_ + ": " + e.what());
   }
-  if (!(path_tolerance > 0)) throw Error(name_ + ": path_tolerance must be > 0");
+  CheckSettings();
   Eigen::MatrixX2d limits = ControlledLimits(robot_, dofs_);
   for (size_t w = 0; w < trajectory.positions.size(); ++w) {
     const Eigen::VectorXd& p = trajectory.positions[w];
@@ -345,7 +365,13 @@ void JointTrajectoryController::SetPath(const std::vector<Eigen::VectorXd>& path
   SetTrajectory(t);
 }
 
+void JointTrajectoryController::CheckSettings() const {
+  Controller::CheckSettings();
+  CheckPositive(name_, "path_tolerance", path_tolerance);
+}
+
 void JointTrajectoryController::Update() {
+  CheckSettings();
   if (!started_) {
     WriteQf(robot_, dofs_, Eigen::VectorXd::Zero(NumJoints()), options_.gravity_compensation);
     return;
@@ -426,6 +452,26 @@ Pose EndEffectorController::GetEndEffectorPose() const {
   return robot_.GetLink(state_->link).GetPose() * state_->tcp;
 }
 
+void EndEffectorController::CheckSettings() const {
+  Controller::CheckSettings();
+  CheckPositive(name_, "max_linear_speed", max_linear_speed);
+  CheckPositive(name_, "max_angular_speed", max_angular_speed);
+  CheckPositive(name_, "position_tolerance", position_tolerance);
+  CheckPositive(name_, "rotation_tolerance", rotation_tolerance);
+  CheckPositive(name_, "ik.position_tolerance", ik.position_tolerance);
+  CheckPositive(name_, "ik.rotation_tolerance", ik.rotation_tolerance);
+  CheckPositive(name_, "ik.max_step", ik.max_step);
+  CheckFiniteNonNegative(name_, "ik.damping", ik.damping);
+  if (ik.max_iterations < 1)
+    throw Error(name_ + ": ik.max_iterations must be >= 1, got " +
+                std::to_string(ik.max_iterations));
+  if (ik.restarts < 0)
+    throw Error(name_ + ": ik.restarts must be >= 0, got " + std::to_string(ik.restarts));
+  if (!ik.active.empty() && static_cast<int>(ik.active.size()) != robot_.Dof())
+    throw Error(name_ + ": ik.active has " + std::to_string(ik.active.size()) +
+                " entries, expected none or one per dof (" + std::to_string(robot_.Dof()) + ")");
+}
+
 namespace {
 
 Pose ToWorld(const Articulation& robot, const Pose& pose, ControlFrame frame) {
@@ -437,6 +483,7 @@ Pose ToWorld(const Articulation& robot, const Pose& pose, ControlFrame frame) {
 void EndEffectorController::SetTargetPose(const Pose& target, ControlFrame frame) {
   if (!target.IsValid())
     throw Error(name_ + ": target pose " + target.ToString() + " is not finite or not unit");
+  CheckSettings();
   State& s = *state_;
   s.model.SetRootPose(robot_.GetRootPose());
   Pose goal = ToWorld(robot_, target, frame);
@@ -468,6 +515,7 @@ void EndEffectorController::SetTargetPose(const Pose& target, ControlFrame frame
 void EndEffectorController::SetTargetTwist(const Eigen::Matrix<double, 6, 1>& twist,
                                            ControlFrame frame) {
   if (!twist.allFinite()) throw Error(name_ + ": twist is not finite");
+  CheckSettings();
   State& s = *state_;
   s.model.SetRootPose(robot_.GetRootPose());
   Eigen::Matrix<double, 6, 1> w = twist;
@@ -499,6 +547,7 @@ void EndEffectorController::SetTargetTwist(const Eigen::Matrix<double, 6, 1>& tw
 }
 
 void EndEffectorController::Update() {
+  CheckSettings();
   State& s = *state_;
   const double now = robot_.GetScene()->GetTime();
   const double dt = Period() * robot_.GetScene()->GetTimestep();
@@ -637,8 +686,5 @@ bool ControlLoop::RunUntilDone(double max_seconds) {
   for (long long k = 0; k < max_steps && !all_done(); ++k) Step(1);
   return all_done() && all_reached();
 }
-
-// ---------------------------------------------------------------------------------------------
-// Imu (src/robot/imu.cc)
 
 }  // namespace partsim

@@ -1,10 +1,11 @@
 // An IMU on a link or an actor: orientation, proper linear acceleration and angular velocity in
 // the sensor frame, from MuJoCo's body accelerations (mj_rnePostConstraint), the way MuJoCo's own
 // accelerometer and gyro sensors read them.
+#include "partsim/robot/imu.h"
+
 #include <mujoco/mujoco.h>
 
 #include "partsim/core/error.h"
-#include "partsim/robot/controllers.h"
 #include "physics/scene_internal.h"
 
 namespace partsim {

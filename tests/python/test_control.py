@@ -141,6 +141,46 @@ def test_other_controllers_construct_and_run():
     assert effort.get_status().state == partsim.ControllerState.REACHED
 
 
+@pytest.mark.parametrize("name, value, printed", [
+    ("control_rate", -100.0, "-100"), ("stiffness", -1.0, "-1"), ("damping", math.nan, "nan"),
+    ("force_limit", 0.0, "0"), ("position_tolerance", -0.01, "-0.01"),
+    ("velocity_tolerance", math.nan, "nan"), ("timeout", -5.0, "-5")])
+def test_bad_controller_options_raise_naming_the_option_and_value(name, value, printed):
+    scene = partsim.Scene()
+    arm = planar_arm(scene)
+    options = partsim.JointControllerOptions()
+    setattr(options, name, value)
+    with pytest.raises(partsim.PartsimError, match=f"{name} must .*, got {printed}$"):
+        partsim.JointPositionController(arm, [], options)
+
+
+def test_bad_controller_settings_raise_where_they_are_used():
+    scene = partsim.Scene()
+    arm = planar_arm(scene)
+    loop = partsim.ControlLoop(scene)
+    ee = partsim.EndEffectorController(arm, [], "tip", partsim.Pose())
+    ee.ik.position_only = True
+    loop.add(ee)
+    ee.set_target_twist(np.zeros(6))
+    # a negative speed limit would flip the twist: refused when set, and by the next update
+    ee.max_linear_speed = -0.5
+    with pytest.raises(partsim.PartsimError, match="max_linear_speed must be > 0, got -0.5"):
+        ee.set_target_twist(np.array([0.2, 0, 0, 0, 0, 0]))
+    with pytest.raises(partsim.PartsimError, match="max_linear_speed"):
+        loop.step(5)
+    ee.max_linear_speed = 0.5
+    ee.ik.damping = -1.0
+    with pytest.raises(partsim.PartsimError, match="ik.damping"):
+        ee.set_target_pose(ee.get_end_effector_pose())
+    ee.ik.damping = 0.01
+    loop.step(5)
+    loop.remove(ee)
+    traj = partsim.JointTrajectoryController(arm, [])
+    traj.path_tolerance = math.nan
+    with pytest.raises(partsim.PartsimError, match="path_tolerance must be > 0, got nan"):
+        traj.set_path([arm.get_qpos(), np.array([0.2, 0.3])], np.ones(2), np.ones(2))
+
+
 def test_controller_keeps_scene_alive():
     scene = partsim.Scene()
     arm = planar_arm(scene)

@@ -1,11 +1,14 @@
 // Controllers run from the ControlLoop: each reaches a reachable target and reports kFailed on
 // an unreachable one; bad input throws and leaves the scene usable; the control rate divides
-// the physics rate. And the IMU: gravity at rest, spin rate, free fall.
+// the physics rate; settings that make no sense throw naming the setting and its value.
 #include "partsim/robot/controllers.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
 
 #include "robot/test_robots.h"
 
@@ -331,62 +334,144 @@ TEST(EndEffectorController, UnreachablePoseFailsAndArmStays) {
   EXPECT_THROW(EndEffectorController(w.arm, {}, "nope", Pose(), JointControllerOptions()), Error);
 }
 
-TEST(Imu, ReadsGravityAtRest) {
-  Scene scene;
-  scene.AddGround(0);
-  Actor box = scene.CreateActorBuilder()
-                  .AddBoxCollision(Pose(), Eigen::Vector3d::Constant(0.1))
-                  .SetInitialPose(Pose(Eigen::Vector3d(0, 0, 0.1)))
-                  .Build();
-  scene.Step(500);
-  // sensor tilted by 90 degrees about x: world up is its -y... its y axis points down
-  Imu imu(box, Pose(Eigen::Vector3d(0.05, 0, 0),
-                    Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()))));
-  ImuReading r = imu.Read();
-  EXPECT_LT((r.linear_acceleration - Eigen::Vector3d(0, 9.81, 0)).norm(), 0.05)
-      << r.linear_acceleration.transpose();
-  EXPECT_LT(r.angular_velocity.norm(), 1e-3);
-  EXPECT_NEAR(r.time, 1.0, 1e-9);
-  EXPECT_NEAR(std::abs(r.orientation[0]), std::cos(M_PI / 4), 1e-3);
-  // on a link of a fixed robot at rest too
-  Articulation arm = testing::AddArm7(scene, Pose(Eigen::Vector3d(1, 0, 0)));
-  arm.SetDriveProperty(1e4, 1e3);
-  arm.SetDriveTarget(Eigen::VectorXd::Zero(7));
-  arm.SetQf(arm.ComputePassiveForce());
-  ImuReading l = Imu(arm.FindLinkByName("link3")).Read();
-  EXPECT_LT((l.linear_acceleration - Eigen::Vector3d(0, 0, 9.81)).norm(), 0.05);
+// The message of what `f` throws as partsim::Error; "" when it throws nothing.
+template <typename F>
+std::string ErrorOf(F f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
 }
 
-TEST(Imu, ReadsSpinRateAndCentripetalAcceleration) {
-  SceneConfig cfg;
-  cfg.gravity.setZero();
-  Scene scene(cfg);
-  Actor ball = scene.CreateActorBuilder()
-                   .AddSphereCollision(Pose(), 0.1)
-                   .SetInitialPose(Pose(Eigen::Vector3d(0, 0, 1)))
-                   .Build();
-  ball.SetAngularVelocity(Eigen::Vector3d(0, 0, 2.0));
-  scene.Step(100);
-  const double r = 0.05;
-  Imu imu(ball, Pose(Eigen::Vector3d(r, 0, 0)));
-  ImuReading reading = imu.Read();
-  // the sensor turns with the ball: the rate about its own z is the same
-  EXPECT_LT((reading.angular_velocity - Eigen::Vector3d(0, 0, 2.0)).norm(), 1e-6);
-  // proper acceleration points to the axis: -w^2 r along the sensor's x
-  EXPECT_LT((reading.linear_acceleration - Eigen::Vector3d(-4.0 * r, 0, 0)).norm(), 1e-3)
-      << reading.linear_acceleration.transpose();
+// A setting out of range, the text its value prints as, and how to apply it.
+template <typename T>
+struct BadSetting {
+  std::string name, value;
+  std::function<void(T&)> set;
+};
+
+TEST(Controller, EachBadOptionThrowsNamingItAndItsValue) {
+  ArmWorld w;
+  const std::vector<BadSetting<JointControllerOptions>> cases = {
+      {"control_rate", "-100", [](auto& o) { o.control_rate = -100; }},
+      {"control_rate", "0", [](auto& o) { o.control_rate = 0; }},
+      {"control_rate", "inf", [](auto& o) { o.control_rate = kInf; }},
+      {"stiffness", "-1", [](auto& o) { o.stiffness = -1; }},
+      {"stiffness", "nan", [](auto& o) { o.stiffness = NAN; }},
+      {"damping", "-2", [](auto& o) { o.damping = -2; }},
+      {"damping", "inf", [](auto& o) { o.damping = kInf; }},
+      {"force_limit", "0", [](auto& o) { o.force_limit = 0; }},
+      {"force_limit", "nan", [](auto& o) { o.force_limit = NAN; }},
+      {"position_tolerance", "-0.01", [](auto& o) { o.position_tolerance = -0.01; }},
+      {"velocity_tolerance", "nan", [](auto& o) { o.velocity_tolerance = NAN; }},
+      {"timeout", "-5", [](auto& o) { o.timeout = -5; }},
+  };
+  for (const auto& c : cases) {
+    JointControllerOptions opt;
+    c.set(opt);
+    const std::string what = ErrorOf([&] { JointPositionController(w.arm, {}, opt); });
+    EXPECT_NE(what.find(c.name), std::string::npos) << c.name << ": " << what;
+    EXPECT_NE(what.find("got " + c.value), std::string::npos) << c.name << ": " << what;
+    EXPECT_NE(ErrorOf([&] { opt.Validate("test"); }), "") << c.name;
+  }
+  // the limits that mean "none" are allowed
+  JointControllerOptions unlimited;
+  unlimited.force_limit = unlimited.timeout = unlimited.position_tolerance = kInf;
+  EXPECT_NO_THROW(JointPositionController(w.arm, {}, unlimited));
 }
 
-TEST(Imu, FreeFallReadsZero) {
-  Scene scene;
-  Actor box = scene.CreateActorBuilder()
-                  .AddBoxCollision(Pose(), Eigen::Vector3d::Constant(0.1))
-                  .SetInitialPose(Pose(Eigen::Vector3d(0, 0, 10)))
-                  .Build();
-  scene.Step(100);
-  ImuReading r = Imu(box).Read();
-  EXPECT_LT(r.linear_acceleration.norm(), 0.05) << r.linear_acceleration.transpose();
-  EXPECT_LT(box.GetPose().p.z(), 9.9);  // it does fall
+TEST(JointTrajectoryController, BadPathToleranceThrowsWhereItIsUsed) {
+  ArmWorld w;
+  auto c = std::make_shared<JointTrajectoryController>(w.arm, std::vector<std::string>{},
+                                                       JointControllerOptions());
+  ControlLoop loop(&w.scene);
+  loop.Add(c);
+  JointTrajectory t;
+  t.times = {0.0, 1.0};
+  t.positions = {kHome, kHome};
+  for (double bad : {-0.1, 0.0, double(NAN)}) {
+    c->path_tolerance = bad;
+    const std::string what = ErrorOf([&] { c->SetTrajectory(t); });
+    EXPECT_NE(what.find("path_tolerance must be > 0, got"), std::string::npos) << what;
+    EXPECT_EQ(c->GetStatus().state, ControllerState::kIdle);  // nothing was taken
+  }
+  // set while following: the next update refuses it, and the loop steps on once it is fixed
+  c->path_tolerance = 0.1;
+  c->SetTrajectory(t);
+  c->path_tolerance = -1;
+  EXPECT_NE(ErrorOf([&] { loop.Step(10); }).find("path_tolerance must be > 0, got -1"),
+            std::string::npos);
+  c->path_tolerance = 0.1;
+  EXPECT_TRUE(loop.RunUntilDone(3.0)) << c->GetStatus().message;
+}
+
+TEST(EndEffectorController, EachBadSettingThrowsNamingItAndItsValue) {
+  Eigen::Matrix<double, 6, 1> twist;
+  twist << 0.05, 0, 0, 0, 0, 0.1;
+  const std::vector<BadSetting<EndEffectorController>> cases = {
+      {"max_linear_speed", "-0.5", [](auto& e) { e.max_linear_speed = -0.5; }},
+      {"max_linear_speed", "0", [](auto& e) { e.max_linear_speed = 0; }},
+      {"max_linear_speed", "nan", [](auto& e) { e.max_linear_speed = NAN; }},
+      {"max_angular_speed", "-1.5", [](auto& e) { e.max_angular_speed = -1.5; }},
+      {"max_angular_speed", "nan", [](auto& e) { e.max_angular_speed = NAN; }},
+      {"position_tolerance", "-0.002", [](auto& e) { e.position_tolerance = -0.002; }},
+      {"rotation_tolerance", "nan", [](auto& e) { e.rotation_tolerance = NAN; }},
+      {"ik.position_tolerance", "0", [](auto& e) { e.ik.position_tolerance = 0; }},
+      {"ik.rotation_tolerance", "-1", [](auto& e) { e.ik.rotation_tolerance = -1; }},
+      {"ik.max_step", "nan", [](auto& e) { e.ik.max_step = NAN; }},
+      {"ik.damping", "-0.01", [](auto& e) { e.ik.damping = -0.01; }},
+      {"ik.max_iterations", "0", [](auto& e) { e.ik.max_iterations = 0; }},
+      {"ik.restarts", "-1", [](auto& e) { e.ik.restarts = -1; }},
+      {"ik.active", "3 entries",
+       [](auto& e) {
+         e.ik.active = {true, true, true};
+       }},
+  };
+  for (const auto& bad : cases) {
+    ArmWorld w;
+    auto c = std::make_shared<EndEffectorController>(w.arm, std::vector<std::string>{}, "hand",
+                                                     Pose(), JointControllerOptions());
+    ControlLoop loop(&w.scene);
+    loop.Add(c);
+    const Pose here = c->GetEndEffectorPose();
+    // refused when a target is set, and at the next update of a target set before
+    c->SetTargetTwist(Eigen::Matrix<double, 6, 1>::Zero());
+    bad.set(*c);
+    for (const std::string& what :
+         {ErrorOf([&] { c->SetTargetTwist(twist); }), ErrorOf([&] { c->SetTargetPose(here); }),
+          ErrorOf([&] { loop.Step(10); })}) {
+      EXPECT_NE(what.find(bad.name), std::string::npos) << bad.name << ": " << what;
+      EXPECT_NE(what.find(bad.value), std::string::npos) << bad.name << ": " << what;
+    }
+  }
+}
+
+TEST(EndEffectorController, ANegativeSpeedLimitDoesNotFlipTheTwist) {
+  ArmWorld w;
+  auto c = std::make_shared<EndEffectorController>(w.arm, std::vector<std::string>{}, "hand",
+                                                   Pose(), JointControllerOptions());
+  ControlLoop loop(&w.scene);
+  loop.Add(c);
+  loop.Step(50);
+  const Pose start = c->GetEndEffectorPose();
+  Eigen::Matrix<double, 6, 1> twist;
+  twist << 0.2, 0, 0, 0, 0, 0;
+  c->max_linear_speed = -0.05;  // scaling by -0.05 / 0.2 would send the hand along -x
+  EXPECT_THROW(c->SetTargetTwist(twist), Error);
+  EXPECT_THROW(loop.Step(1), Error);  // and so do the updates while the limit stays negative
+  // the twist was not taken: the hand holds
+  c->max_linear_speed = 0.05;
+  loop.Step(250);
+  EXPECT_LT((c->GetEndEffectorPose().p - start.p).norm(), 2e-3);
+  // a positive limit scales the twist down along its own direction
+  c->SetTargetTwist(twist);
+  EXPECT_NE(c->GetStatus().message.find("clamped to 0.05"), std::string::npos);
+  loop.Step(250);  // 0.5 s, then stop and settle
+  c->SetTargetTwist(Eigen::Matrix<double, 6, 1>::Zero());
+  loop.Step(250);
+  EXPECT_NEAR(c->GetEndEffectorPose().p.x() - start.p.x(), 0.025, 3e-3);
 }
 
 }  // namespace

@@ -1,12 +1,16 @@
 // Robot controllers run from the step loop at a control rate below the physics rate, the way a
 // real robot's controller runs: joint effort, joint position (PD), joint velocity, joint
-// trajectory and end-effector (pose or twist through damped least-squares IK); and an IMU.
+// trajectory and end-effector (pose or twist through damped least-squares IK). The IMU, once
+// declared here, has its own header, partsim/robot/imu.h, which this one includes.
 //
 // Like a real robot's, a controller can fail: a target it cannot reach (outside the joint
 // limits, out of the arm's reach, or blocked for longer than its timeout) sets its status to
 // kFailed with a message, instead of silently doing something else. Bad input (wrong sizes, NaN
 // or infinite values) throws partsim::Error naming the controller and the entry, and leaves the
-// controller and the scene as they were.
+// controller and the scene as they were. Settings are checked where they take effect: the
+// options when a controller is made, the settings a controller exposes as fields (speeds,
+// tolerances, IK options) whenever a target is set and at every update; a setting out of range
+// (a negative speed or gain, a NaN) throws partsim::Error naming the setting and its value.
 #pragma once
 
 #include <Eigen/Core>
@@ -16,6 +20,7 @@
 
 #include "partsim/core/pose.h"
 #include "partsim/physics/scene.h"
+#include "partsim/robot/imu.h"
 #include "partsim/robot/kinematics.h"
 #include "partsim/robot/trajectory.h"
 
@@ -35,16 +40,22 @@ struct ControllerStatus {
   std::string message;  ///< why it failed, or what was clamped
 };
 
-/// Common settings of the joint controllers.
+/// Common settings of the joint controllers. Infinity is allowed where it means "no limit"
+/// (force_limit, the tolerances, timeout).
 struct JointControllerOptions {
-  double control_rate = 100.0;       ///< Hz; the controller updates every round(1/(rate dt)) steps
+  double control_rate = 100.0;       ///< Hz, finite, > 0; the controller updates every
+                                     ///< round(1/(rate dt)) steps
   bool gravity_compensation = true;  ///< add the passive force (gravity, Coriolis) as qf
-  double stiffness = 1e4;            ///< PD gains written to the joints' drives
-  double damping = 1e3;
-  double force_limit = kInf;         ///< per joint; also clamps efforts
-  double position_tolerance = 1e-2;  ///< rad or m, for kReached
-  double velocity_tolerance = 5e-2;  ///< rad/s or m/s, for kReached
-  double timeout = 5.0;              ///< s without reaching the target before kFailed
+  double stiffness = 1e4;            ///< N/m or N m/rad, finite, >= 0: PD gain of the drives
+  double damping = 1e3;              ///< N s/m or N m s/rad, finite, >= 0: PD gain of the drives
+  double force_limit = kInf;         ///< N or N m, > 0, per joint; also clamps efforts
+  double position_tolerance = 1e-2;  ///< rad or m, > 0, for kReached
+  double velocity_tolerance = 5e-2;  ///< rad/s or m/s, > 0, for kReached
+  double timeout = 5.0;              ///< s, > 0, without reaching the target before kFailed
+
+  /// Throws partsim::Error naming the first setting out of its range above and its value
+  /// ("`who`: control_rate must be finite and > 0, got -1").
+  void Validate(const std::string& who) const;
 };
 
 /// Base class: a controller of some joints of one articulation.
@@ -68,6 +79,10 @@ class Controller {
   int Period() const;
   /// Called by ControlLoop every Period() steps, before the physics steps.
   virtual void Update() = 0;
+  /// Throws partsim::Error naming a setting of this controller that is out of range, and its
+  /// value. The options are checked once, by the constructor; controllers that expose settings
+  /// as fields check them again where they are used (targets, updates).
+  virtual void CheckSettings() const;
   /// Writes this controller's drive gains to its joints: PD (stiffness, damping) for position
   /// control, damping only for velocity control, none for efforts. The constructor and
   /// ControlLoop::Add call it, so that switching between controllers of the same joints
@@ -145,13 +160,15 @@ class JointTrajectoryController : public Controller {
  public:
   JointTrajectoryController(const Articulation& robot, const std::vector<std::string>& joints,
                             const JointControllerOptions& options);
-  double path_tolerance = 0.1;  ///< rad or m
+  double path_tolerance = 0.1;  ///< rad or m, > 0
   void SetTrajectory(const JointTrajectory& trajectory);
   /// A path without times: TimeParameterize with these limits, then follow it.
   void SetPath(const std::vector<Eigen::VectorXd>& path, const Eigen::VectorXd& velocity_limits,
                const Eigen::VectorXd& acceleration_limits);
   const JointTrajectory& GetTrajectory() const { return trajectory_; }
   void Update() override;
+  /// The options, and path_tolerance > 0.
+  void CheckSettings() const override;
 
  private:
   JointTrajectory trajectory_;
@@ -176,11 +193,11 @@ class EndEffectorController : public Controller {
   EndEffectorController(const Articulation& robot, const std::vector<std::string>& joints,
                         const std::string& ee_link, const Pose& tcp,
                         const JointControllerOptions& options);
-  IkOptions ik;                        ///< IK settings used for pose targets
-  double max_linear_speed = 0.5;       ///< m/s, pose targets are approached no faster
-  double max_angular_speed = 1.5;      ///< rad/s
-  double position_tolerance = 2e-3;    ///< m, of the measured frame, for kReached
-  double rotation_tolerance = 1.5e-2;  ///< rad, of the measured frame, for kReached
+  IkOptions ik;                        ///< IK settings used for pose targets (offset unused)
+  double max_linear_speed = 0.5;       ///< m/s, > 0: pose targets are approached no faster
+  double max_angular_speed = 1.5;      ///< rad/s, > 0
+  double position_tolerance = 2e-3;    ///< m, > 0, of the measured frame, for kReached
+  double rotation_tolerance = 1.5e-2;  ///< rad, > 0, of the measured frame, for kReached
   void SetTargetPose(const Pose& target, ControlFrame frame = ControlFrame::kWorld);
   /// Linear (m/s) and angular (rad/s) velocity, stacked; held until changed.
   void SetTargetTwist(const Eigen::Matrix<double, 6, 1>& twist,
@@ -188,6 +205,10 @@ class EndEffectorController : public Controller {
   /// Current pose of the controlled frame (world).
   Pose GetEndEffectorPose() const;
   void Update() override;
+  /// The options, the speeds and tolerances above (> 0) and the IK options (tolerances and
+  /// max_step > 0, damping finite and >= 0, max_iterations >= 1, restarts >= 0, active empty or
+  /// one entry per dof).
+  void CheckSettings() const override;
 
  private:
   struct State;
@@ -215,29 +236,6 @@ class ControlLoop {
   Scene* scene_;
   std::vector<Entry> entries_;
   long long step_count_ = 0;
-};
-
-/// What an IMU reads, in its own frame.
-struct ImuReading {
-  Eigen::Vector4d orientation;          ///< quaternion wxyz of the sensor in the world
-  Eigen::Vector3d linear_acceleration;  ///< proper acceleration (m/s^2): +9.81 up at rest
-  Eigen::Vector3d angular_velocity;     ///< rad/s
-  double time = 0.0;                    ///< simulation time of the reading
-};
-
-/// An inertial measurement unit fixed to a link or an actor at `local_pose`.
-class Imu {
- public:
-  Imu(const Link& link, const Pose& local_pose = Pose());
-  Imu(const Actor& actor, const Pose& local_pose = Pose());
-  /// Reading at the current state (after the last step).
-  ImuReading Read() const;
-
- private:
-  Scene* scene_;
-  bool is_link_;
-  int articulation_id_ = -1, link_index_ = -1, actor_id_ = -1;
-  Pose local_pose_;
 };
 
 }  // namespace partsim
