@@ -526,6 +526,59 @@ const Camera& ServedRobot::TakePicture(size_t i) {
   return cameras_[i].camera;
 }
 
+std::string SensorTopic(const ServedRobot& robot, SensorStream stream, size_t camera) {
+  if (stream == SensorStream::kImu) return "/imu";
+  const std::string base = "/" + robot.GetCameras().at(camera).name;
+  switch (stream) {
+    case SensorStream::kImage:
+      return base + "/image_raw";
+    case SensorStream::kPoints:
+      return base + "/points";
+    default:
+      return base + "/camera_info";
+  }
+}
+
+SensorSchedule::SensorSchedule(ServedRobot* robot) : robot_(robot) {
+  if (!robot) throw Error("SensorSchedule: robot is null");
+  cameras_.resize(robot->GetCameras().size());
+}
+
+void SensorSchedule::Publish(double t, const Listened& listened, const Output& out) {
+  // a message is due once the simulated time reaches its next time (within rounding)
+  const double eps = 1e-9;
+  const ServedRobotOptions& ro = robot_->GetOptions();
+  // which streams are due and listened to, asked before anything is read
+  const bool imu = robot_->GetImu() && t + eps >= imu_next_ && listened(SensorStream::kImu, 0);
+  struct Want {
+    bool image = false, points = false, info = false;
+  };
+  std::vector<Want> want(cameras_.size());
+  for (size_t i = 0; i < cameras_.size(); ++i) {
+    if (t + eps >= cameras_[i].next_picture) {
+      want[i].image = listened(SensorStream::kImage, i);
+      want[i].points = listened(SensorStream::kPoints, i);
+    }
+    if (t + eps >= cameras_[i].next_info) want[i].info = listened(SensorStream::kCameraInfo, i);
+  }
+  if (imu) {
+    imu_next_ = ro.imu_rate > 0 ? t + 1.0 / ro.imu_rate : 0;
+    out.imu(robot_->GetImu()->Read());
+  }
+  const double period = ro.camera_rate > 0 ? 1.0 / ro.camera_rate : 0;
+  for (size_t i = 0; i < cameras_.size(); ++i) {
+    if (want[i].image || want[i].points) {
+      const Camera& pictured = robot_->TakePicture(i);
+      cameras_[i].next_picture = t + period;
+      out.picture(i, pictured, want[i].image, want[i].points);
+    }
+    if (want[i].info) {
+      cameras_[i].next_info = t + period;
+      out.camera_info(i, robot_->GetCameras()[i].camera);
+    }
+  }
+}
+
 std::vector<uint8_t> CameraRgb8(const Camera& cam) {
   const size_t n = static_cast<size_t>(cam.GetWidth()) * cam.GetHeight();
   std::vector<uint8_t> rgba = cam.GetColorRGBA8(), rgb(n * 3);

@@ -168,6 +168,7 @@ class ServedRobot {
   JointStateReading ReadJointStates() const;
   std::vector<FrameReading> ReadFrames() const;
   std::vector<CameraSensor>& GetCameras() { return cameras_; }
+  const std::vector<CameraSensor>& GetCameras() const { return cameras_; }
   /// Camera `i` pictured at the current step (Color and Position: images and point clouds):
   /// renders it unless it already was this step.
   const Camera& TakePicture(size_t i);
@@ -187,6 +188,49 @@ class ServedRobot {
   std::unique_ptr<Imu> imu_;
   std::string imu_frame_;
   std::unique_ptr<Impl> impl_;
+};
+
+/// A sensor stream the front-ends publish: the IMU (/imu), or one of a camera's topics
+/// (/<camera>/image_raw, /<camera>/points, /<camera>/camera_info).
+enum class SensorStream { kImu, kImage, kPoints, kCameraInfo };
+
+/// The topic of a sensor stream of `robot`; `camera` indexes robot.GetCameras() (unused for
+/// kImu).
+std::string SensorTopic(const ServedRobot& robot, SensorStream stream, size_t camera = 0);
+
+/// One front-end's schedule of sensor messages, in simulated time: the IMU every 1/imu_rate s,
+/// each camera's picture (image_raw and points) and its camera_info every 1/camera_rate s
+/// (every step for a rate of 0), each only while a client listens to it. Each front-end keeps a
+/// schedule of its own (their listeners differ); a camera pictured for several at one step is
+/// rendered once (ServedRobot::TakePicture).
+class SensorSchedule {
+ public:
+  /// Whether some client listens to `stream` (of camera `camera`) now.
+  using Listened = std::function<bool(SensorStream stream, size_t camera)>;
+  /// What a front-end publishes of the readings due (all called on the simulation thread).
+  struct Output {
+    std::function<void(const ImuReading& reading)> imu;
+    /// Camera `camera` pictured at this step (Color and Position); `image` and `points`: which
+    /// of its two picture topics are due.
+    std::function<void(size_t camera, const Camera& pictured, bool image, bool points)> picture;
+    /// camera_info of camera `camera` (its intrinsics; no picture is taken).
+    std::function<void(size_t camera, const Camera& camera_model)> camera_info;
+  };
+
+  /// `robot` must outlive the schedule.
+  explicit SensorSchedule(ServedRobot* robot);
+  /// After a step, at simulation time `t` (s): asks `listened` about the streams whose time has
+  /// come, reads those listened to (taking pictures as needed), hands them to `out`, and sets
+  /// their next time.
+  void Publish(double t, const Listened& listened, const Output& out);
+
+ private:
+  struct CameraTimes {
+    double next_picture = 0, next_info = 0;  // simulated time of the next message
+  };
+  ServedRobot* robot_;
+  double imu_next_ = 0;
+  std::vector<CameraTimes> cameras_;  // one per robot->GetCameras()
 };
 
 // ---- message payloads shared by the front-ends ----

@@ -85,10 +85,9 @@ struct Ros1Bridge::Impl {
   ros::Publisher clock_pub, joint_pub, tf_pub, imu_pub;
   struct CameraPubs {
     ros::Publisher image, info, points;
-    double next_render = 0, next_info = 0;
   };
-  std::vector<CameraPubs> cameras;
-  double imu_next = 0;
+  std::vector<CameraPubs> cameras;           // one per robot->GetCameras()
+  std::unique_ptr<SensorSchedule> schedule;  // simulation thread
   std::vector<ros::Subscriber> subs;
   std::vector<ros::ServiceServer> services;
   std::unique_ptr<FollowServer> follow;
@@ -138,12 +137,12 @@ struct Ros1Bridge::Impl {
     PublishSensors(t, stamp);
   }
 
+  /// Reads the sensors somebody subscribes to, when due (ServedRobot's schedule), and publishes
+  /// them.
   void PublishSensors(double t, const ros::Time& stamp) {
-    const double eps = 1e-9;
-    const ServedRobotOptions& ro = robot->GetOptions();
-    if (robot->GetImu() && t + eps >= imu_next && imu_pub.getNumSubscribers() > 0) {
-      imu_next = ro.imu_rate > 0 ? t + 1.0 / ro.imu_rate : 0;
-      ImuReading r = robot->GetImu()->Read();
+    const std::vector<CameraSensor>& sensors = robot->GetCameras();
+    SensorSchedule::Output out;
+    out.imu = [&](const ImuReading& r) {
       sensor_msgs::Imu m;
       m.header.stamp = stamp;
       m.header.frame_id = robot->GetImuFrame();
@@ -158,70 +157,75 @@ struct Ros1Bridge::Impl {
       m.linear_acceleration.y = r.linear_acceleration.y();
       m.linear_acceleration.z = r.linear_acceleration.z();
       imu_pub.publish(m);
-    }
-    const double period = ro.camera_rate > 0 ? 1.0 / ro.camera_rate : 0;
-    std::vector<CameraSensor>& sensors = robot->GetCameras();
-    for (size_t i = 0; i < cameras.size(); ++i) {
-      CameraPubs& c = cameras[i];
+    };
+    out.picture = [&](size_t i, const Camera& cam, bool image, bool points) {
       const std::string& frame = sensors[i].frame;
-      const bool image = c.image.getNumSubscribers() > 0, points = c.points.getNumSubscribers() > 0;
-      if ((image || points) && t + eps >= c.next_render) {
-        c.next_render = t + period;
-        const Camera& cam = robot->TakePicture(i);
-        if (image) {
-          sensor_msgs::Image m;
-          m.header.stamp = stamp;
-          m.header.frame_id = frame;
-          m.height = cam.GetHeight();
-          m.width = cam.GetWidth();
-          m.encoding = "rgb8";
-          m.is_bigendian = 0;
-          m.step = 3 * m.width;
-          m.data = CameraRgb8(cam);
-          c.image.publish(m);
-        }
-        if (points) {
-          std::vector<float> xyz = CameraOpticalPoints(cam);
-          sensor_msgs::PointCloud2 m;
-          m.header.stamp = stamp;
-          m.header.frame_id = frame;
-          m.height = 1;
-          m.width = static_cast<uint32_t>(xyz.size() / 3);
-          const char* names[] = {"x", "y", "z"};
-          for (int k = 0; k < 3; ++k) {
-            sensor_msgs::PointField f;
-            f.name = names[k];
-            f.offset = 4 * k;
-            f.datatype = sensor_msgs::PointField::FLOAT32;
-            f.count = 1;
-            m.fields.push_back(f);
-          }
-          m.is_bigendian = false;
-          m.point_step = 12;
-          m.row_step = 12 * m.width;
-          m.data.resize(xyz.size() * 4);
-          std::memcpy(m.data.data(), xyz.data(), m.data.size());
-          m.is_dense = true;
-          c.points.publish(m);
-        }
-      }
-      if (c.info.getNumSubscribers() > 0 && t + eps >= c.next_info) {
-        c.next_info = t + period;
-        const Camera& cam = sensors[i].camera;
-        std::vector<double> p = CameraProjection(cam);
-        sensor_msgs::CameraInfo m;
+      if (image) {
+        sensor_msgs::Image m;
         m.header.stamp = stamp;
         m.header.frame_id = frame;
         m.height = cam.GetHeight();
         m.width = cam.GetWidth();
-        m.distortion_model = "plumb_bob";
-        m.D.assign(5, 0.0);
-        m.K = {p[0], p[1], p[2], p[4], p[5], p[6], p[8], p[9], p[10]};
-        m.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-        std::copy(p.begin(), p.end(), m.P.begin());
-        c.info.publish(m);
+        m.encoding = "rgb8";
+        m.is_bigendian = 0;
+        m.step = 3 * m.width;
+        m.data = CameraRgb8(cam);
+        cameras[i].image.publish(m);
       }
-    }
+      if (points) {
+        std::vector<float> xyz = CameraOpticalPoints(cam);
+        sensor_msgs::PointCloud2 m;
+        m.header.stamp = stamp;
+        m.header.frame_id = frame;
+        m.height = 1;
+        m.width = static_cast<uint32_t>(xyz.size() / 3);
+        const char* names[] = {"x", "y", "z"};
+        for (int k = 0; k < 3; ++k) {
+          sensor_msgs::PointField f;
+          f.name = names[k];
+          f.offset = 4 * k;
+          f.datatype = sensor_msgs::PointField::FLOAT32;
+          f.count = 1;
+          m.fields.push_back(f);
+        }
+        m.is_bigendian = false;
+        m.point_step = 12;
+        m.row_step = 12 * m.width;
+        m.data.resize(xyz.size() * 4);
+        std::memcpy(m.data.data(), xyz.data(), m.data.size());
+        m.is_dense = true;
+        cameras[i].points.publish(m);
+      }
+    };
+    out.camera_info = [&](size_t i, const Camera& cam) {
+      std::vector<double> p = CameraProjection(cam);
+      sensor_msgs::CameraInfo m;
+      m.header.stamp = stamp;
+      m.header.frame_id = sensors[i].frame;
+      m.height = cam.GetHeight();
+      m.width = cam.GetWidth();
+      m.distortion_model = "plumb_bob";
+      m.D.assign(5, 0.0);
+      m.K = {p[0], p[1], p[2], p[4], p[5], p[6], p[8], p[9], p[10]};
+      m.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+      std::copy(p.begin(), p.end(), m.P.begin());
+      cameras[i].info.publish(m);
+    };
+    schedule->Publish(
+        t,
+        [&](SensorStream stream, size_t i) {
+          switch (stream) {
+            case SensorStream::kImu:
+              return imu_pub.getNumSubscribers() > 0;
+            case SensorStream::kImage:
+              return cameras[i].image.getNumSubscribers() > 0;
+            case SensorStream::kPoints:
+              return cameras[i].points.getNumSubscribers() > 0;
+            default:
+              return cameras[i].info.getNumSubscribers() > 0;
+          }
+        },
+        out);
   }
 
   // ---- callback threads ----
@@ -392,14 +396,17 @@ void Ros1Bridge::Start() {
   m.clock_pub = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   m.joint_pub = nh.advertise<sensor_msgs::JointState>("/joint_states", 10);
   m.tf_pub = nh.advertise<tf2_msgs::TFMessage>("/tf", 100);
-  m.imu_pub = nh.advertise<sensor_msgs::Imu>("/imu", 10);
-  for (const CameraSensor& c : m.robot->GetCameras()) {
+  m.imu_pub = nh.advertise<sensor_msgs::Imu>(SensorTopic(*m.robot, SensorStream::kImu), 10);
+  for (size_t i = 0; i < m.robot->GetCameras().size(); ++i) {
     Impl::CameraPubs p;
-    p.image = nh.advertise<sensor_msgs::Image>("/" + c.name + "/image_raw", 2);
-    p.info = nh.advertise<sensor_msgs::CameraInfo>("/" + c.name + "/camera_info", 2);
-    p.points = nh.advertise<sensor_msgs::PointCloud2>("/" + c.name + "/points", 2);
+    p.image = nh.advertise<sensor_msgs::Image>(SensorTopic(*m.robot, SensorStream::kImage, i), 2);
+    p.info = nh.advertise<sensor_msgs::CameraInfo>(
+        SensorTopic(*m.robot, SensorStream::kCameraInfo, i), 2);
+    p.points =
+        nh.advertise<sensor_msgs::PointCloud2>(SensorTopic(*m.robot, SensorStream::kPoints, i), 2);
     m.cameras.push_back(p);
   }
+  m.schedule = std::make_unique<SensorSchedule>(m.robot);
   Impl* im = impl_.get();
   for (const char* kind : {"position", "velocity", "effort"}) {
     const std::string k = kind, topic = m.prefix + "/joint_" + k + "_controller/command";

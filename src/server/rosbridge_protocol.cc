@@ -1,0 +1,741 @@
+#include "server/rosbridge_protocol.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "core/json_parse.h"
+#include "partsim/core/error.h"
+
+namespace partsim::internal {
+
+namespace {
+
+// Most pieces of fragmented messages held for one client at a time (each costs a map node
+// beside its bytes): a 16 MB message arrives in pieces of 256 bytes or more.
+constexpr size_t kMaxFragmentsHeld = 65536;
+
+// Messages in pieces held for one client at once.
+constexpr size_t kMaxPartialMessages = 16;
+
+// Calls to client-advertised services: unanswered ones per caller, and how long one may wait.
+constexpr size_t kMaxPendingCalls = 100;
+constexpr std::chrono::seconds kCallTimeout{60};
+
+// Open subscribe requests (distinct ids) of one client on one topic.
+constexpr size_t kMaxRequestsPerTopic = 64;
+
+// Compares without stopping at the first difference (the time taken says nothing of where).
+bool SameToken(const std::string& a, const std::string& b) {
+  unsigned char diff = a.size() != b.size();
+  for (size_t i = 0; i < a.size(); ++i) diff |= a[i] ^ b[i % (b.empty() ? 1 : b.size())];
+  return diff == 0 && !b.empty();
+}
+
+std::string Str(const Json& j, const char* key, const std::string& op) {
+  if (!j.contains(key) || !j[key].is_string())
+    throw Error("op '" + op + "' needs a string '" + key + "'");
+  return j[key].get<std::string>();
+}
+
+/// A topic or service name; ROS resolves "rosapi/topics" to "/rosapi/topics" at the root.
+std::string Name(const Json& j, const char* key, const std::string& op) {
+  std::string n = Str(j, key, op);
+  if (n.empty()) throw Error("op '" + op + "': empty '" + key + "'");
+  return n[0] == '/' ? n : "/" + n;
+}
+
+/// The key of a subscribe request or message id: strings as they are, other ids as JSON text.
+std::string IdKey(const Json& id) { return id.is_string() ? id.get<std::string>() : DumpJson(id); }
+
+}  // namespace
+
+void Subscription::Merge() {
+  throttle_ms = 1e300;
+  queue_length = fragment_size = 0;
+  bool server_bound = false, all_fragment = true;
+  long long latest = -1;
+  for (const auto& [id, r] : requests) {
+    throttle_ms = std::min(throttle_ms, r.throttle_ms);
+    if (r.queue_length == 0) server_bound = true;  // the largest queue there is
+    queue_length = std::max(queue_length, r.queue_length);
+    all_fragment = all_fragment && r.fragment_size > 0;
+    fragment_size = fragment_size == 0 ? r.fragment_size : std::min(fragment_size, r.fragment_size);
+    if (r.order > latest) {
+      latest = r.order;
+      cbor = r.cbor;
+    }
+  }
+  if (server_bound) queue_length = 0;
+  if (!all_fragment) fragment_size = 0;
+}
+
+RosbridgeProtocol::RosbridgeProtocol(ServedRobot* robot, const RosbridgeOptions& options,
+                                     RosbridgeTransport* transport)
+    : robot_(robot),
+      sim_(robot->GetSim()),
+      options_(options),
+      transport_(transport),
+      sensors_(robot) {
+  for (size_t i = 0; i < robot->GetCameras().size(); ++i)
+    camera_topics_.push_back({SensorTopic(*robot, SensorStream::kImage, i),
+                              SensorTopic(*robot, SensorStream::kPoints, i),
+                              SensorTopic(*robot, SensorStream::kCameraInfo, i)});
+  ops_ = {{"subscribe", &RosbridgeProtocol::OpSubscribe},
+          {"unsubscribe", &RosbridgeProtocol::OpUnsubscribe},
+          {"advertise", &RosbridgeProtocol::OpAdvertise},
+          {"unadvertise", &RosbridgeProtocol::OpUnadvertise},
+          {"publish", &RosbridgeProtocol::OpPublish},
+          {"call_service", &RosbridgeProtocol::OpCallService},
+          {"advertise_service", &RosbridgeProtocol::OpAdvertiseService},
+          {"unadvertise_service", &RosbridgeProtocol::OpUnadvertiseService},
+          {"service_response", &RosbridgeProtocol::OpServiceResponse},
+          {"auth", &RosbridgeProtocol::OpAuth}};
+  AddServices();
+}
+
+// ---- clients ----
+
+size_t RosbridgeProtocol::AddClient(const ClientPtr& client) {
+  client->authenticated = options_.auth_token.empty();
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  clients_[client->connection] = client;
+  return clients_.size();
+}
+
+ClientPtr RosbridgeProtocol::RemoveClient(const std::weak_ptr<void>& connection, size_t* count) {
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  *count = clients_.size();
+  auto it = clients_.find(connection);
+  if (it == clients_.end()) return nullptr;
+  ClientPtr c = it->second;
+  clients_.erase(it);
+  *count = clients_.size();
+  // its calls are forgotten, and the callers of the services it provided told
+  for (auto call = pending_calls_.begin(); call != pending_calls_.end();) {
+    if (call->second.caller.lock() == c)
+      call = pending_calls_.erase(call);
+    else
+      ++call;
+  }
+  AbandonCalls(c, "", "the provider disconnected");
+  return c;
+}
+
+ClientPtr RosbridgeProtocol::FindClient(const std::weak_ptr<void>& connection) const {
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  auto it = clients_.find(connection);
+  return it == clients_.end() ? nullptr : it->second;
+}
+
+size_t RosbridgeProtocol::ClientCount() const {
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  return clients_.size();
+}
+
+void RosbridgeProtocol::Reply(const ClientPtr& c, const Json& j) {
+  transport_->Send(c, std::make_shared<const std::string>(DumpJson(j)), 0, false, "", 0);
+}
+
+void RosbridgeProtocol::Status(const ClientPtr& c, const std::string& level, const std::string& msg,
+                               const Json& id) {
+  if (level == "error") ++errors_;
+  Reply(c, StatusToJson(level, msg, id));
+}
+
+// ---- incoming messages (network thread) ----
+
+void RosbridgeProtocol::OnMessage(const ClientPtr& c, const std::string& payload) {
+  // nothing a client sends may end the network thread
+  try {
+    HandleText(c, payload);
+  } catch (const std::exception& e) {
+    try {
+      Status(c, "error", std::string("could not handle the message: ") + e.what());
+    } catch (...) {
+    }
+  } catch (...) {
+  }
+}
+
+void RosbridgeProtocol::HandleText(const ClientPtr& c, const std::string& payload) {
+  Json j;
+  try {
+    j = ParseJsonBounded(payload);
+  } catch (const std::exception& e) {
+    Status(c, "error", std::string("malformed JSON: ") + e.what());
+    return;
+  }
+  Json id = j.is_object() && j.contains("id") ? j["id"] : Json();
+  if (!c->authenticated) {
+    // with a token set, nothing but the auth op until it has come right
+    const bool auth = j.is_object() && j.contains("op") && j["op"] == "auth";
+    if (!auth) {
+      Status(c, "error",
+             "authenticate first: send {\"op\": \"auth\", \"mac\": <the server's token>}", id);
+      return;
+    }
+    const bool ok = j.contains("mac") && j["mac"].is_string() &&
+                    SameToken(j["mac"].get<std::string>(), options_.auth_token);
+    if (!ok) {
+      Status(c, "error", "auth: wrong token; closing the connection", id);
+      transport_->Close(c, "authentication failed");
+      return;
+    }
+    c->authenticated = true;
+    Status(c, "info", "authenticated", id);
+    return;
+  }
+  if (j.is_object() && j.value("op", "") == "fragment") {
+    try {
+      std::string whole;
+      if (Reassemble(c, j, &whole)) HandleText(c, whole);
+    } catch (const std::exception& e) {
+      Status(c, "error", e.what(), id);
+    }
+    return;
+  }
+  try {
+    if (!j.is_object() || !j.contains("op") || !j["op"].is_string())
+      throw Error("message has no 'op' string");
+    const std::string& op = j["op"].get_ref<const std::string&>();
+    auto handler = ops_.find(op);
+    if (handler == ops_.end()) throw Error("unknown op '" + op + "'");
+    (this->*handler->second)(c, j, id);
+  } catch (const std::exception& e) {
+    Status(c, "error", e.what(), id);
+  }
+}
+
+bool RosbridgeProtocol::Reassemble(const ClientPtr& c, const Json& j, std::string* whole) {
+  if (!j.contains("id") || !(j["id"].is_string() || j["id"].is_number()))
+    throw Error("fragment needs an 'id'");
+  if (!j.contains("data") || !j["data"].is_string()) throw Error("fragment needs string 'data'");
+  if (!j.contains("num") || !j["num"].is_number_unsigned() || !j.contains("total") ||
+      !j["total"].is_number_unsigned() || j["total"].get<size_t>() == 0 ||
+      j["num"].get<size_t>() >= j["total"].get<size_t>())
+    throw Error("fragment needs integers 0 <= num < total");
+  const std::string key = IdKey(j["id"]);
+  const size_t total = j["total"].get<size_t>(), num = j["num"].get<size_t>();
+  if (total > kMaxFragmentsHeld)
+    throw Error("fragment: total " + std::to_string(total) + " is more than " +
+                std::to_string(kMaxFragmentsHeld) + " pieces");
+  auto it = c->partial.find(key);
+  if (it == c->partial.end()) {
+    if (c->partial.size() >= kMaxPartialMessages)
+      throw Error("fragment: too many messages in pieces at once");
+    it = c->partial.emplace(key, Partial()).first;
+    it->second.total = total;
+  }
+  Partial& p = it->second;
+  if (p.total != total) {
+    c->partial.erase(it);
+    throw Error("fragment '" + key + "': total changed between pieces");
+  }
+  const std::string& data = j["data"].get_ref<const std::string&>();
+  // the bytes held for this client, all its messages in pieces together, stay within one
+  // message's bound
+  size_t held = 0, held_pieces = 0;
+  for (const auto& [k, other] : c->partial) {
+    held += other.bytes;
+    held_pieces += other.pieces.size();
+  }
+  if (held_pieces >= kMaxFragmentsHeld && !p.pieces.count(num)) {
+    c->partial.erase(it);
+    throw Error("fragment '" + key + "': more than " + std::to_string(kMaxFragmentsHeld) +
+                " pieces held for this client");
+  }
+  auto old_piece = p.pieces.find(num);
+  const size_t replaced = old_piece == p.pieces.end() ? 0 : old_piece->second.size();
+  if (held - replaced + data.size() > options_.max_message_bytes) {
+    c->partial.erase(it);
+    throw Error("fragment '" + key + "': the pieces held for this client exceed " +
+                std::to_string(options_.max_message_bytes) + " bytes");
+  }
+  p.bytes = p.bytes - replaced + data.size();
+  p.pieces[num] = data;
+  if (p.pieces.size() < total) return false;
+  // all pieces have come: the message in order of num
+  whole->clear();
+  whole->reserve(p.bytes);
+  for (const auto& [k, piece] : p.pieces) *whole += piece;
+  c->partial.erase(it);
+  return true;
+}
+
+// ---- ops ----
+
+void RosbridgeProtocol::OpSubscribe(const ClientPtr& c, const Json& j, const Json& id) {
+  const std::string op = "subscribe", topic = Name(j, "topic", op);
+  if (j.contains("type") && j["type"].is_string()) {
+    std::lock_guard<std::mutex> lock(clients_mutex_);
+    auto all = AllTopics();
+    auto it = all.find(topic);
+    if (it != all.end() && it->second != j["type"].get<std::string>())
+      throw Error("subscribe " + topic + ": type is " + it->second + ", not " +
+                  j["type"].get<std::string>());
+  }
+  // the request's settings; out-of-range values are ignored, as rosbridge does
+  SubscribeRequest s;
+  s.order = next_request_++;
+  if (j.contains("throttle_rate") && j["throttle_rate"].is_number())
+    s.throttle_ms = j["throttle_rate"].get<double>();
+  if (j.contains("queue_length") && j["queue_length"].is_number_integer() &&
+      j["queue_length"].get<long long>() > 0)
+    s.queue_length = static_cast<size_t>(j["queue_length"].get<long long>());
+  if (j.contains("fragment_size") && j["fragment_size"].is_number_integer() &&
+      j["fragment_size"].get<long long>() > 0)
+    s.fragment_size = static_cast<size_t>(j["fragment_size"].get<long long>());
+  if (j.contains("compression") && j["compression"].is_string()) {
+    const std::string comp = j["compression"].get<std::string>();
+    if (comp == "cbor")
+      s.cbor = true;
+    else if (comp != "none" && comp != "")
+      throw Error("subscribe " + topic + ": compression '" + comp +
+                  "' is not supported (none, cbor)");
+  }
+  const std::string sub_id = id.is_null() ? "" : IdKey(id);
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  if (!c->subs.count(topic) && c->subs.size() >= options_.max_subscriptions)
+    throw Error("subscribe " + topic + ": this client already subscribes to " +
+                std::to_string(c->subs.size()) + " topics (at most " +
+                std::to_string(options_.max_subscriptions) + ")");
+  Subscription& sub = c->subs[topic];
+  if (!sub.requests.count(sub_id) && sub.requests.size() >= kMaxRequestsPerTopic)
+    throw Error("subscribe " + topic + ": " + std::to_string(sub.requests.size()) +
+                " subscribe requests of this client are open on it (at most " +
+                std::to_string(kMaxRequestsPerTopic) + ")");
+  sub.requests[sub_id] = s;
+  sub.Merge();
+}
+
+void RosbridgeProtocol::OpUnsubscribe(const ClientPtr& c, const Json& j, const Json& id) {
+  // with an id: that subscribe request only; without: the whole topic
+  const std::string topic = Name(j, "topic", "unsubscribe");
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  auto it = c->subs.find(topic);
+  if (it == c->subs.end()) return;
+  if (!id.is_null()) {
+    it->second.requests.erase(IdKey(id));
+    if (!it->second.requests.empty()) {
+      it->second.Merge();
+      return;
+    }
+  }
+  c->subs.erase(it);
+}
+
+void RosbridgeProtocol::OpAdvertise(const ClientPtr& c, const Json& j, const Json&) {
+  const std::string op = "advertise", topic = Name(j, "topic", op), type = Str(j, "type", op);
+  const auto sim_topics = SimTopics();
+  auto it = sim_topics.find(topic);
+  if (it != sim_topics.end() && it->second != type)
+    throw Error("advertise " + topic + ": its type is " + it->second + ", not " + type);
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  for (auto& [h, other] : clients_) {
+    auto o = other->advertised.find(topic);
+    if (o != other->advertised.end() && o->second != type)
+      throw Error("advertise " + topic + ": already advertised as " + o->second);
+  }
+  if (!c->advertised.count(topic) && c->advertised.size() >= options_.max_subscriptions)
+    throw Error("advertise " + topic + ": this client already advertises " +
+                std::to_string(c->advertised.size()) + " topics (at most " +
+                std::to_string(options_.max_subscriptions) + ")");
+  c->advertised[topic] = type;
+}
+
+void RosbridgeProtocol::OpUnadvertise(const ClientPtr& c, const Json& j, const Json&) {
+  const std::string topic = Name(j, "topic", "unadvertise");
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  c->advertised.erase(topic);
+}
+
+void RosbridgeProtocol::OpPublish(const ClientPtr& c, const Json& j, const Json& id) {
+  const std::string topic = Name(j, "topic", "publish");
+  if (!j.contains("msg")) throw Error("publish " + topic + ": no 'msg'");
+  if (Published(topic)) throw Error("publish " + topic + ": the simulation publishes this topic");
+  if (SimTopics().count(topic)) {
+    HandleCommand(c, topic, j["msg"], id);
+    return;
+  }
+  // a client's own topic: relay to its subscribers
+  auto text = std::make_shared<const std::string>(DumpJson(PublishToJson(topic, j["msg"])));
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  for (auto& [h, other] : clients_) {
+    auto it = other->subs.find(topic);
+    if (it != other->subs.end())
+      transport_->Send(other, text, it->second.queue_length, false, topic, 0);
+  }
+}
+
+void RosbridgeProtocol::OpCallService(const ClientPtr& c, const Json& j, const Json& id) {
+  const std::string service = Name(j, "service", "call_service");
+  const Json args = j.contains("args") ? j["args"] : Json::object();
+  if (const ServiceHandler* builtin = FindService(service)) {
+    if (std::optional<Json> values = (*builtin)(c, service, args, id))
+      Reply(c, ServiceResponseToJson(service, *values, true, id));
+    return;
+  }
+  // a service some client advertised: forward it with our own id, which no other client can
+  // guess
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  ExpireCalls();
+  for (auto& [h, provider] : clients_) {
+    if (!provider->services.count(service)) continue;
+    size_t mine = 0;
+    for (const auto& [k, call] : pending_calls_) mine += call.caller.lock() == c;
+    if (mine >= kMaxPendingCalls)
+      throw Error("call_service " + service + ": " + std::to_string(mine) +
+                  " calls of this client are still unanswered (at most " +
+                  std::to_string(kMaxPendingCalls) + ")");
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "partsim_call_%016llx%016llx",
+                  static_cast<unsigned long long>(call_ids_()),
+                  static_cast<unsigned long long>(call_ids_()));
+    pending_calls_[buf] = {c, id, provider, service, WallClock::now()};
+    Reply(provider,
+          Json{{"op", "call_service"}, {"service", service}, {"args", args}, {"id", buf}});
+    return;
+  }
+  throw Error("call_service: no service '" + service + "'");
+}
+
+void RosbridgeProtocol::OpAdvertiseService(const ClientPtr& c, const Json& j, const Json&) {
+  const std::string service = Name(j, "service", "advertise_service");
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  if (FindService(service))
+    throw Error("advertise_service " + service + ": partsim provides this service");
+  for (auto& [h, other] : clients_)
+    if (other != c && other->services.count(service))
+      throw Error("advertise_service " + service +
+                  ": another client provides this service (it must unadvertise first)");
+  if (!c->services.count(service) && c->services.size() >= options_.max_services)
+    throw Error("advertise_service " + service + ": this client already provides " +
+                std::to_string(c->services.size()) + " services (at most " +
+                std::to_string(options_.max_services) + ")");
+  c->services.insert(service);
+}
+
+void RosbridgeProtocol::OpUnadvertiseService(const ClientPtr& c, const Json& j, const Json&) {
+  const std::string service = Name(j, "service", "unadvertise_service");
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  c->services.erase(service);
+  AbandonCalls(c, service, "the provider unadvertised " + service);
+}
+
+void RosbridgeProtocol::OpServiceResponse(const ClientPtr& c, const Json& j, const Json&) {
+  if (!j.contains("id") || !j["id"].is_string())
+    throw Error("service_response needs the 'id' of the call it answers");
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  auto it = pending_calls_.find(j["id"].get<std::string>());
+  // only the client the call went to may answer it
+  if (it == pending_calls_.end() || it->second.provider.lock() != c)
+    throw Error("service_response: no pending call '" + j["id"].get<std::string>() +
+                "' to this client");
+  // the caller gets the answer under its own id
+  Json r = j;
+  if (it->second.id.is_null())
+    r.erase("id");
+  else
+    r["id"] = it->second.id;
+  if (ClientPtr caller = it->second.caller.lock()) Reply(caller, r);
+  pending_calls_.erase(it);
+}
+
+void RosbridgeProtocol::OpAuth(const ClientPtr& c, const Json&, const Json& id) {
+  // already authenticated, or no token is set
+  Status(c, "info", options_.auth_token.empty() ? "no token needed" : "authenticated", id);
+}
+
+// ---- services ----
+
+void RosbridgeProtocol::AddServices() {
+  auto empty = [](std::function<void()> f) {
+    return
+        [f](const ClientPtr&, const std::string&, const Json&, const Json&) -> std::optional<Json> {
+          f();
+          return Json::object();
+        };
+  };
+  services_ = {
+      {"/rosapi/topics",
+       [this](const ClientPtr&, const std::string&, const Json&,
+              const Json&) -> std::optional<Json> {
+         std::lock_guard<std::mutex> lock(clients_mutex_);
+         return TopicsToJson(AllTopics());
+       }},
+      {"/rosapi/topic_type",
+       [this](const ClientPtr&, const std::string&, const Json& args,
+              const Json&) -> std::optional<Json> {
+         if (!args.is_object() || !args.contains("topic") || !args["topic"].is_string())
+           throw Error("/rosapi/topic_type needs args {topic: string}");
+         std::lock_guard<std::mutex> lock(clients_mutex_);
+         const auto all = AllTopics();
+         auto it = all.find(args["topic"].get<std::string>());
+         return Json{{"type", it == all.end() ? "" : it->second}};
+       }},
+      {"/rosapi/services",
+       [this](const ClientPtr&, const std::string&, const Json&,
+              const Json&) -> std::optional<Json> {
+         Json names = Json::array();
+         for (const auto& [name, handler] : services_) names.push_back(name);
+         std::lock_guard<std::mutex> lock(clients_mutex_);
+         for (auto& [h, cl] : clients_)
+           for (const std::string& s : cl->services) names.push_back(s);
+         return Json{{"services", names}};
+       }},
+      {"/partsim/pause", empty([this] { sim_->Pause(); })},
+      {"/partsim/resume", empty([this] { sim_->Resume(); })},
+      {"/partsim/reset", empty([this] { sim_->Reset(); })},
+      {"/partsim/step",
+       [this](const ClientPtr&, const std::string&, const Json& args,
+              const Json&) -> std::optional<Json> {
+         sim_->StepN(StepCountFromJson(args));
+         return Json::object();
+       }},
+      {"/partsim/stats",
+       [this](const ClientPtr&, const std::string&, const Json&,
+              const Json&) -> std::optional<Json> {
+         const RosbridgeStats s = stats();
+         return Json{{"clients", s.clients},
+                     {"messages_sent", s.messages_sent},
+                     {"messages_dropped", s.messages_dropped},
+                     {"commands", s.commands},
+                     {"mean_latency_steps", s.mean_latency_steps},
+                     {"max_latency_steps", s.max_latency_steps},
+                     {"clock_steps", sim_->GetClockSteps()},
+                     {"timestep", sim_->GetTimestep()}};
+       }},
+      {Prefix() + "/plan", [this](const ClientPtr& c, const std::string& service, const Json& args,
+                                  const Json& id) { return CallPlan(c, service, args, id); }},
+  };
+}
+
+const RosbridgeProtocol::ServiceHandler* RosbridgeProtocol::FindService(
+    const std::string& name) const {
+  for (const auto& [n, handler] : services_)
+    if (n == name) return &handler;
+  return nullptr;
+}
+
+/// /<robot>/plan: answers once planned, from the planning worker.
+std::optional<Json> RosbridgeProtocol::CallPlan(const ClientPtr& c, const std::string& service,
+                                                const Json& args, const Json& id) {
+  const PlanRequest req = PlanRequestFromJson(args, service);
+  std::weak_ptr<RosbridgeClient> weak = c;
+  robot_->Plan(req, [this, weak, service, id](const PlanResult& r) {
+    if (ClientPtr cp = weak.lock())
+      Reply(cp,
+            ServiceResponseToJson(service, PlanResultToJson(r, robot_->GetJointNames()), true, id));
+  });
+  return std::nullopt;
+}
+
+ServedRobot::ErrorSink RosbridgeProtocol::ErrorsTo(const ClientPtr& client, const Json& id) {
+  std::weak_ptr<RosbridgeClient> weak = client;
+  return [this, weak, id](const std::string& e) {
+    if (ClientPtr c = weak.lock()) Status(c, "error", e, id);
+  };
+}
+
+/// Checks and applies a message published to one of the simulation's command topics (applied
+/// on the simulation thread).
+void RosbridgeProtocol::HandleCommand(const ClientPtr& c, const std::string& topic, const Json& msg,
+                                      const Json& id) {
+  if (!msg.is_object()) throw Error("publish to " + topic + ": msg is not an object");
+  for (const char* kind : {"position", "velocity", "effort"}) {
+    if (topic != Prefix() + "/joint_" + kind + "_controller/command") continue;
+    const std::vector<double> data = Float64MultiArrayFromJson(msg, topic);
+    if (kind[0] == 'p')
+      robot_->CommandPositions(data, topic, ErrorsTo(c, id));
+    else if (kind[0] == 'v')
+      robot_->CommandVelocities(data, topic, ErrorsTo(c, id));
+    else
+      robot_->CommandEfforts(data, topic, ErrorsTo(c, id));
+    return;
+  }
+  const TrajectoryCommand cmd = JointTrajectoryFromJson(msg, topic);
+  auto errors = ErrorsTo(c, id);
+  robot_->CommandTrajectory(cmd, topic, [errors](TrajectoryOutcome o, const std::string& m) {
+    if (o == TrajectoryOutcome::kInvalidGoal) errors(m);
+  });
+}
+
+// ---- calls to client-advertised services ----
+
+void RosbridgeProtocol::AbandonCalls(const ClientPtr& provider, const std::string& service,
+                                     const std::string& why) {
+  for (auto it = pending_calls_.begin(); it != pending_calls_.end();) {
+    const PendingCall& call = it->second;
+    if (call.provider.lock() == provider && (service.empty() || call.service == service)) {
+      FailCall(call, why);
+      it = pending_calls_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+void RosbridgeProtocol::FailCall(const PendingCall& call, const std::string& why) {
+  if (ClientPtr caller = call.caller.lock())
+    Reply(caller, ServiceResponseToJson(call.service, why, false, call.id));
+}
+
+void RosbridgeProtocol::ExpireCalls() {
+  // calls whose caller left are dropped; calls unanswered for kCallTimeout fail
+  const WallClock::time_point now = WallClock::now();
+  for (auto it = pending_calls_.begin(); it != pending_calls_.end();) {
+    const PendingCall& call = it->second;
+    if (call.caller.expired()) {
+      it = pending_calls_.erase(it);
+    } else if (now - call.since > kCallTimeout) {
+      FailCall(call, "the provider of " + call.service + " did not answer in " +
+                         std::to_string(kCallTimeout.count()) + " s");
+      it = pending_calls_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+// ---- topics ----
+
+std::map<std::string, std::string> RosbridgeProtocol::SimTopics() const {
+  std::map<std::string, std::string> t = {
+      {"/clock", kClockType},
+      {"/joint_states", kJointStateType},
+      {"/tf", kTfType},
+      {Prefix() + "/joint_position_controller/command", kFloat64ArrayType},
+      {Prefix() + "/joint_velocity_controller/command", kFloat64ArrayType},
+      {Prefix() + "/joint_effort_controller/command", kFloat64ArrayType},
+      {Prefix() + "/joint_trajectory_controller/command", kTrajectoryType},
+      {"/imu", kImuType}};
+  for (const CameraTopics& c : camera_topics_) {
+    t.emplace(c.image, kImageType);
+    t.emplace(c.info, kCameraInfoType);
+    t.emplace(c.points, kPointCloud2Type);
+  }
+  return t;
+}
+
+bool RosbridgeProtocol::Published(const std::string& topic) const {
+  if (topic == "/clock" || topic == "/joint_states" || topic == "/tf" || topic == "/imu")
+    return true;
+  for (const CameraTopics& c : camera_topics_)
+    if (topic == c.image || topic == c.info || topic == c.points) return true;
+  return false;
+}
+
+std::map<std::string, std::string> RosbridgeProtocol::AllTopics() const {
+  std::map<std::string, std::string> t = SimTopics();
+  for (auto& [h, c] : clients_)
+    for (auto& [topic, type] : c->advertised) t.emplace(topic, type);
+  return t;
+}
+
+bool RosbridgeProtocol::Wanted(const std::string& topic) const {
+  for (auto& [h, c] : clients_)
+    if (c->subs.count(topic)) return true;
+  return false;
+}
+
+// ---- simulation thread ----
+
+void RosbridgeProtocol::OnStep(long long steps) {
+  const double t = steps * sim_->GetTimestep();
+  const WallClock::time_point now = WallClock::now();
+  if (ClientCount() == 0) return;
+  Publish(
+      "/clock", [&] { return ClockToJson(t); }, now);
+  Publish(
+      "/joint_states", [&] { return JointStateToJson(robot_->ReadJointStates(), t); }, now);
+  Publish(
+      "/tf", [&] { return TfToJson(robot_->ReadFrames(), t); }, now);
+  PublishSensors(t, now);
+}
+
+/// Sends `make()` (built once, and encoded once per form: JSON text or CBOR) to the clients
+/// subscribed to `topic` that are not throttled. uint8[] fields are json::binary values: base64
+/// strings in JSON, byte strings in CBOR.
+void RosbridgeProtocol::Publish(const std::string& topic, const std::function<Json()>& make,
+                                WallClock::time_point now) {
+  Json msg;
+  std::shared_ptr<const std::string> text, cbor;
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  for (auto& [h, c] : clients_) {
+    auto it = c->subs.find(topic);
+    if (it == c->subs.end()) continue;
+    Subscription& s = it->second;
+    if (s.throttle_ms > 0 &&
+        std::chrono::duration<double, std::milli>(now - s.last_sent).count() < s.throttle_ms)
+      continue;
+    if (msg.is_null()) msg = PublishToJson(topic, make());
+    s.last_sent = now;
+    // encoded once; each client gets a pointer (this is the simulation thread)
+    if (s.cbor) {
+      if (!cbor) {
+        std::vector<uint8_t> bytes = Json::to_cbor(msg);
+        cbor = std::make_shared<const std::string>(bytes.begin(), bytes.end());
+      }
+      transport_->Send(c, cbor, s.queue_length, true, topic, 0);
+      continue;
+    }
+    if (!text) text = std::make_shared<const std::string>(DumpJson(TextForm(msg)));
+    const size_t fragment = text->size() > s.fragment_size ? s.fragment_size : 0;
+    transport_->Send(c, text, s.queue_length, false, topic, fragment);
+  }
+}
+
+const std::string& RosbridgeProtocol::SensorTopicName(SensorStream stream, size_t camera) const {
+  static const std::string imu = "/imu";
+  switch (stream) {
+    case SensorStream::kImu:
+      return imu;
+    case SensorStream::kImage:
+      return camera_topics_[camera].image;
+    case SensorStream::kPoints:
+      return camera_topics_[camera].points;
+    default:
+      return camera_topics_[camera].info;
+  }
+}
+
+/// Reads the sensors somebody subscribes to, when due (ServedRobot's schedule), and publishes
+/// them.
+void RosbridgeProtocol::PublishSensors(double t, WallClock::time_point now) {
+  const std::vector<CameraSensor>& cams = robot_->GetCameras();
+  SensorSchedule::Output out;
+  out.imu = [&](const ImuReading& r) {
+    Publish(
+        "/imu", [&] { return ImuToJson(r, t, robot_->GetImuFrame()); }, now);
+  };
+  out.picture = [&](size_t i, const Camera& cam, bool image, bool points) {
+    const std::string& frame = cams[i].frame;
+    if (image)
+      Publish(
+          camera_topics_[i].image,
+          [&] { return ImageToJson(cam.GetWidth(), cam.GetHeight(), CameraRgb8(cam), t, frame); },
+          now);
+    if (points)
+      Publish(
+          camera_topics_[i].points,
+          [&] { return PointCloudToJson(CameraOpticalPoints(cam), t, frame); }, now);
+  };
+  out.camera_info = [&](size_t i, const Camera& cam) {
+    Publish(
+        camera_topics_[i].info,
+        [&] {
+          return CameraInfoToJson(cam.GetWidth(), cam.GetHeight(), CameraProjection(cam), t,
+                                  cams[i].frame);
+        },
+        now);
+  };
+  sensors_.Publish(
+      t,
+      [&](SensorStream stream, size_t camera) {
+        std::lock_guard<std::mutex> lock(clients_mutex_);
+        return Wanted(SensorTopicName(stream, camera));
+      },
+      out);
+}
+
+}  // namespace partsim::internal
