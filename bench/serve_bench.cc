@@ -11,9 +11,10 @@
 //      simulated seconds per wall second meanwhile.
 // The set repeats and the median of each figure is printed (a Markdown table); see README.md.
 //
-// Usage: partsim_serve_bench [--repeat N] [--quick]
+// Usage: partsim_serve_bench [--repeat N] [--quick] [--images]
 //   --repeat N   repetitions of the whole set (default 3); the medians are taken over them
 //   --quick      one repetition with shorter windows (a smoke run)
+//   --images     3. alone: 640x480 images per second
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
@@ -445,16 +446,18 @@ int ParseCount(const char* flag, const char* value) {
 
 int main(int argc, char** argv) {
   int repeat = 3;
-  bool quick = false;
+  bool quick = false, images_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--repeat") {
       repeat = ParseCount("--repeat", i + 1 < argc ? argv[++i] : nullptr);
     } else if (arg == "--quick") {
       quick = true;
+    } else if (arg == "--images") {
+      images_only = true;
     } else {
-      std::fprintf(stderr, "unknown argument '%s'\nusage: %s [--repeat N] [--quick]\n", arg.c_str(),
-                   argv[0]);
+      std::fprintf(stderr, "unknown argument '%s'\nusage: %s [--repeat N] [--quick] [--images]\n",
+                   arg.c_str(), argv[0]);
       return 2;
     }
   }
@@ -480,12 +483,14 @@ int main(int argc, char** argv) {
   const Clock::time_point start = Clock::now();
   for (int r = 0; r < repeat; ++r) {
     Figures f;
-    {
-      ServedScene served(10.0);
-      for (int n : client_counts) MeasureJointStates(&served, n, js_window, &f);
+    if (!images_only) {
+      {
+        ServedScene served(10.0);
+        for (int n : client_counts) MeasureJointStates(&served, n, js_window, &f);
+      }
+      MeasureLatency(0, commands, command_spread, &f);
+      MeasureLatency(50, commands, command_spread, &f);
     }
-    MeasureLatency(0, commands, command_spread, &f);
-    MeasureLatency(50, commands, command_spread, &f);
     {
       // the two encodings take turns going first
       ServedScene served(0.0);
@@ -493,13 +498,17 @@ int main(int argc, char** argv) {
       served.Stop();
       renderer = served.Renderer();
     }
-    std::printf(
-        "rep %d: joint states/client [Hz] 1: %.0f, 10: %.0f (min %.0f), 50: %.0f (min %.0f); "
-        "latency [steps] idle %.2f (max %.0f), 50 clients %.2f (max %.0f); images/s json %.1f, "
-        "cbor %.1f\n",
-        r, f["js1 mean"], f["js10 mean"], f["js10 min"], f["js50 mean"], f["js50 min"],
-        f["lat0 mean"], f["lat0 max"], f["lat50 mean"], f["lat50 max"], f["img json rate"],
-        f["img cbor rate"]);
+    if (images_only)
+      std::printf("rep %d: images/s json %.1f, cbor %.1f\n", r, f["img json rate"],
+                  f["img cbor rate"]);
+    else
+      std::printf(
+          "rep %d: joint states/client [Hz] 1: %.0f, 10: %.0f (min %.0f), 50: %.0f (min %.0f); "
+          "latency [steps] idle %.2f (max %.0f), 50 clients %.2f (max %.0f); images/s json %.1f, "
+          "cbor %.1f\n",
+          r, f["js1 mean"], f["js10 mean"], f["js10 min"], f["js50 mean"], f["js50 min"],
+          f["lat0 mean"], f["lat0 max"], f["lat50 mean"], f["lat50 max"], f["img json rate"],
+          f["img cbor rate"]);
     std::fflush(stdout);
     runs.push_back(f);
   }
@@ -525,7 +534,7 @@ int main(int argc, char** argv) {
     std::snprintf(cell, sizeof(cell), fmt, Median(v));
     std::printf("| %s | %s | %s |\n", label.c_str(), cell, each.c_str());
   };
-  for (int n : client_counts) {
+  for (int n : images_only ? std::vector<int>{} : client_counts) {
     const std::string k = "js" + std::to_string(n);
     const std::string who = std::to_string(n) + (n == 1 ? " client" : " clients");
     print("/joint_states per client, " + who + ", mean [Hz]", k + " mean", "%.0f");
@@ -539,10 +548,12 @@ int main(int argc, char** argv) {
     print("  process CPU [cores], " + who, k + " cpu", "%.2f");
     print("  of which the clients' thread [cores], " + who, k + " client cpu", "%.2f");
   }
-  print("command latency, idle, mean [steps]", "lat0 mean", "%.2f");
-  print("command latency, idle, max [steps]", "lat0 max", "%.0f");
-  print("command latency, 50 clients subscribed, mean [steps]", "lat50 mean", "%.2f");
-  print("command latency, 50 clients subscribed, max [steps]", "lat50 max", "%.0f");
+  if (!images_only) {
+    print("command latency, idle, mean [steps]", "lat0 mean", "%.2f");
+    print("command latency, idle, max [steps]", "lat0 max", "%.0f");
+    print("command latency, 50 clients subscribed, mean [steps]", "lat50 mean", "%.2f");
+    print("command latency, 50 clients subscribed, max [steps]", "lat50 max", "%.0f");
+  }
   for (const char* enc : {"json", "cbor"}) {
     const std::string k = std::string("img ") + enc;
     const std::string name = std::string(enc) == "json" ? "JSON (base64)" : "CBOR";

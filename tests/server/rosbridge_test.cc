@@ -1338,24 +1338,5 @@ TEST_F(RosbridgeSensorTest, TfCameraOpticalFrameLooksAlongTheViewWithYDown) {
   EXPECT_LT((y + up).norm(), 1e-6) << y.transpose();
 }
 
-/// Images per second at 640x480 delivered to one client, cameras rendered every step
-/// (llvmpipe: the rasterizer on the CPU). Prints the figure for the README.
-TEST_F(RosbridgeSensorTest, ImageThroughput640x480) {
-  Start(640, 480, 0);
-  TestClient c(port_);
-  ASSERT_TRUE(c.WaitOpen());
-  c.CountOnly("/cam/image_raw");
-  c.Send(json{{"op", "subscribe"}, {"topic", "/cam/image_raw"}});
-  ASSERT_TRUE(WaitFor([&] { return c.Counted() > 0; }));
-  const long long n0 = c.Counted();
-  const auto t0 = std::chrono::steady_clock::now();
-  std::this_thread::sleep_for(5s);
-  const long long n = c.Counted() - n0;
-  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("rosbridge 640x480 image_raw: %lld images in %.2f s = %.1f images/s\n", n, secs,
-              n / secs);
-  EXPECT_GT(n, 0);
-}
-
 }  // namespace
 }  // namespace partsim
