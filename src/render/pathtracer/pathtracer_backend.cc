@@ -47,8 +47,8 @@
 #include "partsim/core/error.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera_math.h"
-#include "render/pt_sampling.h"
-#include "render/pt_texture.h"
+#include "render/pathtracer/pt_sampling.h"
+#include "render/pathtracer/pt_texture.h"
 
 namespace partsim {
 

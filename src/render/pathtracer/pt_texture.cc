@@ -1,4 +1,4 @@
-#include "render/pt_texture.h"
+#include "render/pathtracer/pt_texture.h"
 
 #include <cmath>
 

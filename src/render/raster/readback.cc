@@ -1,0 +1,132 @@
+// The rasterizer's read-back: glReadnPixels of each target asked for, straight into the Picture
+// (the flipped projection put the image's top row in framebuffer row 0: no flip).
+#include "render/raster/readback.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <system_error>
+#include <thread>
+
+#include "partsim/core/error.h"
+#include "render/depth_to_position.h"
+#include "render/picture_internal.h"
+
+namespace partsim::internal::raster {
+
+namespace {
+
+// one target of `fbo` into `dst` (`bytes` long)
+void Read(const Targets& targets, GLuint fbo, GLenum attachment, GLenum format, GLenum type,
+          void* dst, size_t bytes) {
+  glNamedFramebufferReadBuffer(fbo, attachment);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+  glReadnPixels(0, 0, targets.width(), targets.height(), format, type, static_cast<GLsizei>(bytes),
+                dst);
+}
+
+}  // namespace
+
+// The depth buffer is read back first and converted on worker threads while this thread reads the
+// colour back (on a GPU the conversion would otherwise be most of the frame's time at 512 x 512:
+// bench/README.md).
+void ReadBack::Forward(const Targets& targets, const CameraParams& camera, unsigned outputs,
+                       Picture* out) {
+  const int width = targets.width(), height = targets.height();
+  size_t n = static_cast<size_t>(width) * height;
+  out->width = width;
+  out->height = height;
+  internal::KeepOutputs(outputs, out);
+  if (outputs & kColor) out->color.resize(n * 4);
+  if (outputs & kPosition) {
+    out->position.resize(n * 4);
+    window_depth_.resize(n);
+  }
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  const Eigen::Matrix4d P = FlippedProjection(camera);
+  const int parts = (outputs & kPosition) ? ConversionParts(n) : 0;
+  auto convert = [&](int part) {
+    internal::PositionFromDepth(
+        P, width, height, window_depth_.data(), out->position.data(),
+        static_cast<int>(static_cast<int64_t>(height) * part / parts),
+        static_cast<int>(static_cast<int64_t>(height) * (part + 1) / parts));
+  };
+  bool started = false;
+  if (outputs & kPosition) {
+    Read(targets, targets.forward_fbo(), GL_COLOR_ATTACHMENT0, GL_DEPTH_COMPONENT, GL_FLOAT,
+         window_depth_.data(), window_depth_.size() * sizeof(float));
+    if (parts > 1) {
+      try {
+        conversion_workers_.Start(parts, convert);
+        started = true;
+      } catch (const std::system_error&) {
+        // no thread to be had: this thread converts after the colour
+      }
+    }
+  }
+  if (outputs & kColor) {
+    Read(targets, targets.forward_fbo(), GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, out->color.data(),
+         out->color.size() * sizeof(float));
+  }
+  if (started) {
+    conversion_workers_.Wait();
+  } else if (outputs & kPosition) {
+    for (int part = 0; part < parts; ++part) convert(part);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  GLenum err = glGetError();
+  if (err == GL_OUT_OF_MEMORY) throw Error("rasterizer: out of GPU memory");
+}
+
+// the parts the depth of n pixels is converted in: one below 64 x 64 (converted on this
+// thread), else one per 16k pixels, from 2 to twice the workers. (Converting 128 x 128 on this
+// thread instead made the frame slower on a GPU machine: bench/README.md.)
+int ReadBack::ConversionParts(size_t n) const {
+  if (n < 64 * 64) return 1;
+  return std::clamp(static_cast<int>(n / 16384), 2, 2 * conversion_workers_.size());
+}
+
+// threads converting the depth buffer to Position while this one reads the colour back: at most
+// 4, one fewer than the cores
+int ReadBack::ConversionWorkers() {
+  int cores = static_cast<int>(std::thread::hardware_concurrency());
+  return std::clamp(cores - 1, 1, 4);
+}
+
+void ReadBack::Deferred(const Targets& targets, unsigned outputs, Picture* out) {
+  const int width = targets.width(), height = targets.height();
+  size_t n = static_cast<size_t>(width) * height;
+  out->width = width;
+  out->height = height;
+  internal::KeepOutputs(outputs, out);
+  if (outputs & kColor) out->color.resize(n * 4);
+  if (outputs & kAlbedo) out->albedo.resize(n * 4);
+  if (outputs & kNormal) out->normal.resize(n * 4);
+  if (outputs & kPosition) out->position.resize(n * 4);
+  if (outputs & kSegmentation) out->segmentation.resize(n * 2);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  if (outputs & kColor) {
+    Read(targets, targets.color_fbo(), GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, out->color.data(),
+         out->color.size() * sizeof(float));
+  }
+  if (outputs & kAlbedo) {
+    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetAlbedo, GL_RGBA, GL_FLOAT,
+         out->albedo.data(), out->albedo.size() * sizeof(float));
+  }
+  if (outputs & kNormal) {
+    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetNormal, GL_RGBA, GL_FLOAT,
+         out->normal.data(), out->normal.size() * sizeof(float));
+  }
+  if (outputs & kPosition) {
+    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetPosition, GL_RGBA, GL_FLOAT,
+         out->position.data(), out->position.size() * sizeof(float));
+  }
+  if (outputs & kSegmentation) {
+    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER,
+         GL_UNSIGNED_INT, out->segmentation.data(), out->segmentation.size() * sizeof(uint32_t));
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  GLenum err = glGetError();
+  if (err == GL_OUT_OF_MEMORY) throw Error("rasterizer: out of GPU memory");
+}
+
+}  // namespace partsim::internal::raster

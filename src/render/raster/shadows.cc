@@ -1,0 +1,169 @@
+// The rasterizer's shadow maps: an orthographic camera around the receivers for a directional
+// light, a perspective one over the light's cone for a spot light; 3x3 PCF in the shading reads
+// them.
+#include "render/raster/shadows.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace partsim::internal::raster {
+
+namespace {
+
+Eigen::Matrix4f ToFloat(const Eigen::Matrix4d& m) { return m.cast<float>(); }
+
+// a right-handed look-at view matrix (world -> eye, eye looks along -z)
+Eigen::Matrix4d LookAlong(const Eigen::Vector3d& eye, const Eigen::Vector3d& forward) {
+  Eigen::Vector3d f = forward.normalized();
+  Eigen::Vector3d up = std::abs(f.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  Eigen::Vector3d x = f.cross(up).normalized();
+  Eigen::Vector3d y = x.cross(f);
+  Eigen::Matrix4d v = Eigen::Matrix4d::Identity();
+  v.block<1, 3>(0, 0) = x.transpose();
+  v.block<1, 3>(1, 0) = y.transpose();
+  v.block<1, 3>(2, 0) = -f.transpose();
+  v(0, 3) = -x.dot(eye);
+  v(1, 3) = -y.dot(eye);
+  v(2, 3) = f.dot(eye);
+  return v;
+}
+
+Eigen::Matrix4d Ortho(double l, double r, double b, double t, double n, double f) {
+  Eigen::Matrix4d p = Eigen::Matrix4d::Identity();
+  p(0, 0) = 2 / (r - l);
+  p(1, 1) = 2 / (t - b);
+  p(2, 2) = -2 / (f - n);
+  p(0, 3) = -(r + l) / (r - l);
+  p(1, 3) = -(t + b) / (t - b);
+  p(2, 3) = -(f + n) / (f - n);
+  return p;
+}
+
+Eigen::Matrix4d Perspective(double fovy, double n, double f) {
+  double c = 1 / std::tan(fovy / 2);
+  Eigen::Matrix4d p = Eigen::Matrix4d::Zero();
+  p(0, 0) = c;
+  p(1, 1) = c;
+  p(2, 2) = -(f + n) / (f - n);
+  p(2, 3) = -2 * f * n / (f - n);
+  p(3, 2) = -1;
+  return p;
+}
+
+}  // namespace
+
+void ShadowMaps::Create() { glCreateFramebuffers(1, &fbo_); }
+
+void ShadowMaps::Delete() {
+  glDeleteTextures(1, &maps_);
+  glDeleteFramebuffers(1, &fbo_);
+  maps_ = fbo_ = 0;
+}
+
+GLuint ShadowMaps::Texture() {
+  if (maps_ != 0) return maps_;
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &maps_);
+  glTextureStorage3D(maps_, 1, GL_DEPTH_COMPONENT32F, size_, size_, kMaxShadows);
+  glTextureParameteri(maps_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(maps_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(maps_, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(maps_, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(maps_, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTextureParameteri(maps_, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  return maps_;
+}
+
+int ShadowMaps::Render(const RenderWorld& world, const CameraParams& camera,
+                       const Eigen::AlignedBox3d& scene_box, const Resources& resources,
+                       GLuint program, GLint mvp_location) {
+  int count = 0;
+  layer_.assign(world.lights.size(), -1);
+  if (scene_box.isEmpty()) return 0;
+  Eigen::Matrix4d X_WG = camera.view.inverse();
+
+  // receivers: the scene's box cut by the box of the view frustum
+  Eigen::AlignedBox3d frustum_box;
+  double far = std::min(camera.far, 1e4);
+  for (int c = 0; c < 8; ++c) {
+    double z = (c & 4) ? far : camera.near;
+    double u = (c & 1) ? camera.width - 0.5 : -0.5;
+    double v = (c & 2) ? camera.height - 0.5 : -0.5;
+    // OpenCV ray through the image corner, into G (y and z flip)
+    Eigen::Vector3d ray = camera.K.inverse() * Eigen::Vector3d(u, v, 1.0);
+    Eigen::Vector3d p_G(ray.x() * z, -ray.y() * z, -z);
+    frustum_box.extend((X_WG * p_G.homogeneous()).head<3>());
+  }
+  Eigen::AlignedBox3d receivers = scene_box.intersection(frustum_box);
+  if (receivers.isEmpty()) receivers = scene_box;
+
+  for (size_t li = 0; li < world.lights.size() && count < kMaxShadows; ++li) {
+    const LightDesc& light = world.lights[li];
+    if (!light.shadow || light.type == LightType::kPoint) continue;
+    Eigen::Vector3d dir = light.direction.normalized();
+    if (!dir.allFinite()) continue;
+    Eigen::Matrix4d view, proj;
+    Eigen::Vector2d texel;
+    if (light.type == LightType::kDirectional) {
+      Eigen::Vector3d c = receivers.center();
+      double r = std::max(0.5 * receivers.diagonal().norm(), 1e-3);
+      view = LookAlong(c, dir);
+      // depth range over every caster: all corners of the scene box
+      double zmin = std::numeric_limits<double>::max(), zmax = -zmin;
+      for (int k = 0; k < 8; ++k) {
+        double z = (view * scene_box.corner(Eigen::AlignedBox3d::CornerType(k)).homogeneous())(2);
+        zmin = std::min(zmin, z);
+        zmax = std::max(zmax, z);
+      }
+      double margin = 0.01 * (zmax - zmin) + 1e-3;
+      proj = Ortho(-r, r, -r, r, -zmax - margin, -zmin + margin);
+      texel = Eigen::Vector2d(2 * r / size_, 0);
+    } else {
+      view = LookAlong(light.position, dir);
+      double dmax = 0;
+      for (int k = 0; k < 8; ++k) {
+        dmax = std::max(
+            dmax, (scene_box.corner(Eigen::AlignedBox3d::CornerType(k)) - light.position).norm());
+      }
+      double fovy = std::min(2 * std::max(light.outer_angle, light.inner_angle) + 0.05, 3.0);
+      double f = dmax * 1.01 + 1e-3;
+      double n = std::max(f * 1e-4, 1e-3);
+      proj = Perspective(fovy, n, f);
+      texel = Eigen::Vector2d(0, 2 * std::tan(fovy / 2) / size_);
+    }
+    Eigen::Matrix4d view_proj = proj * view;
+    Texture();
+    glNamedFramebufferTextureLayer(fbo_, GL_DEPTH_ATTACHMENT, maps_, 0, count);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, size_, size_);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(1.5f, 2.0f);
+    const float one = 1.0f;
+    glClearNamedFramebufferfv(fbo_, GL_DEPTH, 0, &one);
+    glUseProgram(program);
+    for (size_t i = 0; i < world.instances.size(); ++i) {
+      const GpuMesh* mesh = resources.mesh(i);
+      if (mesh == nullptr) continue;
+      Eigen::Matrix4f mvp = ToFloat(view_proj * world.instances[i].X_WV);
+      glUniformMatrix4fv(mvp_location, 1, GL_FALSE, mvp.data());
+      glBindVertexArray(mesh->vao);
+      glDrawElements(GL_TRIANGLES, mesh->index_count, GL_UNSIGNED_INT, nullptr);
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    // camera G -> light clip -> [0, 1]^3
+    Eigen::Matrix4d bias = Eigen::Matrix4d::Identity() * 0.5;
+    bias(3, 3) = 1;
+    bias.block<3, 1>(0, 3).setConstant(0.5);
+    matrix_[count] = ToFloat(bias * view_proj * X_WG);
+    texel_[count] = texel.cast<float>();
+    layer_[li] = count;
+    ++count;
+  }
+  return count;
+}
+
+}  // namespace partsim::internal::raster
