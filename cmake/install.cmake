@@ -2,7 +2,7 @@
 #
 # `cmake --install build --prefix PREFIX` installs:
 #   PREFIX/bin/partsim                            the command line
-#   PREFIX/lib/<multiarch>/libpartsim.so          the C++ library (everything of partsim_core)
+#   PREFIX/lib/<multiarch>/libpartsim.so          the C++ library (every layer's library whole)
 #   PREFIX/include/partsim/                       its headers (they need Eigen only)
 #   PREFIX/lib/<multiarch>/cmake/partsim/         find_package(partsim) -> partsim::partsim
 #   PREFIX/lib/python3/dist-packages/partsim/     the Python package (Debian's path for /usr)
@@ -13,10 +13,21 @@ include(CMakePackageConfigHelpers)
 
 # libpartsim.so: the static core whole, for C++ programs that link partsim
 file(WRITE ${CMAKE_BINARY_DIR}/partsim_shared.cc
-     "// libpartsim.so holds the objects of partsim_core; this file only gives it a source.\n")
+     "// libpartsim.so holds the objects of every layer; this file only gives it a source.\n")
 add_library(partsim SHARED ${CMAKE_BINARY_DIR}/partsim_shared.cc)
 add_library(partsim::partsim ALIAS partsim)
-target_link_libraries(partsim PRIVATE "$<LINK_LIBRARY:WHOLE_ARCHIVE,partsim_core>")
+# every layer's archive whole (each once: a layer is also a dependency of the ones above it, so
+# CMake's own WHOLE_ARCHIVE feature would list it twice), then the layers and their external
+# libraries as usual
+set(PARTSIM_LAYER_LIBS partsim_core partsim_physics partsim_assets partsim_render partsim_robot
+                       partsim_planning partsim_tasks partsim_server)
+set(whole "LINKER:--whole-archive")
+foreach(lib ${PARTSIM_LAYER_LIBS})
+  list(APPEND whole "$<TARGET_FILE:${lib}>")
+endforeach()
+list(APPEND whole "LINKER:--no-whole-archive")
+target_link_options(partsim PRIVATE ${whole})
+target_link_libraries(partsim PRIVATE partsim_all)
 target_link_libraries(partsim PUBLIC Eigen3::Eigen Threads::Threads)
 target_include_directories(partsim PUBLIC $<BUILD_INTERFACE:${CMAKE_SOURCE_DIR}/include>
                                           $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)

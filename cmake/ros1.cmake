@@ -123,6 +123,6 @@ endif()
 
 add_library(partsim_ros1 STATIC ${CMAKE_SOURCE_DIR}/src/server/ros1/ros1_bridge.cc)
 target_include_directories(partsim_ros1 SYSTEM PRIVATE ${ROS1_OUT}/include)
-target_link_libraries(partsim_ros1 PUBLIC partsim_core PRIVATE PkgConfig::ROS1)
+target_link_libraries(partsim_ros1 PUBLIC partsim_server PRIVATE PkgConfig::ROS1)
 target_compile_options(partsim_ros1 PRIVATE -Wall -Wextra -Wno-unused-parameter)
 target_compile_definitions(partsim_ros1 PUBLIC PARTSIM_WITH_ROS1=1)

@@ -19,6 +19,13 @@ if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
 fi
 npm install --prefix build/node --no-audit --no-fund roslib@^2.1.0 ws@^8
 
+echo "== physics alone: core and physics built and tested without the layers above (build-physics/)"
+if [ ! -f build-physics/CMakeCache.txt ]; then
+  cmake -S . -B build-physics -DCMAKE_BUILD_TYPE=Release -DPARTSIM_PHYSICS_ONLY=ON >/dev/null
+fi
+cmake --build build-physics -j"${PARTSIM_JOBS:-2}"
+ctest --test-dir build-physics --output-on-failure -j2
+
 echo "== C++ tests (ctest)"
 ctest --test-dir build --output-on-failure -j2
 

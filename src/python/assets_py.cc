@@ -7,9 +7,9 @@
 #include "partsim/assets/mesh.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/assets/quality.h"
-#include "partsim/render/visibility.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/physics/scene.h"
+#include "partsim/render/visibility.h"
 
 namespace partsim::python {
 
@@ -267,9 +267,9 @@ void BindAssets(py::module_& m) {
       },
       py::arg("folder"), py::arg("options") = QualityOptions(),
       py::call_guard<py::gil_scoped_release>(),
-        "Runs the quality checks (load, labels, rest, range, visible) on one folder and "
-        "returns an ObjectQualityReport; never raises for a bad object (the failure is in the "
-        "report). Releases the GIL.");
+      "Runs the quality checks (load, labels, rest, range, visible) on one folder and "
+      "returns an ObjectQualityReport; never raises for a bad object (the failure is in the "
+      "report). Releases the GIL.");
   m.def("paper_statistics", &PaperStatistics,
         "The SAPIEN paper's models and movable parts per category.");
 }

@@ -40,3 +40,17 @@ int ClearOwnedOutputs(const std::string& dir,
                       const std::vector<std::pair<std::string, std::string>>& names);
 
 }  // namespace partsim::tools
+
+namespace partsim {
+
+/// `partsim assets check DIR ...` (arguments after "check"); returns the exit code.
+int RunQualityCommand(int argc, char** argv);
+
+/// `partsim assets decompose MESH --out DIR [--concavity C] [--max-pieces N] [--min-pieces N]
+/// [--max-hull-vertices N] [--name BASENAME]`: decomposes MESH, prints the piece count, coverage,
+/// max surface distance, excess and time, and writes the pieces (WriteConvexPieces; basename:
+/// the mesh's file stem). As in main(), `argv[0]` is the command's name ("decompose") and the
+/// arguments follow. Returns 0 on success, 2 on bad arguments, 1 on failure (message on stderr).
+int RunDecomposeCommand(int argc, char** argv);
+
+}  // namespace partsim

@@ -16,6 +16,7 @@
 #include "partsim/assets/urdf.h"
 #include "partsim/core/error.h"
 #include "partsim/physics/scene.h"
+#include "tools/commands.h"
 
 namespace partsim {
 namespace {

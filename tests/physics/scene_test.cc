@@ -573,10 +573,17 @@ TEST(SceneTest, ConvexMeshRestsAtItsExtent) {
                     {-0.1f, 0.1f, -0.05f},
                     {0.1f, 0.1f, -0.05f},
                     {0.0f, 0.0f, 0.15f}};
-  Actor a = scene.CreateActorBuilder()
-                .AddConvexCollisionFromMesh(mesh, Pose(Eigen::Vector3d(0, 0, 0.02)))
-                .SetInitialPose(Pose(Eigen::Vector3d(0, 0, 0.5)))
-                .Build();
+  // the shape straight into the description (the builder's AddConvexCollisionFromMesh, which
+  // checks the piece first, belongs to the assets layer)
+  ActorDesc desc;
+  desc.name = "wedge";
+  desc.pose = Pose(Eigen::Vector3d(0, 0, 0.5));
+  CollisionShape shape;
+  shape.type = ShapeType::kConvexMesh;
+  shape.mesh = mesh;
+  shape.pose = Pose(Eigen::Vector3d(0, 0, 0.02));
+  desc.collisions.push_back(shape);
+  Actor a = scene.AddActor(desc);
   scene.Step(1000);
   // body origin sits 0.05 - 0.02 = 0.03 above the ground
   EXPECT_NEAR(a.GetPose().p.z(), 0.03, 2e-3);

@@ -98,11 +98,4 @@ std::shared_ptr<MeshData> ConvexHull(const std::vector<Eigen::Vector3d>& points)
 /// counter-clockwise seen from outside.
 double MeshVolume(const MeshData& mesh);
 
-/// `partsim assets decompose MESH --out DIR [--concavity C] [--max-pieces N] [--min-pieces N]
-/// [--max-hull-vertices N] [--name BASENAME]`: decomposes MESH, prints the piece count, coverage,
-/// max surface distance, excess and time, and writes the pieces (WriteConvexPieces; basename:
-/// the mesh's file stem). As in main(), `argv[0]` is the command's name ("decompose") and the
-/// arguments follow. Returns 0 on success, 2 on bad arguments, 1 on failure (message on stderr).
-int RunDecomposeCommand(int argc, char** argv);
-
 }  // namespace partsim

@@ -67,9 +67,6 @@ struct DatasetStatistics {
   std::string ToTable(bool with_paper = true) const;
 };
 
-/// `partsim assets check DIR ...` (arguments after "check"); returns the exit code.
-int RunQualityCommand(int argc, char** argv);
-
 /// The SAPIEN paper's PartNet-Mobility figures: category -> (models, movable parts).
 const std::map<std::string, std::pair<int, int>>& PaperStatistics();
 

@@ -20,6 +20,7 @@
 #include "partsim/assets/quality.h"
 #include "partsim/core/error.h"
 #include "partsim/render/visibility.h"
+#include "tools/commands.h"
 
 namespace partsim {
 

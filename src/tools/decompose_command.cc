@@ -6,6 +6,7 @@
 
 #include "partsim/assets/convex_decomposition.h"
 #include "partsim/core/error.h"
+#include "tools/commands.h"
 
 namespace partsim {
 namespace {
