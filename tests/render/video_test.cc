@@ -2,6 +2,7 @@
 #include "partsim/render/video.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -24,7 +25,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("partsim_video_test_" + name);
+  fs::path d =
+      fs::temp_directory_path() / ("partsim_video_test_" + std::to_string(getpid()) + "_" + name);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

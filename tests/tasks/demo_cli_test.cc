@@ -1,6 +1,7 @@
 // `partsim tasks demo`: the video it writes and the errors of its options, through the program.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -29,7 +30,8 @@ CliRun Cli(const std::string& args) {
 }
 
 TEST(TasksDemoCliTest, WritesTheVideoAndSaysWhere) {
-  fs::path dir = fs::temp_directory_path() / "partsim_demo_cli_test";
+  // per process: two test runs at once must not share it
+  fs::path dir = fs::temp_directory_path() / ("partsim_demo_cli_test_" + std::to_string(getpid()));
   fs::remove_all(dir);
   CliRun r = Cli("tasks demo --out " + dir.string() + " --size 160x120 --every 10 --frames");
   ASSERT_EQ(r.code, 0) << r.out;

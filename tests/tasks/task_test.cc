@@ -1,6 +1,7 @@
 // The drawer and door tasks on generated cabinets: set-up, determinism, bad actions, cameras,
 // a scripted grasp-and-pull and the heuristic solvers.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -94,7 +95,8 @@ TEST(TaskTest, RecordsTheEpisodeWithoutChangingIt) {
   EXPECT_EQ(video.GetWidth(), 160);
   EXPECT_EQ(recorded.GetCameras().size(), 3u);  // the perception cameras only
   namespace fs = std::filesystem;
-  fs::path dir = fs::temp_directory_path() / "partsim_task_video_test";
+  fs::path dir =
+      fs::temp_directory_path() / ("partsim_task_video_test_" + std::to_string(getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   SolverOptions so;
