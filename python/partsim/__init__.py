@@ -11,11 +11,11 @@ import sys as _sys
 
 from ._partsim import *  # noqa: F401,F403
 from ._partsim import PartsimError, PartsimIndexError  # noqa: F401  (explicit for readers)
+from ._partsim import __version__  # noqa: F401  (the project's version, set by CMake)
 from ._sapien import (  # noqa: F401
     Engine, KuafuRenderer, RenderBodyComponent, RenderMaterial, SapienContact, SapienRenderer,
     SceneConfig, Viewer, VulkanRenderer, physx, render, set_log_level, utils)
 
-__version__ = "0.1.0"
 
 # SAPIEN 2 scripts say `import sapien.core as sapien`: partsim.core is partsim itself
 core = _sys.modules[__name__]

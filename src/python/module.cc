@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 
 #include "bindings.h"
+#include "partsim/core/version.h"
 
 PYBIND11_MODULE(_partsim, m) {
   m.doc() = "partsim: simulation of robots interacting with articulated objects (MuJoCo 2.2.2).";
@@ -14,4 +15,5 @@ PYBIND11_MODULE(_partsim, m) {
   partsim::python::BindControl(m);
   partsim::python::BindTasks(m);
   partsim::python::BindPlanning(m);
+  m.attr("__version__") = partsim::Version();
 }

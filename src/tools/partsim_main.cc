@@ -10,10 +10,9 @@
 
 #include "arg_parser.h"
 #include "commands.h"
+#include "partsim/core/version.h"
 
 namespace {
-
-constexpr char kVersion[] = "0.1.0";
 
 constexpr char kUsage[] = R"(partsim: simulate robots and articulated objects (doors, drawers, ...)
 
@@ -84,7 +83,8 @@ int main(int argc, char** argv) {
   }
   if (command == "--version") {
     int v = mj_version();
-    std::printf("partsim %s (MuJoCo %d.%d.%d)\n", kVersion, v / 100, (v / 10) % 10, v % 10);
+    std::printf("partsim %s (MuJoCo %d.%d.%d)\n", partsim::Version(), v / 100, (v / 10) % 10,
+                v % 10);
     return 0;
   }
   if (command == "assets") return partsim::tools::RunAssetsCommand(argc - 2, argv + 2);

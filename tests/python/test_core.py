@@ -82,5 +82,16 @@ def test_exception_hierarchy():
     assert issubclass(partsim.PartsimIndexError, partsim.PartsimError)
 
 
-def test_version():
-    assert isinstance(partsim.__version__, str)
+def test_version_is_the_projects_everywhere():
+    import os
+    import re
+    import subprocess
+
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    with open(os.path.join(repo, "CMakeLists.txt")) as f:
+        project = re.search(r"project\(partsim VERSION ([0-9.]+)", f.read()).group(1)
+    assert partsim.__version__ == project
+    cli = os.path.join(os.path.dirname(os.path.dirname(partsim.__file__)), "..", "partsim")
+    if os.path.exists(cli):  # the build tree's command line beside build/python
+        out = subprocess.run([cli, "--version"], capture_output=True, text=True, timeout=30)
+        assert out.stdout.startswith("partsim " + project + " "), out.stdout
