@@ -89,3 +89,19 @@ def test_package_exports_the_module():
                     callable(ours))
         elif not name.startswith("_"):
             assert getattr(partsim, name) is getattr(ext, name)
+
+
+def test_stubs_are_what_gen_stubs_writes():
+    """Signatures and docstrings too, not only names: the committed .pyi is exactly what
+    scripts/gen_stubs.py makes from the built module (run it to update the file)."""
+    import subprocess
+    import sys
+
+    from conftest import PYTHON_DIR
+
+    script = os.path.join(REPO, "scripts", "gen_stubs.py")
+    out = subprocess.run([sys.executable, script, "--python-dir", PYTHON_DIR, "--check"],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, (
+        "python/partsim/_partsim.pyi is stale: run /usr/bin/python3 scripts/gen_stubs.py "
+        "--python-dir build/python\n" + out.stdout[-3000:] + out.stderr[-3000:])
