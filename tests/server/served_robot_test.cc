@@ -653,5 +653,69 @@ TEST(ServedRobotTest, CameraOpticalFrameLooksAlongTheViewWithYDown) {
   EXPECT_LT((R.transpose() - R_OW).norm(), 1e-6);
 }
 
+// ---- the sensor schedule ----
+
+TEST(ServedRobotTest, SensorScheduleKeepsItsRatesInSimulatedTimeAndServesOnlyListeners) {
+  World w({/*panda=*/false, /*camera=*/true});
+  ASSERT_EQ(w.served->GetOptions().camera_rate, 10.0);  // pictures every 0.1 s
+  ASSERT_EQ(w.served->GetOptions().imu_rate, 0.0);      // the IMU every step
+  SensorSchedule schedule(w.served.get());
+  int imu = 0, images = 0, points = 0, infos = 0;
+  std::vector<double> picture_times;
+  double now = 0;
+  SensorSchedule::Output out;
+  out.imu = [&](const ImuReading&) { ++imu; };
+  out.picture = [&](size_t i, const Camera& cam, bool image, bool pts) {
+    EXPECT_EQ(i, 0u);
+    EXPECT_EQ(cam.GetWidth(), 32);
+    images += image;
+    points += pts;
+    picture_times.push_back(now);
+  };
+  out.camera_info = [&](size_t, const Camera&) { ++infos; };
+  // `t` in steps of 2 ms from `from` to `to` (inclusive), the listeners given by `listened`
+  auto run = [&](int from, int to, const SensorSchedule::Listened& listened) {
+    OnSim(*w.sim, [&] {
+      for (int k = from; k <= to; ++k) {
+        now = k * 0.002;
+        schedule.Publish(now, listened, out);
+      }
+      return 0;
+    });
+  };
+
+  // nobody listens: nothing is read, and the clock of each stream stands still
+  run(0, 100, [](SensorStream, size_t) { return false; });
+  EXPECT_EQ(imu + images + points + infos, 0);
+
+  // everything listened from t = 0.202 s to 0.7 s: the IMU every step, a picture (image and
+  // points at once) and camera_info at once, then every 0.1 s
+  run(101, 350, [](SensorStream, size_t) { return true; });
+  EXPECT_EQ(imu, 250);
+  EXPECT_EQ(images, 5);
+  EXPECT_EQ(points, 5);
+  EXPECT_EQ(infos, 5);
+  ASSERT_EQ(picture_times.size(), 5u);
+  for (size_t k = 0; k < picture_times.size(); ++k)
+    EXPECT_NEAR(picture_times[k], 0.202 + 0.1 * k, 1e-9);
+
+  // only the image listened: pictures without points, at the same rate, no IMU or camera_info
+  imu = images = points = infos = 0;
+  run(351, 400, [](SensorStream s, size_t) { return s == SensorStream::kImage; });
+  EXPECT_EQ(images, 1);  // at 0.702 s; the next falls due at 0.802 s
+  EXPECT_EQ(points, 0);
+  EXPECT_EQ(imu + infos, 0);
+}
+
+TEST(ServedRobotTest, SensorTopicsAreNamedAfterTheCamera) {
+  World w({/*panda=*/false, /*camera=*/true});
+  const ServedRobot& r = *w.served;
+  EXPECT_EQ(SensorTopic(r, SensorStream::kImu), "/imu");
+  EXPECT_EQ(SensorTopic(r, SensorStream::kImage, 0), "/cam/image_raw");
+  EXPECT_EQ(SensorTopic(r, SensorStream::kPoints, 0), "/cam/points");
+  EXPECT_EQ(SensorTopic(r, SensorStream::kCameraInfo, 0), "/cam/camera_info");
+  EXPECT_THROW(SensorTopic(r, SensorStream::kImage, 1), std::out_of_range);
+}
+
 }  // namespace
 }  // namespace partsim

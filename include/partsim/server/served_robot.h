@@ -1,9 +1,10 @@
 // A robot served to network clients, shared by the protocol front-ends (rosbridge, native ROS 1):
 // its controllers and the commands that switch between them, trajectory goals with tolerances
 // and an outcome (what ROS's follow_joint_trajectory action reports), motion planning off the
-// simulation thread, and the readings the front-ends publish (joint states, frames, cameras,
-// IMU). Commands are checked on the caller's thread and applied on the simulation thread between
-// two steps, so several front-ends can drive one robot at once without racing.
+// simulation thread, the readings the front-ends publish (joint states, frames, cameras, IMU)
+// and the schedule of the sensor topics (SensorSchedule). Commands are checked on the caller's
+// thread and applied on the simulation thread between two steps, so several front-ends can drive
+// one robot at once without racing.
 #pragma once
 
 #include <Eigen/Core>
