@@ -12,6 +12,7 @@
 #include "core/file_read.h"
 #include "core/json_parse.h"
 #include "partsim/core/error.h"
+#include "partsim/physics/kinematics.h"
 
 namespace partsim {
 namespace {
@@ -144,15 +145,12 @@ PartNetLink ReadLinkEntry(const json& e, size_t index, const fs::path& file) {
   return l;
 }
 
-// Forward kinematics at q = 0 of a description with its root at the origin: X_BL per link.
+// Forward kinematics at q = 0 (coupled joints where their sources put them) of a description
+// with its root at the origin: X_BL per link.
 std::vector<Pose> RestPoses(const ArticulationDesc& desc) {
-  std::vector<Pose> X(desc.links.size());
-  for (size_t i = 0; i < desc.links.size(); ++i) {
-    const LinkDesc& l = desc.links[i];
-    X[i] = l.parent < 0 ? Pose()
-                        : X[l.parent] * l.joint.pose_in_parent * l.joint.pose_in_child.Inverse();
-  }
-  return X;
+  KinematicModel model(desc);
+  model.SetRootPose(Pose());
+  return model.ForwardKinematics(Eigen::VectorXd::Zero(model.Dof()));
 }
 
 int FindLink(const ArticulationDesc& desc, const std::string& name) {

@@ -239,8 +239,11 @@ void SceneImpl::EnsureCompiled() {
   uncompiled_actors.clear();
   ++description_version;
   BuildTables(*this);
-  for (auto& a : articulations)
-    if (a.desc.kinematic) UpdateKinematicArticulation(a);
+  for (auto& a : articulations) {
+    if (!a.desc.kinematic) continue;
+    compiled_articulations.at(a.id).kinematics.emplace(a.desc);
+    UpdateKinematicArticulation(a);
+  }
   Invalidate();
 }
 
@@ -281,39 +284,18 @@ void SceneImpl::ApplyDrives() {
 }
 
 void SceneImpl::UpdateKinematicArticulation(ArticulationEntry& a) {
-  const ArticulationDesc& desc = a.desc;
   const CompiledArticulation& c = compiled_articulations.at(a.id);
-  int dof = static_cast<int>(c.dof_links.size());
+  // the model of the last compile, at the root pose of now
+  KinematicModel model = *c.kinematics;
+  Pose X_WR = a.desc.root_pose;
+  X_WR.q.normalize();
+  model.SetRootPose(X_WR);
+  const int dof = model.Dof();
   if (a.kin_qpos.size() != dof) a.kin_qpos = Eigen::VectorXd::Zero(dof);
   if (a.kin_qvel.size() != dof) a.kin_qvel = Eigen::VectorXd::Zero(dof);
-  // joint values, couplings included
-  std::vector<double> q(desc.links.size(), 0.0);
-  for (int k = 0; k < dof; ++k) q[c.dof_links[k]] = a.kin_qpos[k];
-  for (const JointCoupling& cp : desc.couplings) {
-    int j = -1, s = -1;
-    for (size_t i = 0; i < desc.links.size(); ++i) {
-      if (desc.links[i].parent < 0) continue;
-      if (desc.links[i].joint.name == cp.joint) j = static_cast<int>(i);
-      if (desc.links[i].joint.name == cp.source) s = static_cast<int>(i);
-    }
-    q[j] = cp.multiplier * q[s] + cp.offset;
-  }
-  // forward kinematics, parents first
-  std::vector<Pose> X_WL(desc.links.size());
-  for (size_t i = 0; i < desc.links.size(); ++i) {
-    const LinkDesc& l = desc.links[i];
-    if (l.parent < 0) {
-      X_WL[i] = desc.root_pose;
-    } else {
-      const JointDesc& jd = l.joint;
-      Pose motion;
-      if (jd.type == JointType::kPrismatic) motion.p = Eigen::Vector3d(q[i], 0, 0);
-      if (jd.type == JointType::kRevolute || jd.type == JointType::kContinuous ||
-          jd.type == JointType::kScrew)
-        motion.q = Eigen::AngleAxisd(q[i], Eigen::Vector3d::UnitX());
-      if (jd.type == JointType::kScrew) motion.p = Eigen::Vector3d(jd.pitch * q[i], 0, 0);
-      X_WL[i] = X_WL[l.parent] * jd.pose_in_parent * motion * jd.pose_in_child.Inverse();
-    }
+  // the mocap bodies of the links, couplings included
+  const std::vector<Pose> X_WL = model.ForwardKinematics(a.kin_qpos);
+  for (size_t i = 0; i < X_WL.size(); ++i) {
     int mocap = c.link_mocap[i];
     Eigen::Quaterniond qn = X_WL[i].q.normalized();
     for (int k = 0; k < 3; ++k) d->mocap_pos[3 * mocap + k] = X_WL[i].p[k];

@@ -8,10 +8,12 @@
 #include <atomic>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "partsim/physics/kinematics.h"
 #include "partsim/physics/observer.h"
 #include "partsim/physics/scene.h"
 
@@ -61,6 +63,8 @@ struct CompiledArticulation {
   std::vector<CompiledJoint> joints;  ///< per link (entry 0 unused)
   std::vector<int> dof_links;         ///< partsim dof -> link index
   std::vector<CompiledCoupling> couplings;
+  /// kinematic articulations: the forward kinematics that places their links
+  std::optional<KinematicModel> kinematics;
   int root_qposadr = -1;  ///< free root joint
   int root_dofadr = -1;
   /// MuJoCo dofs of the articulation's joints (free root excluded), ascending.

@@ -1,6 +1,7 @@
-// Kinematics of an articulation without the physics engine: forward kinematics, Jacobians and
-// damped least-squares inverse kinematics over an ArticulationDesc. Vectors of joint positions
-// have one entry per dof, in the order of Articulation::GetActiveJoints().
+// Inverse kinematics of an articulation without the physics engine: damped least squares over
+// the forward kinematics and Jacobians of KinematicModel (partsim/physics/kinematics.h, included
+// here for the users of the robot layer). Vectors of joint positions have one entry per dof, in
+// the order of Articulation::GetActiveJoints().
 #pragma once
 
 #include <Eigen/Core>
@@ -10,45 +11,10 @@
 
 #include "partsim/core/pose.h"
 #include "partsim/physics/description.h"
+#include "partsim/physics/kinematics.h"
 #include "partsim/physics/scene.h"
 
 namespace partsim {
-
-/// Forward kinematics and Jacobians of a fixed- or free-rooted articulation (the free root is
-/// held at `root_pose`). A coupled joint (JointCoupling) has its dof, as in Articulation, but
-/// moves as its source dictates (multiplier * q[source] + offset), as Articulation::SetQpos
-/// places it: its own entry of q is ignored, its Jacobian column is zero, and its motion adds to
-/// its source's column.
-class KinematicModel {
- public:
-  explicit KinematicModel(const ArticulationDesc& articulation);
-  /// The model of an articulation in a scene, with its current root pose.
-  static KinematicModel FromArticulation(const Articulation& articulation);
-
-  int Dof() const;
-  int NumLinks() const;
-  /// Index of a link by name; throws partsim::Error naming the missing link.
-  int LinkIndex(const std::string& name) const;
-  /// Dof index of a joint by name (-1 if it has no dof); throws naming a missing joint.
-  int DofIndex(const std::string& joint_name) const;
-  /// Lower and upper limits, dof x 2 (+-inf when unlimited).
-  Eigen::MatrixX2d Limits() const;
-  const Pose& GetRootPose() const;
-  void SetRootPose(const Pose& pose);
-
-  /// X_WL of every link for joint positions q (size Dof(); throws naming a wrong size).
-  std::vector<Pose> ForwardKinematics(const Eigen::VectorXd& q) const;
-  /// X_WL of one link (times `offset`, a frame fixed in the link, e.g. a TCP).
-  Pose LinkPose(const Eigen::VectorXd& q, int link, const Pose& offset = Pose()) const;
-  /// World-frame geometric Jacobian of the point and frame `offset` on `link`: 6 x dof, rows
-  /// (linear velocity; angular velocity).
-  Eigen::MatrixXd Jacobian(const Eigen::VectorXd& q, int link, const Pose& offset = Pose()) const;
-
- private:
-  struct Data;
-  std::shared_ptr<const Data> data_;
-  Pose root_pose_;
-};
 
 /// Options of InverseKinematics.
 struct IkOptions {
