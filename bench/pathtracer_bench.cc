@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "partsim/core/constants.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera_math.h"
 
@@ -32,7 +33,7 @@ using partsim::Pose;
 using partsim::RenderInstance;
 using partsim::RenderWorld;
 
-constexpr double kPi = 3.14159265358979323846;
+using partsim::kPi;
 
 /// An axis-aligned box of half-size h: 12 triangles with face normals.
 std::shared_ptr<MeshData> BoxMesh(const Eigen::Vector3f& h) {

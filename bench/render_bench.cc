@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "partsim/core/constants.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera_math.h"
 #include "render/gl_util.h"
@@ -45,7 +46,7 @@ using partsim::MeshData;
 using partsim::RenderInstance;
 using partsim::RenderWorld;
 
-constexpr double kPi = 3.14159265358979323846;
+using partsim::kPi;
 
 std::shared_ptr<MeshData> Box(const Eigen::Vector3f& h) {
   auto m = std::make_shared<MeshData>();

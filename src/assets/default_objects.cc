@@ -9,12 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "partsim/core/constants.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 /// One primitive of a link: a box (full sizes) or a cylinder along its local z axis (URDF).
 struct Part {

@@ -14,6 +14,7 @@
 #include "core/json_parse.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/assets/urdf.h"
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/physics/description.h"
 
@@ -253,9 +254,7 @@ SceneFileSpec ReadSceneFile(const std::string& path) {
 std::vector<Articulation> AddSceneObjects(Scene* scene, const std::string& path,
                                           const Pose& default_pose, bool fix_root) {
   if (scene == nullptr) throw Error("AddSceneObjects(" + path + "): scene is null");
-  if (!default_pose.IsValid())
-    throw Error("AddSceneObjects(" + path + "): default_pose " + default_pose.ToString() +
-                " is not finite with a unit quaternion");
+  CheckPose("AddSceneObjects(" + path + "): default_pose", default_pose);
 
   // read every object before touching the scene
   std::vector<Prepared> prepared;

@@ -17,6 +17,7 @@
 #include "core/file_read.h"
 #include "partsim/assets/mesh.h"
 #include "partsim/assets/srdf.h"
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -496,7 +497,7 @@ std::optional<Inertial> Parser::ReadInertial(const XMLElement* e, const std::str
   if (mass_e == nullptr) Fail(where + " has no <mass>");
   const double s = loader_.scale;
   double mass = Number(mass_e, "value", std::nullopt, where);
-  if (mass < 0) Fail(where + " has negative mass " + std::to_string(mass));
+  if (mass < 0) Fail(where + " has negative mass " + FormatNumber(mass));
   // a massless link (common for frames in ROS files): mass follows from its shapes, if any
   if (mass == 0) return std::nullopt;  // ReadLink warns when shapes then give it a mass
 
@@ -520,8 +521,8 @@ std::optional<Inertial> Parser::ReadInertial(const XMLElement* e, const std::str
   const double largest = std::max(moments.cwiseAbs().maxCoeff(), 0.0);
   if (moments.minCoeff() < -1e-9 - 1e-6 * largest) {
     Fail(where + " has an inertia tensor that is not positive semi-definite (principal moments " +
-         std::to_string(moments[0]) + ", " + std::to_string(moments[1]) + ", " +
-         std::to_string(moments[2]) + ")");
+         FormatNumber(moments[0]) + ", " + FormatNumber(moments[1]) + ", " +
+         FormatNumber(moments[2]) + ")");
   }
   if (largest <= 1e-12 * mass) {
     // no inertia at all (an <inertia> of zeros, or none): a link whose centre of mass lies on
@@ -530,8 +531,8 @@ std::optional<Inertial> Parser::ReadInertial(const XMLElement* e, const std::str
     const double r = 0.05 * s;
     moments.setConstant(0.4 * mass * r * r);
     axes.setIdentity();
-    Warn(where + " has no inertia tensor (all zero) for its mass of " + std::to_string(mass) +
-         " kg: set to that of a solid sphere 5 cm in radius, " + std::to_string(moments[0]) +
+    Warn(where + " has no inertia tensor (all zero) for its mass of " + FormatNumber(mass) +
+         " kg: set to that of a solid sphere 5 cm in radius, " + FormatNumber(moments[0]) +
          " kg m^2 about each axis");
   }
   const double floor = std::max(1e-9 * mass, 1e-6 * largest);
@@ -635,8 +636,8 @@ JointDesc Parser::ReadJoint(const RawJoint& raw, ArticulationDesc* desc) {
       j.lower = Number(limit, "lower", 0.0, where) * s;
       j.upper = Number(limit, "upper", 0.0, where) * s;
       if (j.lower > j.upper) {
-        Fail(where + " <limit> has lower " + std::to_string(j.lower) + " > upper " +
-             std::to_string(j.upper));
+        Fail(where + " <limit> has lower " + FormatNumber(j.lower) + " > upper " +
+             FormatNumber(j.upper));
       }
     }
     double effort = Number(limit, "effort", 0.0, where);
@@ -705,7 +706,7 @@ ArticulationDesc Parser::Run(const std::string& text) {
   const XMLElement* robot = doc.FirstChildElement("robot");
   if (robot == nullptr) Fail("no <robot> element");
   if (!(loader_.scale > 0) || !std::isfinite(loader_.scale)) {
-    Fail("scale " + std::to_string(loader_.scale) + " must be positive and finite");
+    Fail("scale " + FormatNumber(loader_.scale) + " must be positive and finite");
   }
   ArticulationDesc desc;
   if (const char* n = robot->Attribute("name")) desc.name = n;

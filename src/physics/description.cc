@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -84,26 +85,26 @@ void CheckPose(const Pose& pose, const std::string& where, const std::string& wh
 
 void CheckNonNegative(double v, const std::string& where, const std::string& what) {
   Require(std::isfinite(v) && v >= 0.0, where,
-          what + " must be finite and >= 0, got " + std::to_string(v));
+          what + " must be finite and >= 0, got " + FormatNumber(v));
 }
 
 void CheckPositive(double v, const std::string& where, const std::string& what) {
   Require(std::isfinite(v) && v > 0.0, where,
-          what + " must be finite and > 0, got " + std::to_string(v));
+          what + " must be finite and > 0, got " + FormatNumber(v));
 }
 
 // A shape's size: > 0 (or >= 0) and at most kMaxLength.
 void CheckLength(double v, bool allow_zero, const std::string& where, const std::string& what) {
   Require(std::isfinite(v) && (allow_zero ? v >= 0.0 : v > 0.0) && v <= kMaxLength, where,
           what + " must be " + (allow_zero ? ">= 0" : "> 0") + " and at most 1e6 m, got " +
-              std::to_string(v));
+              FormatNumber(v));
 }
 
 void CheckMaterial(const PhysicalMaterial& m, const std::string& where, const std::string& what) {
   CheckNonNegative(m.static_friction, where, what + " static_friction");
   CheckNonNegative(m.dynamic_friction, where, what + " dynamic_friction");
   Require(std::isfinite(m.restitution) && m.restitution >= 0 && m.restitution <= 1, where,
-          what + " restitution must be in [0, 1], got " + std::to_string(m.restitution));
+          what + " restitution must be in [0, 1], got " + FormatNumber(m.restitution));
 }
 
 void CheckBody(const BodyDesc& b, const std::string& where, const std::string& what) {
@@ -171,8 +172,8 @@ void Validate(const ActorDesc& a, const std::string& where) {
   Require(std::isfinite(a.linear_damping) && a.linear_damping >= 0 &&
               std::isfinite(a.angular_damping) && a.angular_damping >= 0,
           where,
-          what + " damping must be finite and >= 0, got linear " +
-              std::to_string(a.linear_damping) + ", angular " + std::to_string(a.angular_damping));
+          what + " damping must be finite and >= 0, got linear " + FormatNumber(a.linear_damping) +
+              ", angular " + FormatNumber(a.angular_damping));
 }
 
 void Validate(const ArticulationDesc& art, const std::string& where) {
@@ -202,14 +203,14 @@ void Validate(const ArticulationDesc& art, const std::string& where) {
     CheckPose(j.pose_in_child, where, jw + " pose_in_child");
     Require(!std::isnan(j.lower) && !std::isnan(j.upper), where, jw + " has a NaN limit");
     Require(j.lower <= j.upper, where,
-            jw + " has lower limit " + std::to_string(j.lower) + " above upper limit " +
-                std::to_string(j.upper));
+            jw + " has lower limit " + FormatNumber(j.lower) + " above upper limit " +
+                FormatNumber(j.upper));
     CheckNonNegative(j.friction, where, jw + " friction");
     CheckNonNegative(j.damping, where, jw + " damping");
     CheckNonNegative(j.armature, where, jw + " armature");
     Require(std::isfinite(j.pitch), where, jw + " pitch must be finite");
     Require(j.effort_limit > 0, where,
-            jw + " effort_limit must be > 0 (inf for none), got " + std::to_string(j.effort_limit));
+            jw + " effort_limit must be > 0 (inf for none), got " + FormatNumber(j.effort_limit));
     CheckNonNegative(j.drive.stiffness, where, jw + " drive stiffness");
     CheckNonNegative(j.drive.damping, where, jw + " drive damping");
     Require(!std::isnan(j.drive.force_limit) && j.drive.force_limit > 0, where,

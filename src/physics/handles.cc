@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "partsim/core/check.h"
 #include "partsim/physics/scene.h"
 #include "physics/scene_internal.h"
 
@@ -22,17 +23,6 @@ SceneImpl& S(Scene* scene) {
 Eigen::Vector3d V3(const double* v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
 Eigen::Quaterniond Q4(const double* q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]); }
 
-void CheckFinite(const Eigen::Vector3d& v, const std::string& what) {
-  if (!v.allFinite())
-    throw Error(what + " must be finite, got [" + std::to_string(v.x()) + ", " +
-                std::to_string(v.y()) + ", " + std::to_string(v.z()) + "]");
-}
-
-void CheckPoseArg(const Pose& pose, const std::string& what) {
-  if (!pose.IsValid())
-    throw Error(what + " must hold finite numbers and a unit quaternion, got " + pose.ToString());
-}
-
 void CheckVector(const Eigen::VectorXd& v, int n, const std::string& what,
                  const std::string& owner) {
   if (v.size() != n)
@@ -40,7 +30,7 @@ void CheckVector(const Eigen::VectorXd& v, int n, const std::string& what,
                 std::to_string(n) + " dof");
   for (int i = 0; i < n; ++i)
     if (!std::isfinite(v[i]))
-      throw Error(what + "[" + std::to_string(i) + "] is " + std::to_string(v[i]) +
+      throw Error(what + "[" + std::to_string(i) + "] is " + FormatNumber(v[i]) +
                   ", must be finite");
 }
 
@@ -53,8 +43,8 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> BodyVelocity(SceneImpl& s, int body)
 }
 
 void AddBodyForce(SceneImpl& s, int body, const Eigen::Vector3d& f, const Eigen::Vector3d& point) {
-  CheckFinite(f, "force");
-  CheckFinite(point, "point");
+  CheckFinite("force", f);
+  CheckFinite("point", point);
   s.EnsureKinematics();
   Eigen::Vector3d com = V3(s.d->xipos + 3 * body);
   Eigen::Vector3d torque = (point - com).cross(f);
@@ -86,7 +76,7 @@ Pose Actor::GetPose() const {
 }
 
 void Actor::SetPose(const Pose& pose) {
-  CheckPoseArg(pose, "actor pose");
+  CheckPose("actor pose", pose);
   SceneImpl& s = S(scene_);
   auto& a = s.GetActor(id_);
   if (s.IsUncompiled(id_)) {  // not in the model yet: it will start there
@@ -133,7 +123,7 @@ Eigen::Vector3d Actor::GetAngularVelocity() const {
 }
 
 void Actor::SetVelocity(const Eigen::Vector3d& v) {
-  CheckFinite(v, "velocity");
+  CheckFinite("velocity", v);
   SceneImpl& s = S(scene_);
   auto& a = s.GetActor(id_);
   const auto& c = s.Compiled(a);
@@ -143,7 +133,7 @@ void Actor::SetVelocity(const Eigen::Vector3d& v) {
 }
 
 void Actor::SetAngularVelocity(const Eigen::Vector3d& w) {
-  CheckFinite(w, "angular velocity");
+  CheckFinite("angular velocity", w);
   SceneImpl& s = S(scene_);
   auto& a = s.GetActor(id_);
   const auto& c = s.Compiled(a);
@@ -184,8 +174,8 @@ void Actor::AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d&
 }
 
 void Actor::AddForceTorque(const Eigen::Vector3d& force, const Eigen::Vector3d& torque) {
-  CheckFinite(force, "force");
-  CheckFinite(torque, "torque");
+  CheckFinite("force", force);
+  CheckFinite("torque", torque);
   SceneImpl& s = S(scene_);
   int body = s.Compiled(s.GetActor(id_)).body;
   for (int k = 0; k < 3; ++k) {
@@ -431,7 +421,7 @@ void Joint::SetLimits(double lower, double upper) {
   JointRef j = GetJointRef(scene_, articulation_id_, index_);
   if (std::isnan(lower) || std::isnan(upper) || lower > upper)
     throw Error("joint '" + j.desc->name + "': limits must satisfy lower <= upper, got (" +
-                std::to_string(lower) + ", " + std::to_string(upper) + ")");
+                FormatNumber(lower) + ", " + FormatNumber(upper) + ")");
   if (j.desc->type == JointType::kFixed || j.desc->type == JointType::kContinuous)
     throw Error("joint '" + j.desc->name + "' is " + JointTypeName(j.desc->type) +
                 " and has no limits to set");
@@ -775,7 +765,7 @@ Pose Articulation::GetRootPose() const {
 }
 
 void Articulation::SetRootPose(const Pose& pose) {
-  CheckPoseArg(pose, "root pose");
+  CheckPose("root pose", pose);
   ArtRef r = GetArt(scene_, id_);
   Eigen::Quaterniond q = pose.q.normalized();
   r.a.desc.root_pose = pose;
@@ -811,7 +801,7 @@ Eigen::Vector3d Articulation::GetRootAngularVelocity() const {
 }
 
 void Articulation::SetRootVelocity(const Eigen::Vector3d& v) {
-  CheckFinite(v, "root velocity");
+  CheckFinite("root velocity", v);
   ArtRef r = GetArt(scene_, id_);
   if (r.c.root_dofadr < 0) throw Error(r.owner() + " has a fixed root: no root velocity to set");
   for (int k = 0; k < 3; ++k) r.s.d->qvel[r.c.root_dofadr + k] = v[k];
@@ -819,7 +809,7 @@ void Articulation::SetRootVelocity(const Eigen::Vector3d& v) {
 }
 
 void Articulation::SetRootAngularVelocity(const Eigen::Vector3d& w) {
-  CheckFinite(w, "root angular velocity");
+  CheckFinite("root angular velocity", w);
   ArtRef r = GetArt(scene_, id_);
   if (r.c.root_dofadr < 0) throw Error(r.owner() + " has a fixed root: no root velocity to set");
   Eigen::Vector3d local = Q4(r.s.d->qpos + r.c.root_qposadr + 3).normalized().conjugate() * w;

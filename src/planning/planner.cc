@@ -20,6 +20,7 @@
 #include <random>
 #include <sstream>
 
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/robot/kinematics.h"
 #include "physics/scene_internal.h"
@@ -389,7 +390,7 @@ PlanResult MotionPlanner::Impl::Plan(const Eigen::VectorXd& goal_in, const Plann
     if (Cancelled(opt)) return fail("cancelled");
     if (!status || !ss.haveExactSolutionPath()) {
       if (round > 0) break;
-      return fail("no collision-free path found in " + std::to_string(opt.time_limit) + " s (" +
+      return fail("no collision-free path found in " + FormatNumber(opt.time_limit) + " s (" +
                   opt.algorithm + ")");
     }
     if (opt.simplify) ss.simplifySolution(1.0);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bindings.h"
+#include "partsim/core/check.h"
 #include "partsim/physics/description.h"
 #include "partsim/physics/scene.h"
 
@@ -143,9 +144,8 @@ void BindDescription(py::module_& m) {
                      "Restitution in [0, 1], mapped to the damping ratio of the contact's "
                      "spring-damper; 0 gives a critically damped, inelastic contact.")
       .def("__repr__", [](const PhysicalMaterial& self) {
-        return "PhysicalMaterial(" + std::to_string(self.static_friction) + ", " +
-               std::to_string(self.dynamic_friction) + ", " + std::to_string(self.restitution) +
-               ")";
+        return "PhysicalMaterial(" + FormatNumber(self.static_friction) + ", " +
+               FormatNumber(self.dynamic_friction) + ", " + FormatNumber(self.restitution) + ")";
       });
 
   py::class_<MeshData, std::shared_ptr<MeshData>>(
@@ -703,7 +703,7 @@ void BindContacts(py::module_& m) {
                     "What happened: a MuJoCo warning, numerical instability (MuJoCo reset the "
                     "state), or a contact buffer that filled and grew.")
       .def("__repr__", [](const Warning& self) {
-        return "<Warning t=" + std::to_string(self.time) + ": " + self.message + ">";
+        return "<Warning t=" + FormatNumber(self.time) + ": " + self.message + ">";
       });
 }
 

@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.h"
+#include "partsim/core/check.h"
 #include "partsim/tasks/tasks.h"
 
 namespace partsim::python {
@@ -180,7 +181,7 @@ void BindTasks(py::module_& m) {
       .def_readonly("message", &SolverResult::message, "Why it failed ('' on success).")
       .def("__repr__", [](const SolverResult& r) {
         return "<SolverResult success=" + std::string(r.success ? "True" : "False") +
-               " progress=" + std::to_string(r.progress) + " stage='" + r.stage + "'>";
+               " progress=" + FormatNumber(r.progress) + " stage='" + r.stage + "'>";
       });
   py::class_<SolverOptions>(m, "SolverOptions", "Options of the heuristic solvers.")
       .def(py::init<>(), "The defaults.")

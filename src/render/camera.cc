@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "partsim/core/check.h"
+#include "partsim/core/constants.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
 #include "render/picture_internal.h"
@@ -21,19 +23,11 @@ using internal::RenderOf;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 CameraEntry& Entry(Scene* scene, int id) {
   if (!scene) throw Error("empty camera handle: it does not belong to a scene");
   for (auto& c : RenderOf(*scene).cameras)
     if (c.id == id) return c;
   throw Error("camera " + std::to_string(id) + " does not exist (it was removed)");
-}
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
 }
 
 const Picture& PictureOf(const CameraEntry& c) {
@@ -89,10 +83,10 @@ double Camera::GetFar() const { return Entry(scene_, id_).far; }
 void Camera::SetNearFar(double near, double far) {
   CameraEntry& c = Entry(scene_, id_);
   if (!std::isfinite(near) || near <= 0)
-    throw Error("camera '" + c.name + "': near must be finite and > 0, got " + Num(near));
+    throw Error("camera '" + c.name + "': near must be finite and > 0, got " + FormatNumber(near));
   if (!std::isfinite(far) || far <= near)
-    throw Error("camera '" + c.name + "': far must be finite and > near (" + Num(near) + "), got " +
-                Num(far));
+    throw Error("camera '" + c.name + "': far must be finite and > near (" + FormatNumber(near) +
+                "), got " + FormatNumber(far));
   c.near = near;
   c.far = far;
 }
@@ -100,7 +94,8 @@ void Camera::SetNearFar(double near, double far) {
 void Camera::SetFovy(double fovy) {
   CameraEntry& c = Entry(scene_, id_);
   if (!std::isfinite(fovy) || fovy <= 0 || fovy >= kPi)
-    throw Error("camera '" + c.name + "': fovy must be in (0, pi) radians, got " + Num(fovy));
+    throw Error("camera '" + c.name + "': fovy must be in (0, pi) radians, got " +
+                FormatNumber(fovy));
   Eigen::Matrix3d K = IntrinsicsFromFovy(c.width, c.height, fovy);
   c.fx = K(0, 0);
   c.fy = K(1, 1);
@@ -122,11 +117,11 @@ void Camera::SetIntrinsics(double fx, double fy, double cx, double cy) {
   CameraEntry& c = Entry(scene_, id_);
   std::string what = "camera '" + c.name + "': ";
   if (!std::isfinite(fx) || fx <= 0)
-    throw Error(what + "fx must be finite and > 0, got " + Num(fx));
+    throw Error(what + "fx must be finite and > 0, got " + FormatNumber(fx));
   if (!std::isfinite(fy) || fy <= 0)
-    throw Error(what + "fy must be finite and > 0, got " + Num(fy));
-  if (!std::isfinite(cx)) throw Error(what + "cx must be finite, got " + Num(cx));
-  if (!std::isfinite(cy)) throw Error(what + "cy must be finite, got " + Num(cy));
+    throw Error(what + "fy must be finite and > 0, got " + FormatNumber(fy));
+  if (!std::isfinite(cx)) throw Error(what + "cx must be finite, got " + FormatNumber(cx));
+  if (!std::isfinite(cy)) throw Error(what + "cy must be finite, got " + FormatNumber(cy));
   c.fx = fx;
   c.fy = fy;
   c.cx = cx;
@@ -179,9 +174,7 @@ void Camera::LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
 
 void Camera::SetLocalPose(const Pose& pose) {
   CameraEntry& c = Entry(scene_, id_);
-  if (!pose.IsValid())
-    throw Error("camera '" + c.name +
-                "': pose must hold finite numbers and a unit quaternion, got " + pose.ToString());
+  CheckPose("camera '" + c.name + "': pose", pose);
   if (c.mount_actor >= 0 || c.mount_articulation >= 0) {
     // keep the mount where it was at the last UpdateRender: X_WM = X_WC X_MC^-1
     c.X_WC = c.X_WC * c.local_pose.Inverse() * pose;

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
@@ -161,7 +162,7 @@ PointCloud MakePointCloud(const Picture& picture, PointCloudFrame frame, const P
   Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
   Eigen::Vector3f t = Eigen::Vector3f::Zero();
   if (frame == PointCloudFrame::kWorld) {
-    if (!X_WC.IsValid()) throw Error("point_cloud: camera pose is not valid: " + X_WC.ToString());
+    CheckPose("point_cloud: X_WC", X_WC);
     R = (X_WC.q.toRotationMatrix() * RotationCameraToGl()).cast<float>();
     t = X_WC.p.cast<float>();
   }

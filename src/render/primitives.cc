@@ -5,13 +5,13 @@
 #include <memory>
 #include <vector>
 
+#include "partsim/core/constants.h"
 #include "partsim/core/error.h"
 #include "partsim/render/backend.h"
 
 namespace partsim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kSegments = 32;  // around the axis
 constexpr int kRings = 16;     // from pole to pole of a sphere
 

@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "partsim/core/check.h"
+#include "partsim/core/constants.h"
 #include "partsim/physics/observer.h"
 #include "partsim/physics/scene.h"
 #include "partsim/render/backend.h"
@@ -23,18 +25,7 @@ using internal::RenderState;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxImageSize = 16384;
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-
-std::string Vec(const Eigen::Vector3d& v) {
-  return "[" + Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z()) + "]";
-}
 
 // checks what every camera needs; `what` names the call for the message
 void CheckCameraArgs(const std::string& what, int width, int height, double fovy, double near,
@@ -46,26 +37,22 @@ void CheckCameraArgs(const std::string& what, int width, int height, double fovy
     throw Error(what + ": height must be in [1, " + std::to_string(kMaxImageSize) + "], got " +
                 std::to_string(height));
   if (!std::isfinite(fovy) || fovy <= 0 || fovy >= kPi)
-    throw Error(what + ": fovy must be in (0, pi) radians, got " + Num(fovy));
+    throw Error(what + ": fovy must be in (0, pi) radians, got " + FormatNumber(fovy));
   if (!std::isfinite(near) || near <= 0)
-    throw Error(what + ": near must be finite and > 0, got " + Num(near));
+    throw Error(what + ": near must be finite and > 0, got " + FormatNumber(near));
   if (!std::isfinite(far) || far <= near)
-    throw Error(what + ": far must be finite and > near (" + Num(near) + "), got " + Num(far));
-}
-
-void CheckPose(const std::string& what, const Pose& pose) {
-  if (!pose.IsValid())
-    throw Error(what + " must hold finite numbers and a unit quaternion, got " + pose.ToString());
+    throw Error(what + ": far must be finite and > near (" + FormatNumber(near) + "), got " +
+                FormatNumber(far));
 }
 
 void CheckColor(const std::string& what, const Eigen::Vector3f& c) {
   if (!c.allFinite() || (c.array() < 0).any())
-    throw Error(what + ": color must be finite and >= 0, got " + Vec(c.cast<double>()));
+    throw Error(what + ": color must be finite and >= 0, got " + FormatVector(c));
 }
 
 Eigen::Vector3d CheckDirection(const std::string& what, const Eigen::Vector3d& d) {
   if (!d.allFinite() || d.norm() < 1e-12)
-    throw Error(what + ": direction must be finite and non-zero, got " + Vec(d));
+    throw Error(what + ": direction must be finite and non-zero, got " + FormatVector(d));
   return d.normalized();
 }
 
@@ -238,8 +225,7 @@ void Scene::AddDirectionalLight(const Eigen::Vector3d& direction, const Eigen::V
 }
 
 void Scene::AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f& color) {
-  if (!position.allFinite())
-    throw Error("add_point_light: position must be finite, got " + Vec(position));
+  CheckFinite("add_point_light: position", position);
   CheckColor("add_point_light", color);
   LightDesc l;
   l.type = LightType::kPoint;
@@ -252,17 +238,16 @@ void Scene::AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f
 void Scene::AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d& direction,
                          double inner_angle, double outer_angle, const Eigen::Vector3f& color,
                          bool shadow) {
-  if (!position.allFinite())
-    throw Error("add_spot_light: position must be finite, got " + Vec(position));
+  CheckFinite("add_spot_light: position", position);
   LightDesc l;
   l.type = LightType::kSpot;
   l.direction = CheckDirection("add_spot_light", direction);
   if (!std::isfinite(outer_angle) || outer_angle <= 0 || outer_angle > 0.5 * kPi)
     throw Error("add_spot_light: outer_angle must be in (0, pi/2] radians, got " +
-                Num(outer_angle));
+                FormatNumber(outer_angle));
   if (!std::isfinite(inner_angle) || inner_angle < 0 || inner_angle > outer_angle)
     throw Error("add_spot_light: inner_angle must be in [0, outer_angle] radians, got " +
-                Num(inner_angle));
+                FormatNumber(inner_angle));
   CheckColor("add_spot_light", color);
   l.position = position;
   l.inner_angle = inner_angle;

@@ -8,6 +8,7 @@
 #include <system_error>
 #include <vector>
 
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/render/image_io.h"
 
@@ -99,7 +100,7 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height,
     s.Fail("frame size must be in [2, 16384] pixels, got " + std::to_string(width) + " x " +
            std::to_string(height));
   if (!(options.fps > 0 && options.fps <= 1000))
-    s.Fail("fps must be in (0, 1000], got " + std::to_string(options.fps));
+    s.Fail("fps must be in (0, 1000], got " + FormatNumber(options.fps));
   if (options.quality < 0 || options.quality > 51)
     s.Fail("quality must be in [0, 51], got " + std::to_string(options.quality));
   if (!options.background.allFinite()) s.Fail("background colour must be finite");

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -27,12 +28,6 @@ const char* ControllerStateName(ControllerState s) {
 
 namespace {
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 // index of the entry of largest magnitude
 int Worst(const Eigen::VectorXd& v) {
   Eigen::Index i = 0;
@@ -47,17 +42,17 @@ bool Done(ControllerState s) {
 
 // Checks of one setting: each throws naming `who`, the setting and its value. NaN fails all.
 void CheckPositive(const std::string& who, const char* setting, double value) {
-  if (!(value > 0)) throw Error(who + ": " + setting + " must be > 0, got " + Num(value));
+  if (!(value > 0)) throw Error(who + ": " + setting + " must be > 0, got " + FormatNumber(value));
 }
 
 void CheckFinitePositive(const std::string& who, const char* setting, double value) {
   if (!(value > 0) || !std::isfinite(value))
-    throw Error(who + ": " + setting + " must be finite and > 0, got " + Num(value));
+    throw Error(who + ": " + setting + " must be finite and > 0, got " + FormatNumber(value));
 }
 
 void CheckFiniteNonNegative(const std::string& who, const char* setting, double value) {
   if (!(value >= 0) || !std::isfinite(value))
-    throw Error(who + ": " + setting + " must be finite and >= 0, got " + Num(value));
+    throw Error(who + ": " + setting + " must be finite and >= 0, got " + FormatNumber(value));
 }
 
 }  // namespace
@@ -194,8 +189,8 @@ void JointEffortController::SetTarget(const Eigen::VectorXd& effort) {
     const double limit = std::min(options_.force_limit,
                                   robot_.FindJointByName(joint_names_[i]).GetDesc().effort_limit);
     if (std::abs(effort_[i]) <= limit) continue;
-    clamped += (clamped.empty() ? "" : ", ") + joint_names_[i] + " (" + Num(effort_[i]) + " to +-" +
-               Num(limit) + ")";
+    clamped += (clamped.empty() ? "" : ", ") + joint_names_[i] + " (" + FormatNumber(effort_[i]) +
+               " to +-" + FormatNumber(limit) + ")";
     effort_[i] = std::clamp(effort_[i], -limit, limit);
   }
   status_.state = ControllerState::kReached;
@@ -229,9 +224,9 @@ void JointPositionController::SetTarget(const Eigen::VectorXd& q) {
   for (int i = 0; i < NumJoints(); ++i)
     if (clamped[i] != q[i])
       out_of_limits += (out_of_limits.empty() ? "" : "; ") + std::string("joint '") +
-                       joint_names_[i] + "' target " + Num(q[i]) + " is outside [" +
-                       Num(limits(i, 0)) + ", " + Num(limits(i, 1)) + "], clamped to " +
-                       Num(clamped[i]);
+                       joint_names_[i] + "' target " + FormatNumber(q[i]) + " is outside [" +
+                       FormatNumber(limits(i, 0)) + ", " + FormatNumber(limits(i, 1)) +
+                       "], clamped to " + FormatNumber(clamped[i]);
   target_ = clamped;
   set_time_ = robot_.GetScene()->GetTime();
   status_.state = out_of_limits.empty() ? ControllerState::kRunning : ControllerState::kFailed;
@@ -255,8 +250,8 @@ void JointPositionController::Update() {
   } else if (now - set_time_ > options_.timeout) {
     int w = Worst(err);
     status_.state = ControllerState::kFailed;
-    status_.message = "joint '" + joint_names_[w] + "' is " + Num(err[w]) +
-                      " from its target after the timeout of " + Num(options_.timeout) +
+    status_.message = "joint '" + joint_names_[w] + "' is " + FormatNumber(err[w]) +
+                      " from its target after the timeout of " + FormatNumber(options_.timeout) +
                       " s (blocked?)";
   }
 }
@@ -303,8 +298,8 @@ void JointVelocityController::Update() {
                     std::abs(q - limits(w, 1)) < options_.position_tolerance;
     status_.state = ControllerState::kFailed;
     status_.message = "joint '" + joint_names_[w] + "' has not reached velocity " +
-                      Num(target_[w]) + " for " + Num(options_.timeout) + " s" +
-                      (at_limit ? " (at its limit " + Num(q) + ")" : " (blocked?)");
+                      FormatNumber(target_[w]) + " for " + FormatNumber(options_.timeout) + " s" +
+                      (at_limit ? " (at its limit " + FormatNumber(q) + ")" : " (blocked?)");
   } else if (status_.state == ControllerState::kReached) {
     status_.state = ControllerState::kRunning;
   }
@@ -340,8 +335,8 @@ void JointTrajectoryController::SetTrajectory(const JointTrajectory& trajectory)
       SetTargets(robot_, joint_names_, GetQpos(), nullptr);
       status_.state = ControllerState::kFailed;
       status_.message = "waypoint " + std::to_string(w) + ": joint '" + joint_names_[i] +
-                        "' position " + Num(p[i]) + " is outside its limits [" + Num(limits(i, 0)) +
-                        ", " + Num(limits(i, 1)) + "]";
+                        "' position " + FormatNumber(p[i]) + " is outside its limits [" +
+                        FormatNumber(limits(i, 0)) + ", " + FormatNumber(limits(i, 1)) + "]";
       return;
     }
   }
@@ -387,9 +382,9 @@ void JointTrajectoryController::Update() {
     SetTargets(robot_, joint_names_, GetQpos(), nullptr);
     WriteQf(robot_, dofs_, Eigen::VectorXd::Zero(NumJoints()), options_.gravity_compensation);
     status_.state = ControllerState::kFailed;
-    status_.message = "joint '" + joint_names_[w] + "' is " + Num(err[w]) +
-                      " from the trajectory at t = " + Num(t) + " s (path_tolerance " +
-                      Num(path_tolerance) + ")";
+    status_.message = "joint '" + joint_names_[w] + "' is " + FormatNumber(err[w]) +
+                      " from the trajectory at t = " + FormatNumber(t) + " s (path_tolerance " +
+                      FormatNumber(path_tolerance) + ")";
     return;
   }
   SetTargets(robot_, joint_names_, q, &qd);
@@ -409,7 +404,8 @@ void JointTrajectoryController::Update() {
     int w = Worst(err);
     status_.state = ControllerState::kFailed;
     status_.message = "joint '" + joint_names_[w] + "' did not settle at the last waypoint (" +
-                      Num(err[w]) + " away " + Num(options_.timeout) + " s after the end)";
+                      FormatNumber(err[w]) + " away " + FormatNumber(options_.timeout) +
+                      " s after the end)";
   }
 }
 
@@ -437,7 +433,7 @@ EndEffectorController::EndEffectorController(const Articulation& robot,
                                              const JointControllerOptions& options)
     : Controller(robot, joints, options) {
   name_ = "EndEffectorController of '" + robot.GetName() + "'";
-  if (!tcp.IsValid()) throw Error(name_ + ": tcp pose is not finite or not unit");
+  CheckPose(name_ + ": tcp", tcp);
   state_ = std::make_shared<State>(KinematicModel::FromArticulation(robot));
   state_->link = state_->model.LinkIndex(ee_link);  // throws naming a missing link
   state_->tcp = tcp;
@@ -481,8 +477,7 @@ Pose ToWorld(const Articulation& robot, const Pose& pose, ControlFrame frame) {
 }  // namespace
 
 void EndEffectorController::SetTargetPose(const Pose& target, ControlFrame frame) {
-  if (!target.IsValid())
-    throw Error(name_ + ": target pose " + target.ToString() + " is not finite or not unit");
+  CheckPose(name_ + ": target", target);
   CheckSettings();
   State& s = *state_;
   s.model.SetRootPose(robot_.GetRootPose());
@@ -514,7 +509,7 @@ void EndEffectorController::SetTargetPose(const Pose& target, ControlFrame frame
 
 void EndEffectorController::SetTargetTwist(const Eigen::Matrix<double, 6, 1>& twist,
                                            ControlFrame frame) {
-  if (!twist.allFinite()) throw Error(name_ + ": twist is not finite");
+  CheckFinite(name_ + ": twist", twist);
   CheckSettings();
   State& s = *state_;
   s.model.SetRootPose(robot_.GetRootPose());
@@ -529,12 +524,12 @@ void EndEffectorController::SetTargetTwist(const Eigen::Matrix<double, 6, 1>& tw
   double v = w.head<3>().norm(), a = w.tail<3>().norm();
   if (v > max_linear_speed) {
     w.head<3>() *= max_linear_speed / v;
-    clamped = "linear speed clamped to " + Num(max_linear_speed) + " m/s";
+    clamped = "linear speed clamped to " + FormatNumber(max_linear_speed) + " m/s";
   }
   if (a > max_angular_speed) {
     w.tail<3>() *= max_angular_speed / a;
     clamped += (clamped.empty() ? "" : "; ") + std::string("angular speed clamped to ") +
-               Num(max_angular_speed) + " rad/s";
+               FormatNumber(max_angular_speed) + " rad/s";
   }
   if (s.mode != State::Mode::kTwist) {
     s.q_cmd = robot_.GetQpos();
@@ -591,8 +586,8 @@ void EndEffectorController::Update() {
       s.mode = State::Mode::kHold;
       s.command = s.model.LinkPose(s.q_cmd, s.link, s.tcp);
       status_.state = ControllerState::kFailed;
-      status_.message = "the twist drives the end effector out of reach (" + Num(r.position_error) +
-                        " m from the commanded pose)";
+      status_.message = "the twist drives the end effector out of reach (" +
+                        FormatNumber(r.position_error) + " m from the commanded pose)";
     }
   }
   Eigen::VectorXd q_targets(NumJoints());
@@ -612,9 +607,10 @@ void EndEffectorController::Update() {
     s.arrived = now;
   } else if (status_.state == ControllerState::kRunning && now - s.arrived > options_.timeout) {
     status_.state = ControllerState::kFailed;
-    status_.message = "the end effector is " + Num(e.head<3>().norm()) + " m and " +
-                      Num(e.tail<3>().norm()) + " rad from the target after the timeout of " +
-                      Num(options_.timeout) + " s (blocked?)";
+    status_.message = "the end effector is " + FormatNumber(e.head<3>().norm()) + " m and " +
+                      FormatNumber(e.tail<3>().norm()) +
+                      " rad from the target after the timeout of " +
+                      FormatNumber(options_.timeout) + " s (blocked?)";
   }
 }
 

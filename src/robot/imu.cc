@@ -5,6 +5,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "physics/scene_internal.h"
 
@@ -17,7 +18,7 @@ Imu::Imu(const Link& link, const Pose& local_pose)
       link_index_(link.GetIndex()),
       local_pose_(local_pose) {
   if (!scene_) throw Error("Imu: the link handle is empty");
-  if (!local_pose.IsValid()) throw Error("Imu: local_pose is not finite or not unit");
+  CheckPose("Imu: local_pose", local_pose);
   local_pose_.q.normalize();
   link.GetPose();  // throws for a removed articulation or a bad index
 }
@@ -25,7 +26,7 @@ Imu::Imu(const Link& link, const Pose& local_pose)
 Imu::Imu(const Actor& actor, const Pose& local_pose)
     : scene_(actor.GetScene()), is_link_(false), actor_id_(actor.GetId()), local_pose_(local_pose) {
   if (!scene_) throw Error("Imu: the actor handle is empty");
-  if (!local_pose.IsValid()) throw Error("Imu: local_pose is not finite or not unit");
+  CheckPose("Imu: local_pose", local_pose);
   local_pose_.q.normalize();
   actor.GetPose();  // throws for a removed actor
 }

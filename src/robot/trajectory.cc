@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -117,10 +118,10 @@ void JointTrajectory::Validate(int dof) const {
   for (size_t i = 0; i < times.size(); ++i) {
     if (!std::isfinite(times[i])) throw Error(Where(i) + ": time is not finite");
     if (i == 0 && times[0] < 0)
-      throw Error(Where(0) + ": time " + std::to_string(times[0]) + " is negative");
+      throw Error(Where(0) + ": time " + FormatNumber(times[0]) + " is negative");
     if (i > 0 && !(times[i] > times[i - 1]))
-      throw Error(Where(i) + ": time " + std::to_string(times[i]) +
-                  " does not come after the previous one (" + std::to_string(times[i - 1]) + ")");
+      throw Error(Where(i) + ": time " + FormatNumber(times[i]) +
+                  " does not come after the previous one (" + FormatNumber(times[i - 1]) + ")");
   }
   CheckEntries(positions, dof, "position");
   CheckEntries(velocities, dof, "velocity");

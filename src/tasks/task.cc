@@ -9,6 +9,7 @@
 
 #include "partsim/assets/generator.h"
 #include "partsim/assets/partnet_mobility.h"
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/tasks/tasks.h"
@@ -199,7 +200,7 @@ namespace internal {
 
 TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
   if (!(o.timestep > 0) || !(o.control_rate > 0) || o.control_rate * o.timestep > 1.0 + 1e-9)
-    throw Error("task: the control rate (" + std::to_string(o.control_rate) +
+    throw Error("task: the control rate (" + FormatNumber(o.control_rate) +
                 " Hz) must be positive and at most the physics rate (1 / timestep)");
   if (o.cameras && (o.camera_width <= 0 || o.camera_height <= 0))
     throw Error("task: camera size must be positive");

@@ -23,6 +23,7 @@
 
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/assets/urdf.h"
+#include "partsim/core/constants.h"
 #include "partsim/core/error.h"
 #include "partsim/core/pose.h"
 #include "partsim/physics/scene.h"
@@ -32,7 +33,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using V3 = Eigen::Vector3d;
-constexpr double kPi = 3.14159265358979323846;
 
 std::string ReadFile(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "partsim/core/constants.h"
 #include "partsim/core/error.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera_math.h"
@@ -20,8 +21,6 @@
 
 namespace partsim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // a box of half sizes h centred at the origin, 12 triangles counter-clockwise from outside,
 // without normals (the backend computes flat ones)

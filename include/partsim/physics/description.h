@@ -13,11 +13,10 @@
 #include <utility>
 #include <vector>
 
+#include "partsim/core/constants.h"
 #include "partsim/core/pose.h"
 
 namespace partsim {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// Contact material. MuJoCo has one Coulomb coefficient per contact: partsim uses
 /// `static_friction` for it (the larger of the two bodies' values wins), keeps

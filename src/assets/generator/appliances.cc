@@ -5,13 +5,9 @@
 #include <cmath>
 
 #include "assets/generator/categories.h"
+#include "partsim/core/constants.h"
 
 namespace partsim::internal::gen {
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-}  // namespace
 
 void BuildDishwasher(ObjectBuilder& b, Rng& rng) {
   Material skin = Paint(rng);

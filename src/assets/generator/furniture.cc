@@ -4,11 +4,10 @@
 #include <cmath>
 
 #include "assets/generator/categories.h"
+#include "partsim/core/constants.h"
 
 namespace partsim::internal::gen {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 /// One row of a carcass front, bottom to top.
 struct Row {

@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "partsim/core/constants.h"
+
 namespace partsim::internal::gen {
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}  // namespace
 
 Mesh& Mesh::Transform(const M3& a, const V3& t) {
   for (V3& p : v) p = a * p + t;

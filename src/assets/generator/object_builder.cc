@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "partsim/core/constants.h"
 #include "partsim/core/error.h"
 
 namespace partsim::internal::gen {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kGravity = 9.81;
 // joint dynamics limits (accelerations in m/s^2 or rad/s^2): dry friction below
 // kMaxFrictionAccel; damping such that an effort of kDriveAccel sweeps the range kMinSweeps

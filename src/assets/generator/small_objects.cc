@@ -4,11 +4,10 @@
 #include <cmath>
 
 #include "assets/generator/categories.h"
+#include "partsim/core/constants.h"
 
 namespace partsim::internal::gen {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 /// A grid of buttons on the face y = top of a slab; cells in (x, z) of size pitch, key
 /// footprint `size` (fraction of the pitch).

@@ -4,11 +4,10 @@
 #include <cmath>
 
 #include "assets/generator/categories.h"
+#include "partsim/core/constants.h"
 
 namespace partsim::internal::gen {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 /// Counter-clockwise in the (x, z) plane (ProfileY's polygon orientation).
 std::vector<V2> Ccw(std::vector<V2> poly) {

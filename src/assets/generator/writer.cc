@@ -10,6 +10,7 @@
 #include "assets/generator/mesh_builder.h"
 #include "core/file_read.h"
 #include "partsim/assets/generator.h"
+#include "partsim/core/constants.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -20,8 +21,6 @@ using internal::gen::M3;
 using internal::gen::Mesh;
 using internal::gen::V3;
 using internal::gen::VolumeProps;
-
-constexpr double kPi = 3.14159265358979323846;
 
 /// Appends printf-formatted text to a string.
 void Append(std::string* s, const char* fmt, double x, bool fixed = true) {
