@@ -11,7 +11,7 @@ PACKAGES=(
   # the SAPIEN-style examples save pictures and build rotations as SAPIEN's tutorials do
   python3-pil python3-transforms3d
   libgtest-dev libgmock-dev libbenchmark-dev
-  clang libclang-rt-14-dev clang-format
+  clang libclang-rt-14-dev clang-format clang-tidy
   libegl-dev libegl-mesa0 libgl1-mesa-dri libopengl-dev libembree-dev libpng-dev
   libbullet-extras-dev libjpeg-dev libompl-dev
   libwebsocketpp-dev libboost-dev

@@ -10,6 +10,9 @@ bash scripts/setup.sh
 echo "== source format (clang-format)"
 bash scripts/check_format.sh
 
+echo "== clang-tidy (.clang-tidy's checks on src/)"
+bash scripts/run_clang_tidy.sh build
+
 echo "== Node.js client for the rosbridge test: roslib and ws from npm into build/node"
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
   SUDO=""

@@ -207,7 +207,7 @@ ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh) {
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (const Eigen::Vector3d& p : points) cov += (p - mean) * (p - mean).transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  const Eigen::Matrix3d axes = eig.eigenvectors();
+  const Eigen::Matrix3d& axes = eig.eigenvectors();
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (const Eigen::Vector3d& p : points) {

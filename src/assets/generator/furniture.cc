@@ -208,9 +208,10 @@ void BuildTable(ObjectBuilder& b, Rng& rng) {
   if (pedestal) {
     std::vector<Row> rows;
     if (rng.P(0.5)) {
-      rows = {{Row::kDrawer, 1, 1.0}, {Row::kDrawer, 1, 1.0}, {Row::kDrawer, 1, 1.0}};
+      rows =
+          std::vector<Row>{{Row::kDrawer, 1, 1.0}, {Row::kDrawer, 1, 1.0}, {Row::kDrawer, 1, 1.0}};
     } else {
-      rows = {{Row::kDoor, 1, 2.0}, {Row::kDrawer, 1, 1.0}};
+      rows = std::vector<Row>{{Row::kDoor, 1, 2.0}, {Row::kDrawer, 1, 1.0}};
     }
     Carcass(b, rng, body, V3(w / 2 - ped_w, 0.0, -d / 2 + 0.02),
             V3(w / 2 - 0.01, h - tt - kGap, d / 2 - 0.03), 0.016, rows, wood, hmat, hs);

@@ -155,7 +155,8 @@ void BuildCamera(ObjectBuilder& b, Rng& rng) {
   double pitch = std::min(0.012, 0.75 * h / buttons);
   for (int i = 0; i < buttons; ++i) {
     double x = 0.2 * w + 0.012 + (i % 2) * 0.014;
-    double y = 0.8 * h - (i / 2) * pitch * 1.4 - (i % 2) * 0.5 * pitch;
+    const int row = i / 2;  // two buttons per row
+    double y = 0.8 * h - row * pitch * 1.4 - (i % 2) * 0.5 * pitch;
     Button(b, body, V3(x, y, zb), -V3::UnitZ(), V3::UnitX(), Circle(0.0035, 16), 0.002, 0.0015,
            dark);
   }
