@@ -13,19 +13,13 @@ namespace partsim {
 
 namespace {
 
-CollisionShape Primitive(ShapeType type, const Pose& pose,
-                         const std::optional<PhysicalMaterial>& material, double density) {
+void AddConvexMesh(BodyDesc& b, std::shared_ptr<const MeshData> mesh, const Pose& pose,
+                   const std::optional<PhysicalMaterial>& material, double density) {
   CollisionShape s;
-  s.type = type;
+  s.type = ShapeType::kConvexMesh;
   s.pose = pose;
   s.material = material;
   s.density = density;
-  return s;
-}
-
-void AddConvexMesh(BodyDesc& b, std::shared_ptr<const MeshData> mesh, const Pose& pose,
-                   const std::optional<PhysicalMaterial>& material, double density) {
-  CollisionShape s = Primitive(ShapeType::kConvexMesh, pose, material, density);
   s.mesh = std::move(mesh);
   b.collisions.push_back(s);
 }

@@ -153,28 +153,24 @@ void KinematicModel::SetRootPose(const Pose& pose) {
   root_pose_.q.normalize();
 }
 
-namespace {
-
-void CheckQ(const Eigen::VectorXd& q, int dof, const char* what) {
-  if (q.size() != dof)
+void KinematicModel::CheckJointPositions(const Eigen::VectorXd& q, const char* what) const {
+  if (q.size() != Dof())
     throw Error(std::string("KinematicModel: ") + what + " has " + std::to_string(q.size()) +
-                " entries, the model has " + std::to_string(dof) + " dof");
+                " entries, the model has " + std::to_string(Dof()) + " dof");
   for (Eigen::Index i = 0; i < q.size(); ++i)
     if (!std::isfinite(q[i]))
       throw Error(std::string("KinematicModel: ") + what + "[" + std::to_string(i) +
                   "] is not finite");
 }
 
-void CheckLink(int link, int n) {
-  if (link < 0 || link >= n)
+void KinematicModel::CheckLinkIndex(int link) const {
+  if (link < 0 || link >= NumLinks())
     throw IndexError("KinematicModel: link index " + std::to_string(link) +
-                     " is out of range (model has " + std::to_string(n) + " links)");
+                     " is out of range (model has " + std::to_string(NumLinks()) + " links)");
 }
 
-}  // namespace
-
 std::vector<Pose> KinematicModel::ForwardKinematics(const Eigen::VectorXd& q) const {
-  CheckQ(q, Dof(), "q");
+  CheckJointPositions(q, "q");
   const Data& d = *data_;
   std::vector<Pose> X_WL(d.links.size());
   // Validate has checked that parents come before their children
@@ -194,13 +190,13 @@ std::vector<Pose> KinematicModel::ForwardKinematics(const Eigen::VectorXd& q) co
 }
 
 Pose KinematicModel::LinkPose(const Eigen::VectorXd& q, int link, const Pose& offset) const {
-  CheckLink(link, NumLinks());
+  CheckLinkIndex(link);
   return ForwardKinematics(q)[link] * offset;
 }
 
 Eigen::MatrixXd KinematicModel::Jacobian(const Eigen::VectorXd& q, int link,
                                          const Pose& offset) const {
-  CheckLink(link, NumLinks());
+  CheckLinkIndex(link);
   const Data& d = *data_;
   std::vector<Pose> X_WL = ForwardKinematics(q);
   const Eigen::Vector3d p = (X_WL[link] * offset).p;

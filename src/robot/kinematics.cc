@@ -12,26 +12,6 @@
 
 namespace partsim {
 
-namespace {
-
-void CheckQ(const Eigen::VectorXd& q, int dof, const char* what) {
-  if (q.size() != dof)
-    throw Error(std::string("KinematicModel: ") + what + " has " + std::to_string(q.size()) +
-                " entries, the model has " + std::to_string(dof) + " dof");
-  for (Eigen::Index i = 0; i < q.size(); ++i)
-    if (!std::isfinite(q[i]))
-      throw Error(std::string("KinematicModel: ") + what + "[" + std::to_string(i) +
-                  "] is not finite");
-}
-
-void CheckLink(int link, int n) {
-  if (link < 0 || link >= n)
-    throw IndexError("KinematicModel: link index " + std::to_string(link) +
-                     " is out of range (model has " + std::to_string(n) + " links)");
-}
-
-}  // namespace
-
 Eigen::Matrix<double, 6, 1> PoseError(const Pose& current, const Pose& target) {
   Eigen::Matrix<double, 6, 1> e;
   e.head<3>() = target.p - current.p;
@@ -61,8 +41,8 @@ Eigen::VectorXd Clamp(const Eigen::VectorXd& q, const Eigen::MatrixX2d& limits) 
 IkResult InverseKinematics(const KinematicModel& model, int link, const Pose& target,
                            const Eigen::VectorXd& q_init, const IkOptions& options) {
   const int dof = model.Dof();
-  CheckLink(link, model.NumLinks());
-  CheckQ(q_init, dof, "IK q_init");
+  model.CheckLinkIndex(link);
+  model.CheckJointPositions(q_init, "IK q_init");
   if (!target.p.allFinite() || !target.q.coeffs().allFinite() || target.q.norm() < 1e-9)
     throw Error("InverseKinematics: target pose " + target.ToString() + " is not finite");
   if (!options.offset.IsValid()) throw Error("InverseKinematics: options.offset is not valid");

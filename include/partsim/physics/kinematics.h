@@ -39,6 +39,10 @@ class KinematicModel {
 
   int Dof() const;
   int NumLinks() const;
+  /// Throws partsim::Error naming `what` unless q has Dof() finite entries.
+  void CheckJointPositions(const Eigen::VectorXd& q, const char* what) const;
+  /// Throws partsim::IndexError unless 0 <= link < NumLinks().
+  void CheckLinkIndex(int link) const;
   /// Index of a link by name; throws partsim::Error naming the missing link.
   int LinkIndex(const std::string& name) const;
   /// Dof index of a joint by name (-1 if it has no dof); throws naming a missing joint.
