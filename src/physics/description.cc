@@ -252,4 +252,28 @@ void Validate(const ArticulationDesc& art, const std::string& where) {
   }
 }
 
+namespace {
+
+void NormalizeBody(BodyDesc* b) {
+  for (CollisionShape& c : b->collisions) c.pose.q.normalize();
+  for (VisualShape& v : b->visuals) v.pose.q.normalize();
+  if (b->inertial) b->inertial->cmass_local_pose.q.normalize();
+}
+
+}  // namespace
+
+void NormalizeRotations(ActorDesc* actor) {
+  actor->pose.q.normalize();
+  NormalizeBody(actor);
+}
+
+void NormalizeRotations(ArticulationDesc* articulation) {
+  articulation->root_pose.q.normalize();
+  for (LinkDesc& l : articulation->links) {
+    l.joint.pose_in_parent.q.normalize();
+    l.joint.pose_in_child.q.normalize();
+    NormalizeBody(&l);
+  }
+}
+
 }  // namespace partsim

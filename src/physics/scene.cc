@@ -494,8 +494,10 @@ void CompileOrUndo(internal::SceneImpl& s, Undo undo) {
 
 }  // namespace
 
-Actor Scene::AddActor(const ActorDesc& desc) {
-  Validate(desc);
+Actor Scene::AddActor(const ActorDesc& given) {
+  Validate(given);
+  ActorDesc desc = given;
+  NormalizeRotations(&desc);
   Impl& s = impl();
   s.CheckUser();  // added without compiling: the check EnsureCompiled would make
   // an actor's id is its entity id in segmentation pictures too (as SAPIEN's)
@@ -510,8 +512,10 @@ Actor Scene::AddActor(const ActorDesc& desc) {
   return Actor(this, id);
 }
 
-Articulation Scene::AddArticulation(const ArticulationDesc& desc) {
-  Validate(desc);
+Articulation Scene::AddArticulation(const ArticulationDesc& given) {
+  Validate(given);
+  ArticulationDesc desc = given;
+  NormalizeRotations(&desc);
   Impl& s = impl();
   s.EnsureCompiled();
   // its links take the ids (segmentation entity ids) after the articulation's own

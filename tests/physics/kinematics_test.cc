@@ -152,3 +152,55 @@ TEST(KinematicModel, CoupledJointMovesWithItsSourceInTheJacobian) {
 
 }  // namespace
 }  // namespace partsim
+
+namespace partsim {
+namespace {
+
+// A quaternion of norm 1.5 in a joint frame (Validate accepts any non-zero one) means the same
+// rotation as its unit version: the compiled links, the kinematic model and the stored
+// description agree with the unit description, and no position is scaled.
+TEST(KinematicModel, NonUnitQuaternionsMeanTheirRotation) {
+  auto build = [](double scale) {
+    ArticulationDesc d;
+    d.name = "bent";
+    d.fix_root = true;
+    d.root_pose = Pose(Eigen::Vector3d(0.3, 0, 0.2));
+    d.root_pose.q.coeffs() *= scale;
+    LinkDesc base;
+    base.name = "base";
+    base.inertial = Inertial{1.0, Pose(), Eigen::Vector3d::Constant(0.01)};
+    LinkDesc arm = base;
+    arm.name = "arm";
+    arm.parent = 0;
+    arm.joint.type = JointType::kRevolute;
+    arm.joint.lower = -1;
+    arm.joint.upper = 1;
+    arm.joint.pose_in_parent =
+        Pose(Eigen::Vector3d(0.4, 0.1, 0.0),
+             Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())));
+    arm.joint.pose_in_parent.q.coeffs() *= scale;
+    arm.joint.pose_in_child =
+        Pose(Eigen::Vector3d(-0.2, 0, 0),
+             Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())));
+    arm.joint.pose_in_child.q.coeffs() *= scale;
+    d.links = {base, arm};
+    return d;
+  };
+  Scene unit_scene, scaled_scene;
+  Articulation unit = unit_scene.AddArticulation(build(1.0));
+  Articulation scaled = scaled_scene.AddArticulation(build(1.5));
+  Eigen::VectorXd q = Eigen::VectorXd::Constant(1, 0.4);
+  unit.SetQpos(q);
+  scaled.SetQpos(q);
+  for (int i = 0; i < 2; ++i) {
+    Pose a = unit.GetLink(i).GetPose(), b = scaled.GetLink(i).GetPose();
+    EXPECT_LT((a.p - b.p).norm(), 1e-12) << i;
+    EXPECT_LT(a.q.angularDistance(b.q), 1e-12) << i;
+  }
+  EXPECT_NEAR(scaled.GetDesc().links[1].joint.pose_in_parent.q.norm(), 1.0, 1e-15);
+  std::vector<Pose> fk = KinematicModel(scaled.GetDesc()).ForwardKinematics(q);
+  EXPECT_LT((fk[1].p - unit.GetLink(1).GetPose().p).norm(), 1e-12);
+}
+
+}  // namespace
+}  // namespace partsim

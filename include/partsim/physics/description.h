@@ -199,4 +199,11 @@ void Validate(const ActorDesc& actor, const std::string& where = "");
 void Validate(const ArticulationDesc& art, const std::string& where = "");
 void Validate(const PhysicalMaterial& material, const std::string& where = "");
 
+/// Scales every rotation of the description (root and actor poses, joint frames, shape, visual
+/// and inertial poses) to a unit quaternion. Validate accepts any non-zero quaternion as a
+/// rotation; the scene stores descriptions normalised so that composing their poses cannot scale
+/// positions.
+void NormalizeRotations(ActorDesc* actor);
+void NormalizeRotations(ArticulationDesc* articulation);
+
 }  // namespace partsim
