@@ -21,6 +21,9 @@ import os
 import re
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gen_stubs  # noqa: E402  (the overload parsing the stubs use)
+
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MODULE = "partsim._partsim"
 BINDINGS = os.path.join(REPO, "src", "python")
@@ -54,7 +57,6 @@ REGISTRATION = re.compile(
 OBJECT_REPR = re.compile(r"<%s\.(\w+) object at 0x[0-9a-f]+>" % re.escape(MODULE))
 ENUM_REPR = re.compile(r"<(\w+\.\w+): -?\d+>")
 SIGNATURE = re.compile(r"^(\w+)\((.*)\)(?: -> (.+))?$")
-OVERLOAD_ITEM = re.compile(r"^\d+\. (\w+\(.*)$")
 
 
 def registrations():
@@ -93,18 +95,7 @@ def split_doc(doc):
     """[(signature or None, text)] of a pybind11 docstring, one per overload."""
     lines = (doc or "").splitlines()
     if len(lines) > 1 and lines[1].strip() == "Overloaded function.":
-        out, sig, body = [], None, []
-        for line in lines[2:]:
-            m = OVERLOAD_ITEM.match(line)
-            if m:
-                if sig:
-                    out.append((sig, "\n".join(body).strip()))
-                sig, body = m.group(1), []
-            else:
-                body.append(line)
-        if sig:
-            out.append((sig, "\n".join(body).strip()))
-        return out
+        return gen_stubs.split_overloads(lines[2:])
     if lines and SIGNATURE.match(lines[0].strip()):
         return [(lines[0].strip(), "\n".join(lines[1:]).strip())]
     return [(None, inspect.cleandoc(doc or ""))]

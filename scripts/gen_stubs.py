@@ -105,23 +105,29 @@ def parse_signature(line):
     return name, args, clean_type(ret)
 
 
+def split_overloads(lines):
+    """[(signature line, doc)] of the lines of an "Overloaded function." docstring, after its
+    first two lines: pybind11 numbers each overload's signature ("1. name(...)")."""
+    out, sig, body = [], None, []
+    for line in lines:
+        m = re.match(r"^\d+\. (\w+\(.*)$", line)
+        if m:
+            if sig:
+                out.append((sig, "\n".join(body).strip()))
+            sig, body = m.group(1), []
+        else:
+            body.append(line)
+    if sig:
+        out.append((sig, "\n".join(body).strip()))
+    return out
+
+
 def signatures(func):
     """[(signature line, doc)] of a pybind11 function, one per overload."""
     doc = func.__doc__ or ""
     lines = doc.splitlines()
     if len(lines) > 1 and lines[1].strip() == "Overloaded function.":
-        out, sig, body = [], None, []
-        for line in lines[2:]:
-            m = re.match(r"^\d+\. (\w+\(.*)$", line)
-            if m:
-                if sig:
-                    out.append((sig, "\n".join(body).strip()))
-                sig, body = m.group(1), []
-            else:
-                body.append(line)
-        if sig:
-            out.append((sig, "\n".join(body).strip()))
-        return out
+        return split_overloads(lines[2:])
     return [(lines[0], "\n".join(lines[1:]).strip())] if lines else []
 
 

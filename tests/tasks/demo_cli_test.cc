@@ -1,11 +1,11 @@
 // `partsim tasks demo`: the video it writes and the errors of its options, through the program.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdio>
 #include <filesystem>
 #include <string>
+
+#include "server/process_util.h"
 
 namespace {
 
@@ -13,19 +13,12 @@ namespace fs = std::filesystem;
 
 struct CliRun {
   int code = -1;
-  std::string out;
+  std::string out;  // standard output and error together
 };
 
 CliRun Cli(const std::string& args) {
   CliRun r;
-  std::string cmd = std::string(PARTSIM_CLI_PATH) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.out.append(buf, n);
-  int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = partsim::RunShell(std::string(PARTSIM_CLI_PATH) + " " + args + " 2>&1", &r.code);
   return r;
 }
 

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <string>
 
+#include "server/process_util.h"
+
 namespace partsim {
 namespace {
 
@@ -24,13 +26,7 @@ RunResult RunAssets(const std::string& args) {
   const std::string cmd =
       std::string("'") + PARTSIM_CLI_PATH + "' assets " + args + " 2>&1 >/dev/null";
   RunResult r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.err.append(buf, n);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = RunShell(cmd, &r.code);
   return r;
 }
 

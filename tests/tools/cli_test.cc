@@ -19,6 +19,7 @@
 
 #include "assets/partnet_test_folder.h"
 #include "partsim/assets/default_objects.h"
+#include "server/process_util.h"
 
 #ifndef PARTSIM_CLI_PATH
 #error "PARTSIM_CLI_PATH must name the partsim executable"
@@ -39,13 +40,7 @@ RunResult RunCli(const std::string& args, bool stderr_too = true) {
   std::string cmd =
       std::string("'") + PARTSIM_CLI_PATH + "' " + args + (stderr_too ? " 2>&1" : " 2>/dev/null");
   RunResult r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.output.append(buf, n);
-  int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.output = RunShell(cmd, &r.code);
   return r;
 }
 
