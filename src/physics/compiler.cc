@@ -516,9 +516,9 @@ std::string DescribeMjNames(const SceneImpl& scene, const std::string& text) {
   return out;
 }
 
-void SyncActorDamping(SceneImpl& s, const ActorDesc& desc, const CompiledActor& c) {
+void SyncActorDamping(Model& model, const ActorDesc& desc, const CompiledActor& c) {
   if (c.dofadr < 0) return;
-  mjModel* m = s.m;
+  mjModel* m = model.mj.get();
   const int b = c.body;
   // the free joint's translational dofs move the body in the world, its rotational dofs turn it
   // about its own axes: damping b = rate x (mass, or the inertia about that body axis) gives
@@ -535,17 +535,30 @@ void SyncActorDamping(SceneImpl& s, const ActorDesc& desc, const CompiledActor& 
   }
 }
 
-void BuildTables(SceneImpl& s) {
-  const mjModel* m = s.m;
-  s.compiled_actors.clear();
-  s.compiled_articulations.clear();
-  s.geom_owner.assign(m->ngeom, GeomOwner());
+CompiledDrive CompileDrive(const DriveDesc& drive, double dt) {
+  CompiledDrive out;
+  out.stiffness = drive.stiffness;
+  out.damping = drive.damping;
+  // backward Euler (the implicit integrator): the velocity gain acts on the velocity at the
+  // step's start and the armature makes up the rest; explicit integrators: the damping is in
+  // the actuator's bias
+  out.velocity_gain = dt > 0 ? DriveVelocityGain(drive, dt) : 0.0;
+  out.armature = DriveArmature(drive, dt);
+  return out;
+}
+
+void BuildTables(const SceneImpl& s, Model& model) {
+  const mjModel* m = model.mj.get();
+  model.actors.clear();
+  model.articulations.clear();
+  model.geom_owner.assign(m->ngeom, GeomOwner());
+  const double drive_dt = DriveStep(s.config);
 
   auto own_geoms = [&](const std::string& prefix, size_t count, GeomOwner owner) {
     for (size_t i = 0; i < count; ++i) {
       int g = Id(m, mjOBJ_GEOM, prefix + "_g" + std::to_string(i));
       owner.shape_index = static_cast<int>(i);
-      if (g >= 0) s.geom_owner[g] = owner;
+      if (g >= 0) model.geom_owner[g] = owner;
     }
   };
 
@@ -559,8 +572,8 @@ void BuildTables(SceneImpl& s) {
       c.qposadr = m->jnt_qposadr[j];
       c.dofadr = m->jnt_dofadr[j];
     }
-    s.compiled_actors[a.id] = c;
-    SyncActorDamping(s, a.desc, c);
+    model.actors[a.id] = c;
+    SyncActorDamping(model, a.desc, c);
     GeomOwner owner;
     owner.actor_id = a.id;
     own_geoms(name, a.desc.collisions.size(), owner);
@@ -569,6 +582,7 @@ void BuildTables(SceneImpl& s) {
   for (const auto& a : s.articulations) {
     const ArticulationDesc& desc = a.desc;
     CompiledArticulation c;
+    c.kinematic = desc.kinematic;
     size_t n = desc.links.size();
     c.link_body.resize(n);
     c.link_mocap.assign(n, -1);
@@ -593,11 +607,12 @@ void BuildTables(SceneImpl& s) {
         c.root_dofadr = m->jnt_dofadr[j];
       }
     }
-    // dofs: one per non-fixed joint, in link order; a coupled joint (URDF mimic) is a dof of
-    // its own with its own drive, held to its source by an equality constraint
-    for (size_t i = 0; i < n; ++i) {
+    // dofs as the kinematic model numbers them (DofLinks); a coupled joint (URDF mimic) is a
+    // dof of its own with its own drive, held to its source by an equality constraint
+    c.dof_links = DofLinks(desc);
+    for (size_t k = 0; k < c.dof_links.size(); ++k) {
+      const size_t i = static_cast<size_t>(c.dof_links[k]);
       const LinkDesc& link = desc.links[i];
-      if (link.parent < 0 || link.joint.type == JointType::kFixed) continue;
       CompiledJoint& cj = c.joints[i];
       if (!desc.kinematic) {
         cj.mj_joint = Id(m, mjOBJ_JOINT, JointMjName(a.id, static_cast<int>(i)));
@@ -609,10 +624,11 @@ void BuildTables(SceneImpl& s) {
           cj.screw_slide_dofadr = m->jnt_dofadr[sj];
         }
       }
-      cj.dof_index = static_cast<int>(c.dof_links.size());
-      c.dof_links.push_back(static_cast<int>(i));
-      if (!desc.kinematic)
+      cj.dof_index = static_cast<int>(k);
+      if (!desc.kinematic) {
         cj.actuator = Id(m, mjOBJ_ACTUATOR, ActuatorMjName(a.id, static_cast<int>(i)));
+        cj.drive = CompileDrive(link.joint.drive, drive_dt);
+      }
     }
     for (const JointCoupling& cp : desc.couplings) {
       CompiledCoupling cc;
@@ -638,7 +654,7 @@ void BuildTables(SceneImpl& s) {
         if (rows[r].second.first >= 0) c.G(r, rows[r].second.first) = rows[r].second.second;
       }
     }
-    s.compiled_articulations[a.id] = std::move(c);
+    model.articulations[a.id] = std::move(c);
   }
 }
 

@@ -3,7 +3,9 @@
 #include <cmath>
 
 #include "partsim/core/check.h"
+#include "partsim/physics/frame_motion.h"
 #include "partsim/physics/scene.h"
+#include "physics/dynamics.h"
 #include "physics/scene_internal.h"
 
 namespace partsim {
@@ -38,7 +40,7 @@ void CheckVector(const Eigen::VectorXd& v, int n, const std::string& what,
 std::pair<Eigen::Vector3d, Eigen::Vector3d> BodyVelocity(SceneImpl& s, int body) {
   s.EnsureKinematics();
   mjtNum res[6];
-  mj_objectVelocity(s.m, s.d, mjOBJ_BODY, body, res, 0);
+  mj_objectVelocity(s.m(), s.d(), mjOBJ_BODY, body, res, 0);
   return {V3(res + 3), V3(res)};
 }
 
@@ -46,13 +48,13 @@ void AddBodyForce(SceneImpl& s, int body, const Eigen::Vector3d& f, const Eigen:
   CheckFinite("force", f);
   CheckFinite("point", point);
   s.EnsureKinematics();
-  Eigen::Vector3d com = V3(s.d->xipos + 3 * body);
+  Eigen::Vector3d com = V3(s.d()->xipos + 3 * body);
   Eigen::Vector3d torque = (point - com).cross(f);
   for (int k = 0; k < 3; ++k) {
-    s.d->xfrc_applied[6 * body + k] += f[k];
-    s.d->xfrc_applied[6 * body + 3 + k] += torque[k];
+    s.d()->xfrc_applied[6 * body + k] += f[k];
+    s.d()->xfrc_applied[6 * body + 3 + k] += torque[k];
   }
-  s.xfrc_dirty = true;
+  s.data.xfrc_dirty = true;
 }
 
 }  // namespace
@@ -69,9 +71,9 @@ Pose Actor::GetPose() const {
   SceneImpl& s = S(scene_);
   auto& a = s.GetActor(id_);
   const auto& c = s.Compiled(a);
-  if (c.qposadr >= 0) return Pose(V3(s.d->qpos + c.qposadr), Q4(s.d->qpos + c.qposadr + 3));
+  if (c.qposadr >= 0) return Pose(V3(s.d()->qpos + c.qposadr), Q4(s.d()->qpos + c.qposadr + 3));
   if (c.mocap >= 0)
-    return Pose(V3(s.d->mocap_pos + 3 * c.mocap), Q4(s.d->mocap_quat + 4 * c.mocap));
+    return Pose(V3(s.d()->mocap_pos + 3 * c.mocap), Q4(s.d()->mocap_quat + 4 * c.mocap));
   return a.desc.pose;
 }
 
@@ -87,17 +89,17 @@ void Actor::SetPose(const Pose& pose) {
   Eigen::Quaterniond q = pose.q.normalized();
   double* dst;
   if (c.qposadr >= 0) {
-    dst = s.d->qpos + c.qposadr;
+    dst = s.d()->qpos + c.qposadr;
     for (int k = 0; k < 3; ++k) dst[k] = pose.p[k];
     dst += 3;
   } else if (c.mocap >= 0) {
-    for (int k = 0; k < 3; ++k) s.d->mocap_pos[3 * c.mocap + k] = pose.p[k];
-    dst = s.d->mocap_quat + 4 * c.mocap;
+    for (int k = 0; k < 3; ++k) s.d()->mocap_pos[3 * c.mocap + k] = pose.p[k];
+    dst = s.d()->mocap_quat + 4 * c.mocap;
   } else {
     // a static actor is welded to the world: move the weld in the model (contacts with what
     // rests on it are not carried along)
-    for (int k = 0; k < 3; ++k) s.m->body_pos[3 * c.body + k] = pose.p[k];
-    dst = s.m->body_quat + 4 * c.body;
+    for (int k = 0; k < 3; ++k) s.m()->body_pos[3 * c.body + k] = pose.p[k];
+    dst = s.m()->body_quat + 4 * c.body;
   }
   dst[0] = q.w();
   dst[1] = q.x();
@@ -111,7 +113,7 @@ Eigen::Vector3d Actor::GetVelocity() const {
   SceneImpl& s = S(scene_);
   const auto& c = s.Compiled(s.GetActor(id_));
   if (c.dofadr < 0) return Eigen::Vector3d::Zero();
-  return V3(s.d->qvel + c.dofadr);
+  return V3(s.d()->qvel + c.dofadr);
 }
 
 Eigen::Vector3d Actor::GetAngularVelocity() const {
@@ -119,7 +121,7 @@ Eigen::Vector3d Actor::GetAngularVelocity() const {
   const auto& c = s.Compiled(s.GetActor(id_));
   if (c.dofadr < 0) return Eigen::Vector3d::Zero();
   // a free joint's angular velocity is in the body frame
-  return Q4(s.d->qpos + c.qposadr + 3).normalized() * V3(s.d->qvel + c.dofadr + 3);
+  return Q4(s.d()->qpos + c.qposadr + 3).normalized() * V3(s.d()->qvel + c.dofadr + 3);
 }
 
 void Actor::SetVelocity(const Eigen::Vector3d& v) {
@@ -128,7 +130,7 @@ void Actor::SetVelocity(const Eigen::Vector3d& v) {
   auto& a = s.GetActor(id_);
   const auto& c = s.Compiled(a);
   if (c.dofadr < 0) throw Error("actor '" + a.desc.name + "' is not dynamic: no velocity to set");
-  for (int k = 0; k < 3; ++k) s.d->qvel[c.dofadr + k] = v[k];
+  for (int k = 0; k < 3; ++k) s.d()->qvel[c.dofadr + k] = v[k];
   s.Invalidate();
 }
 
@@ -138,15 +140,15 @@ void Actor::SetAngularVelocity(const Eigen::Vector3d& w) {
   auto& a = s.GetActor(id_);
   const auto& c = s.Compiled(a);
   if (c.dofadr < 0) throw Error("actor '" + a.desc.name + "' is not dynamic: no velocity to set");
-  Eigen::Vector3d local = Q4(s.d->qpos + c.qposadr + 3).normalized().conjugate() * w;
-  for (int k = 0; k < 3; ++k) s.d->qvel[c.dofadr + 3 + k] = local[k];
+  Eigen::Vector3d local = Q4(s.d()->qpos + c.qposadr + 3).normalized().conjugate() * w;
+  for (int k = 0; k < 3; ++k) s.d()->qvel[c.dofadr + 3 + k] = local[k];
   s.Invalidate();
 }
 
 double Actor::GetMass() const {
   SceneImpl& s = S(scene_);
-  const int body = s.Compiled(s.GetActor(id_)).body;  // may compile: before reading s.m
-  return s.m->body_mass[body];
+  const int body = s.Compiled(s.GetActor(id_)).body;  // may compile: before reading s.m()
+  return s.m()->body_mass[body];
 }
 
 void Actor::SetDamping(double linear, double angular) {
@@ -162,7 +164,7 @@ void Actor::SetDamping(double linear, double angular) {
   Validate(changed);
   a.desc.linear_damping = linear;
   a.desc.angular_damping = angular;
-  SyncActorDamping(s, a.desc, c);
+  SyncActorDamping(s.model, a.desc, c);
 }
 
 double Actor::GetLinearDamping() const { return S(scene_).GetActor(id_).desc.linear_damping; }
@@ -179,10 +181,10 @@ void Actor::AddForceTorque(const Eigen::Vector3d& force, const Eigen::Vector3d& 
   SceneImpl& s = S(scene_);
   int body = s.Compiled(s.GetActor(id_)).body;
   for (int k = 0; k < 3; ++k) {
-    s.d->xfrc_applied[6 * body + k] += force[k];
-    s.d->xfrc_applied[6 * body + 3 + k] += torque[k];
+    s.d()->xfrc_applied[6 * body + k] += force[k];
+    s.d()->xfrc_applied[6 * body + 3 + k] += torque[k];
   }
-  s.xfrc_dirty = true;
+  s.data.xfrc_dirty = true;
 }
 
 std::vector<Shape> Actor::GetCollisionShapes() const {
@@ -226,15 +228,15 @@ Pose Link::GetPose() const {
   SceneImpl& s = S(scene_);
   int b = LinkBody(s, articulation_id_, index_);
   s.EnsureKinematics();
-  return Pose(V3(s.d->xpos + 3 * b), Q4(s.d->xquat + 4 * b));
+  return Pose(V3(s.d()->xpos + 3 * b), Q4(s.d()->xquat + 4 * b));
 }
 
 Pose Link::GetCMassPose() const {
   SceneImpl& s = S(scene_);
   int b = LinkBody(s, articulation_id_, index_);
   s.EnsureKinematics();
-  Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> r(s.d->ximat + 9 * b);
-  return Pose(V3(s.d->xipos + 3 * b), Eigen::Quaterniond(Eigen::Matrix3d(r)));
+  Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> r(s.d()->ximat + 9 * b);
+  return Pose(V3(s.d()->xipos + 3 * b), Eigen::Quaterniond(Eigen::Matrix3d(r)));
 }
 
 Eigen::Vector3d Link::GetVelocity() const {
@@ -249,14 +251,14 @@ Eigen::Vector3d Link::GetAngularVelocity() const {
 
 double Link::GetMass() const {
   SceneImpl& s = S(scene_);
-  const int body = LinkBody(s, articulation_id_, index_);  // may compile: before reading s.m
-  return s.m->body_mass[body];
+  const int body = LinkBody(s, articulation_id_, index_);  // may compile: before reading s.m()
+  return s.m()->body_mass[body];
 }
 
 Eigen::Vector3d Link::GetInertia() const {
   SceneImpl& s = S(scene_);
-  const int body = LinkBody(s, articulation_id_, index_);  // may compile: before reading s.m
-  return V3(s.m->body_inertia + 3 * body);
+  const int body = LinkBody(s, articulation_id_, index_);  // may compile: before reading s.m()
+  return V3(s.m()->body_inertia + 3 * body);
 }
 
 void Link::AddForceAtPoint(const Eigen::Vector3d& force, const Eigen::Vector3d& point) {
@@ -308,10 +310,10 @@ void Shape::SetCollisionGroups(const std::array<uint32_t, 4>& groups) {
   s.EnsureCompiled();
   std::string body = articulation_id_ < 0 ? internal::ActorBodyName(actor_id_)
                                           : internal::LinkBodyName(articulation_id_, link_index_);
-  int geom = mj_name2id(s.m, mjOBJ_GEOM, (body + "_g" + std::to_string(index_)).c_str());
+  int geom = mj_name2id(s.m(), mjOBJ_GEOM, (body + "_g" + std::to_string(index_)).c_str());
   if (geom < 0) throw Error("collision shape " + std::to_string(index_) + " was not compiled");
-  s.m->geom_contype[geom] = static_cast<int>(groups[0]);
-  s.m->geom_conaffinity[geom] = static_cast<int>(groups[1]);
+  s.m()->geom_contype[geom] = static_cast<int>(groups[0]);
+  s.m()->geom_conaffinity[geom] = static_cast<int>(groups[1]);
   s.Invalidate();
 }
 
@@ -323,7 +325,7 @@ namespace {
 struct JointRef {
   SceneImpl::ArticulationEntry* entry;
   JointDesc* desc;
-  const CompiledJoint* compiled;
+  CompiledJoint* compiled;
 };
 
 JointRef GetJointRef(Scene* scene, int art, int index) {
@@ -334,8 +336,8 @@ JointRef GetJointRef(Scene* scene, int art, int index) {
                      std::to_string(a.desc.links.size()) +
                      ") (joint i connects link i to its "
                      "parent; the root has none)");
-  const auto& c = s.Compiled(a);
-  return {&a, &a.desc.links[index].joint, &c.joints[index]};
+  s.Compiled(a);  // compiles a changed description
+  return {&a, &a.desc.links[index].joint, &s.model.articulations.at(art).joints[index]};
 }
 
 JointRef DofJoint(Scene* scene, int art, int index, const char* what) {
@@ -354,11 +356,11 @@ void CheckDriveParam(double v, const char* what) {
 // compiles (the mass matrix of simple dofs, dof_M0, used as is; the constraint weights; the mean
 // inertia), as a compile would: mj_setConst works at qpos0, and changes no state but qpos.
 void SetDofArmature(SceneImpl& s, int dofadr, double armature) {
-  if (s.m->dof_armature[dofadr] == armature) return;
-  s.m->dof_armature[dofadr] = armature;
-  std::vector<double> qpos(s.d->qpos, s.d->qpos + s.m->nq);
-  mj_setConst(s.m, s.d);
-  std::copy(qpos.begin(), qpos.end(), s.d->qpos);
+  if (s.m()->dof_armature[dofadr] == armature) return;
+  s.m()->dof_armature[dofadr] = armature;
+  std::vector<double> qpos(s.d()->qpos, s.d()->qpos + s.m()->nq);
+  mj_setConst(s.m(), s.d());
+  std::copy(qpos.begin(), qpos.end(), s.d()->qpos);
   s.Invalidate();
 }
 
@@ -369,13 +371,14 @@ void SyncDrive(SceneImpl& s, const JointRef& j) {
   int a = j.compiled->actuator;
   const DriveDesc& dr = j.desc->drive;
   const double dt = DriveStep(s.config);
-  s.m->actuator_biasprm[a * mjNBIAS + 1] = -dr.stiffness;
-  s.m->actuator_biasprm[a * mjNBIAS + 2] = dt > 0 ? 0.0 : -dr.damping;
-  SetDofArmature(s, j.compiled->dofadr, j.desc->armature + DriveArmature(dr, dt));
+  j.compiled->drive = internal::CompileDrive(dr, dt);
+  s.m()->actuator_biasprm[a * mjNBIAS + 1] = -dr.stiffness;
+  s.m()->actuator_biasprm[a * mjNBIAS + 2] = dt > 0 ? 0.0 : -dr.damping;
+  SetDofArmature(s, j.compiled->dofadr, j.desc->armature + j.compiled->drive.armature);
   bool limited = std::isfinite(dr.force_limit);
-  s.m->actuator_forcelimited[a] = limited;
-  s.m->actuator_forcerange[2 * a] = limited ? -dr.force_limit : 0;
-  s.m->actuator_forcerange[2 * a + 1] = limited ? dr.force_limit : 0;
+  s.m()->actuator_forcelimited[a] = limited;
+  s.m()->actuator_forcerange[2 * a] = limited ? -dr.force_limit : 0;
+  s.m()->actuator_forcerange[2 * a + 1] = limited ? dr.force_limit : 0;
   s.Invalidate();
 }
 
@@ -448,14 +451,14 @@ void Joint::SetFriction(double v) {
   CheckDriveParam(v, "friction");
   JointRef j = GetJointRef(scene_, articulation_id_, index_);
   j.desc->friction = v;
-  if (j.compiled->dofadr >= 0) S(scene_).m->dof_frictionloss[j.compiled->dofadr] = v;
+  if (j.compiled->dofadr >= 0) S(scene_).m()->dof_frictionloss[j.compiled->dofadr] = v;
 }
 
 void Joint::SetDamping(double v) {
   CheckDriveParam(v, "damping");
   JointRef j = GetJointRef(scene_, articulation_id_, index_);
   j.desc->damping = v;
-  if (j.compiled->dofadr >= 0) S(scene_).m->dof_damping[j.compiled->dofadr] = v;
+  if (j.compiled->dofadr >= 0) S(scene_).m()->dof_damping[j.compiled->dofadr] = v;
 }
 
 void Joint::SetArmature(double v) {
@@ -463,8 +466,7 @@ void Joint::SetArmature(double v) {
   JointRef j = GetJointRef(scene_, articulation_id_, index_);
   j.desc->armature = v;
   if (j.compiled->dofadr >= 0)
-    SetDofArmature(S(scene_), j.compiled->dofadr,
-                   v + DriveArmature(j.desc->drive, DriveStep(S(scene_).config)));
+    SetDofArmature(S(scene_), j.compiled->dofadr, v + j.compiled->drive.armature);
   S(scene_).Invalidate();
 }
 
@@ -480,24 +482,39 @@ void Joint::SetDriveProperty(double stiffness, double damping, double force_limi
   SyncDrive(S(scene_), j);
 }
 
+namespace {
+
+// The data of the joint's articulation.
+internal::ArticulationData& JointState(Scene* scene, const JointRef& j) {
+  return S(scene).State(*j.entry);
+}
+
+}  // namespace
+
 void Joint::SetDriveTarget(double target) {
   if (!std::isfinite(target)) throw Error("drive target must be finite");
-  DofJoint(scene_, articulation_id_, index_, "set_drive_target").desc->drive.target = target;
+  JointRef j = DofJoint(scene_, articulation_id_, index_, "set_drive_target");
+  JointState(scene_, j).drive_target[j.compiled->dof_index] = target;
   S(scene_).Invalidate();
 }
 
 void Joint::SetDriveVelocityTarget(double v) {
   if (!std::isfinite(v)) throw Error("drive velocity target must be finite");
-  DofJoint(scene_, articulation_id_, index_, "set_drive_velocity_target")
-      .desc->drive.velocity_target = v;
+  JointRef j = DofJoint(scene_, articulation_id_, index_, "set_drive_velocity_target");
+  JointState(scene_, j).drive_velocity_target[j.compiled->dof_index] = v;
   S(scene_).Invalidate();
 }
 
+// A joint without a dof has no drive: its description's (zero) targets
 double Joint::GetDriveTarget() const {
-  return GetJointRef(scene_, articulation_id_, index_).desc->drive.target;
+  JointRef j = GetJointRef(scene_, articulation_id_, index_);
+  if (j.compiled->dof_index < 0) return j.desc->drive.target;
+  return JointState(scene_, j).drive_target[j.compiled->dof_index];
 }
 double Joint::GetDriveVelocityTarget() const {
-  return GetJointRef(scene_, articulation_id_, index_).desc->drive.velocity_target;
+  JointRef j = GetJointRef(scene_, articulation_id_, index_);
+  if (j.compiled->dof_index < 0) return j.desc->drive.velocity_target;
+  return JointState(scene_, j).drive_velocity_target[j.compiled->dof_index];
 }
 double Joint::GetDriveStiffness() const {
   return GetJointRef(scene_, articulation_id_, index_).desc->drive.stiffness;
@@ -559,36 +576,12 @@ void ScatterDofs(const ArtRef& r, const Eigen::VectorXd& x, double* dst) {
   for (size_t i = 0; i < r.c.mj_dofs.size(); ++i) dst[r.c.mj_dofs[i]] = full[i];
 }
 
-// Rows of the articulation's MuJoCo dofs of a quantity (for G^T projections).
-Eigen::VectorXd MjDofs(const ArtRef& r, const double* src) {
-  Eigen::VectorXd out(r.c.mj_dofs.size());
-  for (size_t i = 0; i < r.c.mj_dofs.size(); ++i) out[i] = src[r.c.mj_dofs[i]];
-  return out;
-}
-
 // Joint-space values with every coupled joint (URDF mimic) set from its source: positions
 // (q = multiplier * q_source + offset) or velocities (qd = multiplier * qd_source).
 Eigen::VectorXd WithCouplings(const ArtRef& r, Eigen::VectorXd x, bool positions) {
   for (const auto& cp : r.c.couplings)
     x[cp.dof] = cp.multiplier * x[cp.source_dof] + (positions ? cp.offset : 0.0);
   return x;
-}
-
-// Mass matrix over the articulation's MuJoCo dofs, without the inertia of backward-Euler drives.
-Eigen::MatrixXd MjMassMatrix(const ArtRef& r) {
-  int nv = r.s.m->nv;
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> full(nv, nv);
-  mj_fullM(r.s.m, full.data(), r.s.d->qM);
-  const double dt = DriveStep(r.s.config);
-  for (int li : r.c.dof_links) {
-    const int v = r.c.joints[li].dofadr;
-    full(v, v) -= DriveArmature(r.a.desc.links[li].joint.drive, dt);
-  }
-  int n = static_cast<int>(r.c.mj_dofs.size());
-  Eigen::MatrixXd out(n, n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) out(i, j) = full(r.c.mj_dofs[i], r.c.mj_dofs[j]);
-  return out;
 }
 
 }  // namespace
@@ -655,9 +648,9 @@ Joint Articulation::FindJointByName(const std::string& name) const {
 
 Eigen::VectorXd Articulation::GetQpos() const {
   ArtRef r = GetArt(scene_, id_);
-  if (r.a.desc.kinematic) return r.a.kin_qpos;
+  if (r.a.desc.kinematic) return r.s.State(r.a).kin_qpos;
   Eigen::VectorXd out(r.dof());
-  for (int k = 0; k < r.dof(); ++k) out[k] = r.s.d->qpos[r.c.joints[r.c.dof_links[k]].qposadr];
+  for (int k = 0; k < r.dof(); ++k) out[k] = r.s.d()->qpos[r.c.joints[r.c.dof_links[k]].qposadr];
   return out;
 }
 
@@ -667,11 +660,11 @@ void Articulation::SetQpos(const Eigen::VectorXd& qpos) {
   // coupled joints follow their sources, so that the coupling holds from the start
   const Eigen::VectorXd values = WithCouplings(r, qpos, true);
   if (r.a.desc.kinematic) {
-    r.a.kin_qpos = values;
+    r.s.State(r.a).kin_qpos = values;
     r.s.UpdateKinematicArticulation(r.a);
     return;
   }
-  double* q = r.s.d->qpos;
+  double* q = r.s.d()->qpos;
   for (int k = 0; k < r.dof(); ++k) {
     const CompiledJoint& j = r.c.joints[r.c.dof_links[k]];
     q[j.qposadr] = values[k];
@@ -683,61 +676,51 @@ void Articulation::SetQpos(const Eigen::VectorXd& qpos) {
 
 Eigen::VectorXd Articulation::GetQvel() const {
   ArtRef r = GetArt(scene_, id_);
-  if (r.a.desc.kinematic) return r.a.kin_qvel;
-  return GatherDofs(r, r.s.d->qvel);
+  if (r.a.desc.kinematic) return r.s.State(r.a).kin_qvel;
+  return GatherDofs(r, r.s.d()->qvel);
 }
 
 void Articulation::SetQvel(const Eigen::VectorXd& qvel) {
   ArtRef r = GetArt(scene_, id_);
   CheckVector(qvel, r.dof(), "qvel", r.owner());
   if (r.a.desc.kinematic) {
-    r.a.kin_qvel = WithCouplings(r, qvel, false);
+    r.s.State(r.a).kin_qvel = WithCouplings(r, qvel, false);
     return;
   }
-  ScatterDofs(r, WithCouplings(r, qvel, false), r.s.d->qvel);
+  ScatterDofs(r, WithCouplings(r, qvel, false), r.s.d()->qvel);
   r.s.Invalidate();
 }
 
 Eigen::VectorXd Articulation::GetQacc() const {
   ArtRef r = GetArt(scene_, id_);
   if (r.a.desc.kinematic) return Eigen::VectorXd::Zero(r.dof());
-  return GatherDofs(r, r.s.d->qacc);
+  return GatherDofs(r, r.s.d()->qacc);
 }
 
 void Articulation::SetQacc(const Eigen::VectorXd& qacc) {
   ArtRef r = DynamicArt(scene_, id_, "set_qacc");
   CheckVector(qacc, r.dof(), "qacc", r.owner());
-  ScatterDofs(r, qacc, r.s.d->qacc);
-  ScatterDofs(r, qacc, r.s.d->qacc_warmstart);
+  ScatterDofs(r, qacc, r.s.d()->qacc);
+  ScatterDofs(r, qacc, r.s.d()->qacc_warmstart);
 }
 
 Eigen::VectorXd Articulation::GetQf() const {
   ArtRef r = GetArt(scene_, id_);
   if (r.a.desc.kinematic) return Eigen::VectorXd::Zero(r.dof());
   // the force on each partsim dof is G^T of the MuJoCo dof forces
-  return r.c.G.transpose() * MjDofs(r, r.s.d->qfrc_applied);
+  return r.c.G.transpose() * internal::MjDofs(r.c, r.s.d()->qfrc_applied);
 }
 
 void Articulation::SetQf(const Eigen::VectorXd& qf) {
   ArtRef r = DynamicArt(scene_, id_, "set_qf");
   CheckVector(qf, r.dof(), "qf", r.owner());
-  for (int mj : r.c.mj_dofs) r.s.d->qfrc_applied[mj] = 0;
+  for (int mj : r.c.mj_dofs) r.s.d()->qfrc_applied[mj] = 0;
   for (int k = 0; k < r.dof(); ++k)
-    r.s.d->qfrc_applied[r.c.joints[r.c.dof_links[k]].dofadr] = qf[k];
+    r.s.d()->qfrc_applied[r.c.joints[r.c.dof_links[k]].dofadr] = qf[k];
   r.s.Invalidate();
 }
 
-Eigen::MatrixX2d Articulation::GetQlimits() const {
-  ArtRef r = GetArt(scene_, id_);
-  Eigen::MatrixX2d out(r.dof(), 2);
-  for (int k = 0; k < r.dof(); ++k) {
-    const JointDesc& j = r.a.desc.links[r.c.dof_links[k]].joint;
-    bool limited = j.type != JointType::kContinuous;
-    out(k, 0) = limited ? j.lower : -kInf;
-    out(k, 1) = limited ? j.upper : kInf;
-  }
-  return out;
-}
+Eigen::MatrixX2d Articulation::GetQlimits() const { return DofLimits(GetArt(scene_, id_).a.desc); }
 
 void Articulation::SetQlimits(const Eigen::MatrixX2d& limits) {
   ArtRef r = GetArt(scene_, id_);
@@ -760,7 +743,7 @@ void Articulation::SetQlimits(const Eigen::MatrixX2d& limits) {
 Pose Articulation::GetRootPose() const {
   ArtRef r = GetArt(scene_, id_);
   if (r.c.root_qposadr >= 0)
-    return Pose(V3(r.s.d->qpos + r.c.root_qposadr), Q4(r.s.d->qpos + r.c.root_qposadr + 3));
+    return Pose(V3(r.s.d()->qpos + r.c.root_qposadr), Q4(r.s.d()->qpos + r.c.root_qposadr + 3));
   return r.a.desc.root_pose;
 }
 
@@ -770,7 +753,7 @@ void Articulation::SetRootPose(const Pose& pose) {
   Eigen::Quaterniond q = pose.q.normalized();
   r.a.desc.root_pose = pose;
   if (r.c.root_qposadr >= 0) {
-    double* dst = r.s.d->qpos + r.c.root_qposadr;
+    double* dst = r.s.d()->qpos + r.c.root_qposadr;
     for (int k = 0; k < 3; ++k) dst[k] = pose.p[k];
     dst[3] = q.w(), dst[4] = q.x(), dst[5] = q.y(), dst[6] = q.z();
   } else if (r.a.desc.kinematic) {
@@ -780,8 +763,8 @@ void Articulation::SetRootPose(const Pose& pose) {
     int b = r.c.link_body[0];
     for (size_t i = 0; i < r.a.desc.links.size(); ++i)
       if (r.a.desc.links[i].parent < 0) b = r.c.link_body[i];
-    for (int k = 0; k < 3; ++k) r.s.m->body_pos[3 * b + k] = pose.p[k];
-    double* mq = r.s.m->body_quat + 4 * b;
+    for (int k = 0; k < 3; ++k) r.s.m()->body_pos[3 * b + k] = pose.p[k];
+    double* mq = r.s.m()->body_quat + 4 * b;
     mq[0] = q.w(), mq[1] = q.x(), mq[2] = q.y(), mq[3] = q.z();
   }
   r.s.Invalidate();
@@ -790,21 +773,21 @@ void Articulation::SetRootPose(const Pose& pose) {
 Eigen::Vector3d Articulation::GetRootVelocity() const {
   ArtRef r = GetArt(scene_, id_);
   if (r.c.root_dofadr < 0) return Eigen::Vector3d::Zero();
-  return V3(r.s.d->qvel + r.c.root_dofadr);
+  return V3(r.s.d()->qvel + r.c.root_dofadr);
 }
 
 Eigen::Vector3d Articulation::GetRootAngularVelocity() const {
   ArtRef r = GetArt(scene_, id_);
   if (r.c.root_dofadr < 0) return Eigen::Vector3d::Zero();
-  return Q4(r.s.d->qpos + r.c.root_qposadr + 3).normalized() *
-         V3(r.s.d->qvel + r.c.root_dofadr + 3);
+  return Q4(r.s.d()->qpos + r.c.root_qposadr + 3).normalized() *
+         V3(r.s.d()->qvel + r.c.root_dofadr + 3);
 }
 
 void Articulation::SetRootVelocity(const Eigen::Vector3d& v) {
   CheckFinite("root velocity", v);
   ArtRef r = GetArt(scene_, id_);
   if (r.c.root_dofadr < 0) throw Error(r.owner() + " has a fixed root: no root velocity to set");
-  for (int k = 0; k < 3; ++k) r.s.d->qvel[r.c.root_dofadr + k] = v[k];
+  for (int k = 0; k < 3; ++k) r.s.d()->qvel[r.c.root_dofadr + k] = v[k];
   r.s.Invalidate();
 }
 
@@ -812,39 +795,33 @@ void Articulation::SetRootAngularVelocity(const Eigen::Vector3d& w) {
   CheckFinite("root angular velocity", w);
   ArtRef r = GetArt(scene_, id_);
   if (r.c.root_dofadr < 0) throw Error(r.owner() + " has a fixed root: no root velocity to set");
-  Eigen::Vector3d local = Q4(r.s.d->qpos + r.c.root_qposadr + 3).normalized().conjugate() * w;
-  for (int k = 0; k < 3; ++k) r.s.d->qvel[r.c.root_dofadr + 3 + k] = local[k];
+  Eigen::Vector3d local = Q4(r.s.d()->qpos + r.c.root_qposadr + 3).normalized().conjugate() * w;
+  for (int k = 0; k < 3; ++k) r.s.d()->qvel[r.c.root_dofadr + 3 + k] = local[k];
   r.s.Invalidate();
 }
 
 void Articulation::SetDriveTarget(const Eigen::VectorXd& target) {
   ArtRef r = GetArt(scene_, id_);
   CheckVector(target, r.dof(), "drive target", r.owner());
-  for (int k = 0; k < r.dof(); ++k) r.a.desc.links[r.c.dof_links[k]].joint.drive.target = target[k];
+  r.s.State(r.a).drive_target = target;
   r.s.Invalidate();
 }
 
 void Articulation::SetDriveVelocityTarget(const Eigen::VectorXd& velocity) {
   ArtRef r = GetArt(scene_, id_);
   CheckVector(velocity, r.dof(), "drive velocity target", r.owner());
-  for (int k = 0; k < r.dof(); ++k)
-    r.a.desc.links[r.c.dof_links[k]].joint.drive.velocity_target = velocity[k];
+  r.s.State(r.a).drive_velocity_target = velocity;
   r.s.Invalidate();
 }
 
 Eigen::VectorXd Articulation::GetDriveTarget() const {
   ArtRef r = GetArt(scene_, id_);
-  Eigen::VectorXd out(r.dof());
-  for (int k = 0; k < r.dof(); ++k) out[k] = r.a.desc.links[r.c.dof_links[k]].joint.drive.target;
-  return out;
+  return r.s.State(r.a).drive_target;
 }
 
 Eigen::VectorXd Articulation::GetDriveVelocityTarget() const {
   ArtRef r = GetArt(scene_, id_);
-  Eigen::VectorXd out(r.dof());
-  for (int k = 0; k < r.dof(); ++k)
-    out[k] = r.a.desc.links[r.c.dof_links[k]].joint.drive.velocity_target;
-  return out;
+  return r.s.State(r.a).drive_velocity_target;
 }
 
 void Articulation::SetDriveProperty(double stiffness, double damping, double force_limit) {
@@ -855,76 +832,34 @@ Eigen::VectorXd Articulation::ComputePassiveForce(bool gravity, bool coriolis,
                                                   bool external) const {
   ArtRef r = DynamicArt(scene_, id_, "compute_passive_force");
   r.s.EnsureForward();
-  const mjModel* m = r.s.m;
-  mjData* d = r.s.d;
-  // qfrc_bias = C(q, qdot) qdot + g(q); gravity alone is the bias at zero velocity
-  Eigen::VectorXd bias = MjDofs(r, d->qfrc_bias);
-  Eigen::VectorXd grav = Eigen::VectorXd::Zero(bias.size());
-  if (gravity || coriolis) {
-    std::vector<double> saved(d->qvel, d->qvel + m->nv), g(m->nv);
-    std::fill(d->qvel, d->qvel + m->nv, 0.0);
-    mj_comVel(m, d);
-    mj_rne(m, d, 0, g.data());
-    std::copy(saved.begin(), saved.end(), d->qvel);
-    mj_comVel(m, d);
-    grav = MjDofs(r, g.data());
-  }
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(bias.size());
-  if (gravity) f += grav;
-  if (coriolis) f += bias - grav;
-  if (external && r.s.xfrc_dirty) {
-    // the wrenches waiting in xfrc_applied (at the links' centres of mass), in joint space
-    std::vector<double> qfrc(m->nv, 0.0);
-    std::vector<int> bodies = r.c.link_body;
-    std::sort(bodies.begin(), bodies.end());
-    bodies.erase(std::unique(bodies.begin(), bodies.end()), bodies.end());
-    for (int b : bodies) {
-      const double* w = d->xfrc_applied + 6 * b;
-      mj_applyFT(m, d, w, w + 3, d->xipos + 3 * b, b, qfrc.data());
-    }
-    f -= MjDofs(r, qfrc.data());
-  }
-  return r.c.G.transpose() * f;
+  return internal::PassiveForce(r.s.model, r.s.data, id_, gravity, coriolis, external);
 }
 
 Eigen::VectorXd Articulation::ComputeForwardDynamics(const Eigen::VectorXd& qf) const {
   ArtRef r = DynamicArt(scene_, id_, "compute_forward_dynamics");
   CheckVector(qf, r.dof(), "qf", r.owner());
   r.s.EnsureForward();
-  const Eigen::MatrixXd& G = r.c.G;
-  Eigen::MatrixXd M = G.transpose() * MjMassMatrix(r) * G;
-  Eigen::VectorXd bias = G.transpose() * MjDofs(r, r.s.d->qfrc_bias);
-  return M.ldlt().solve(qf - bias);
+  return internal::ForwardDynamics(r.s.model, r.s.data, id_, qf);
 }
 
 Eigen::VectorXd Articulation::ComputeInverseDynamics(const Eigen::VectorXd& qacc) const {
   ArtRef r = DynamicArt(scene_, id_, "compute_inverse_dynamics");
   CheckVector(qacc, r.dof(), "qacc", r.owner());
   r.s.EnsureForward();
-  const Eigen::MatrixXd& G = r.c.G;
-  return G.transpose() * (MjMassMatrix(r) * (G * qacc) + MjDofs(r, r.s.d->qfrc_bias));
+  return internal::InverseDynamics(r.s.model, r.s.data, id_, qacc);
 }
 
 Eigen::MatrixXd Articulation::ComputeManipulatorInertiaMatrix() const {
   ArtRef r = DynamicArt(scene_, id_, "compute_manipulator_inertia_matrix");
   r.s.EnsureForward();
-  return r.c.G.transpose() * MjMassMatrix(r) * r.c.G;
+  return internal::MassMatrix(r.s.model, r.s.data, id_);
 }
 
 Eigen::MatrixXd Articulation::ComputeLinkJacobian(int index) const {
   ArtRef r = DynamicArt(scene_, id_, "compute_link_jacobian");
-  int b = LinkBody(r.s, id_, index);
+  LinkBody(r.s, id_, index);  // throws for an index out of range
   r.s.EnsureKinematics();
-  int nv = r.s.m->nv;
-  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> jp(3, nv), jr(3, nv);
-  mj_jacBody(r.s.m, r.s.d, jp.data(), jr.data(), b);
-  int n = static_cast<int>(r.c.mj_dofs.size());
-  Eigen::MatrixXd J(6, n);
-  for (int i = 0; i < n; ++i) {
-    J.block<3, 1>(0, i) = jp.col(r.c.mj_dofs[i]);
-    J.block<3, 1>(3, i) = jr.col(r.c.mj_dofs[i]);
-  }
-  return J * r.c.G;
+  return internal::LinkJacobian(r.s.model, r.s.data, id_, index);
 }
 
 void Articulation::DisableCollision(const Link& a, const Link& b) {
@@ -958,6 +893,41 @@ Eigen::MatrixXd Articulation::ComputeWorldCartesianJacobian() const {
   Eigen::MatrixXd out(6 * n, r.dof());
   for (int i = 0; i < n; ++i) out.middleRows(6 * i, 6) = ComputeLinkJacobian(i);
   return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// frame motion (partsim/physics/frame_motion.h)
+
+namespace {
+
+FrameMotion BodyFrame(SceneImpl& s, int body, const Pose& X_WB, const Pose& offset) {
+  CheckPose("offset", offset);
+  Pose X_BS = offset;
+  X_BS.q.normalize();
+  s.EnsureForward();
+  FrameMotion out;
+  out.pose = X_WB * X_BS;
+  const internal::BodyFrameMotion m = internal::FrameMotion(s.model, s.data, body, out.pose.p);
+  out.linear_velocity = m.linear_velocity;
+  out.angular_velocity = m.angular_velocity;
+  out.linear_acceleration = m.linear_acceleration;
+  out.angular_acceleration = m.angular_acceleration;
+  out.time = s.d()->time;
+  return out;
+}
+
+}  // namespace
+
+FrameMotion ComputeFrameMotion(const Link& link, const Pose& offset) {
+  const Pose X_WL = link.GetPose();  // throws for an empty or removed handle
+  SceneImpl& s = S(link.GetScene());
+  return BodyFrame(s, LinkBody(s, link.GetArticulationId(), link.GetIndex()), X_WL, offset);
+}
+
+FrameMotion ComputeFrameMotion(const Actor& actor, const Pose& offset) {
+  const Pose X_WA = actor.GetPose();
+  SceneImpl& s = S(actor.GetScene());
+  return BodyFrame(s, s.Compiled(s.GetActor(actor.GetId())).body, X_WA, offset);
 }
 
 }  // namespace partsim

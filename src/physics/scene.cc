@@ -7,16 +7,12 @@
 #include <cstring>
 #include <map>
 
+#include "physics/dynamics.h"
 #include "physics/scene_internal.h"
 
 namespace partsim {
 
 namespace internal {
-
-SceneImpl::~SceneImpl() {
-  if (d) mj_deleteData(d);
-  if (m) mj_deleteModel(m);
-}
 
 SceneImpl::ActorEntry& SceneImpl::GetActor(int id) {
   for (auto& a : actors)
@@ -35,12 +31,17 @@ SceneImpl::ArticulationEntry& SceneImpl::GetArticulation(int id) {
 
 const CompiledActor& SceneImpl::Compiled(const ActorEntry& a) {
   EnsureCompiled();
-  return compiled_actors.at(a.id);
+  return model.actors.at(a.id);
 }
 
 const CompiledArticulation& SceneImpl::Compiled(const ArticulationEntry& a) {
   EnsureCompiled();
-  return compiled_articulations.at(a.id);
+  return model.articulations.at(a.id);
+}
+
+ArticulationData& SceneImpl::State(const ArticulationEntry& a) {
+  EnsureCompiled();
+  return data.articulations.at(a.id);
 }
 
 namespace {
@@ -51,7 +52,8 @@ thread_local SceneImpl* stepping_scene = nullptr;
 
 void OnMujocoWarning(const char* msg) {
   if (stepping_scene)
-    stepping_scene->warnings.push_back({stepping_scene->d ? stepping_scene->d->time : 0.0, msg});
+    stepping_scene->warnings.push_back(
+        {stepping_scene->d() ? stepping_scene->d()->time : 0.0, msg});
   else
     std::fprintf(stderr, "partsim: MuJoCo warning: %s\n", msg);
 }
@@ -75,7 +77,7 @@ struct SteppingScope {
   explicit SteppingScope(SceneImpl* s) : scene(s) { stepping_scene = s; }
   ~SteppingScope() {
     stepping_scene = nullptr;
-    if (scene->d) scene->d->pstack = 0;
+    if (scene->d()) scene->d()->pstack = 0;
   }
 };
 
@@ -218,30 +220,48 @@ void SceneImpl::EnsureCompiled() {
     }
     throw Error("MuJoCo could not compile the scene: " + why);
   }
-  mjData* new_d = mj_makeData(new_m);
-  if (!new_d) {
-    const int ncon = new_m->nconmax, nj = new_m->njmax;
-    mj_deleteModel(new_m);
-    throw Error("MuJoCo could not allocate the data of the scene (" + std::to_string(ncon) +
-                " contacts, " + std::to_string(nj) + " constraint rows): out of memory");
-  }
-  // carry the state of everything that existed before
-  if (m && d)
-    RestoreNamed(SaveNamed(m, d), new_m, new_d);
+  Model new_model;
+  new_model.mj.reset(new_m);
+  MjDataPtr new_d(mj_makeData(new_m));
+  if (!new_d)
+    throw Error("MuJoCo could not allocate the data of the scene (" +
+                std::to_string(new_m->nconmax) + " contacts, " + std::to_string(new_m->njmax) +
+                " constraint rows): out of memory");
+  // carry the state of everything that existed before: MuJoCo's by element name, partsim's by
+  // articulation id (a new articulation's drives start at its description's targets)
+  if (model.mj && data.mj)
+    RestoreNamed(SaveNamed(model.mj.get(), data.mj.get()), new_m, new_d.get());
   else
     new_d->time = 0;
-  if (d) mj_deleteData(d);
-  if (m) mj_deleteModel(m);
-  m = new_m;
-  d = new_d;
-  mjcf = std::move(xml);
+  new_model.mjcf = std::move(xml);
+  BuildTables(*this, new_model);
+  std::map<int, ArticulationData> states;
+  for (const ArticulationEntry& a : articulations) {
+    auto old = data.articulations.find(a.id);
+    const CompiledArticulation& c = new_model.articulations.at(a.id);
+    ArticulationData& state = states[a.id];
+    if (old != data.articulations.end() && old->second.drive_target.size() == c.Dof()) {
+      state = old->second;
+      continue;
+    }
+    state.drive_target.resize(c.Dof());
+    state.drive_velocity_target.resize(c.Dof());
+    for (int k = 0; k < c.Dof(); ++k) {
+      const DriveDesc& drive = a.desc.links[c.dof_links[k]].joint.drive;
+      state.drive_target[k] = drive.target;
+      state.drive_velocity_target[k] = drive.velocity_target;
+    }
+  }
+  model = std::move(new_model);
+  data.mj = std::move(new_d);
+  data.articulations = std::move(states);
+  data.xfrc_dirty = false;
   dirty = false;
   uncompiled_actors.clear();
   ++description_version;
-  BuildTables(*this);
   for (auto& a : articulations) {
     if (!a.desc.kinematic) continue;
-    compiled_articulations.at(a.id).kinematics.emplace(a.desc);
+    model.articulations.at(a.id).kinematics.emplace(a.desc);
     UpdateKinematicArticulation(a);
   }
   Invalidate();
@@ -250,51 +270,29 @@ void SceneImpl::EnsureCompiled() {
 void SceneImpl::EnsureForward() {
   CheckUser();
   EnsureCompiled();
-  if (forward_valid) return;
-  ApplyDrives();
-  mj_forward(m, d);
-  forward_valid = true;
+  Forward(model, data);
 }
 
 void SceneImpl::EnsureKinematics() {
   CheckUser();
   EnsureCompiled();
-  if (kinematics_valid || forward_valid) return;
-  mj_kinematics(m, d);
-  mj_comPos(m, d);
-  mj_comVel(m, d);
-  kinematics_valid = true;
-}
-
-void SceneImpl::ApplyDrives() {
-  // with the implicit integrator drives are backward Euler: the velocity gain acts here, on the
-  // velocity at the step's start, and the armature the compiler added makes up the rest
-  const double dt = DriveStep(config);
-  for (const auto& a : articulations) {
-    if (a.desc.kinematic) continue;
-    const CompiledArticulation& c = compiled_articulations.at(a.id);
-    for (int li : c.dof_links) {
-      const CompiledJoint& j = c.joints[li];
-      const DriveDesc& dr = a.desc.links[li].joint.drive;
-      double u = dr.stiffness * dr.target + dr.damping * dr.velocity_target;
-      if (dt > 0) u -= DriveVelocityGain(dr, dt) * d->qvel[j.dofadr];
-      d->ctrl[j.actuator] = u;
-    }
-  }
+  Kinematics(model, data);
 }
 
 void SceneImpl::UpdateKinematicArticulation(ArticulationEntry& a) {
-  const CompiledArticulation& c = compiled_articulations.at(a.id);
+  const CompiledArticulation& c = model.articulations.at(a.id);
+  ArticulationData& state = data.articulations.at(a.id);
   // the model of the last compile, at the root pose of now
-  KinematicModel model = *c.kinematics;
+  KinematicModel kinematics = *c.kinematics;
   Pose X_WR = a.desc.root_pose;
   X_WR.q.normalize();
-  model.SetRootPose(X_WR);
-  const int dof = model.Dof();
-  if (a.kin_qpos.size() != dof) a.kin_qpos = Eigen::VectorXd::Zero(dof);
-  if (a.kin_qvel.size() != dof) a.kin_qvel = Eigen::VectorXd::Zero(dof);
+  kinematics.SetRootPose(X_WR);
+  const int dof = kinematics.Dof();
+  if (state.kin_qpos.size() != dof) state.kin_qpos = Eigen::VectorXd::Zero(dof);
+  if (state.kin_qvel.size() != dof) state.kin_qvel = Eigen::VectorXd::Zero(dof);
   // the mocap bodies of the links, couplings included
-  const std::vector<Pose> X_WL = model.ForwardKinematics(a.kin_qpos);
+  mjData* d = data.mj.get();
+  const std::vector<Pose> X_WL = kinematics.ForwardKinematics(state.kin_qpos);
   for (size_t i = 0; i < X_WL.size(); ++i) {
     int mocap = c.link_mocap[i];
     Eigen::Quaterniond qn = X_WL[i].q.normalized();
@@ -310,7 +308,7 @@ void SceneImpl::UpdateKinematicArticulation(ArticulationEntry& a) {
 void SceneImpl::GrowBuffers(int contacts, long long stack, const std::string& why) {
   const int old_contacts = contact_capacity;
   const long long old_stack = stack_capacity;
-  const int nv = m->nv;
+  const int nv = m()->nv;
   contact_capacity = contacts;
   stack_capacity = stack;
   dirty = true;
@@ -329,8 +327,8 @@ void SceneImpl::GrowBuffers(int contacts, long long stack, const std::string& wh
                 ". Fewer bodies in contact at once, or fewer "
                 "dofs, fit");
   }
-  warnings.push_back({d->time, why + ": grown to " + std::to_string(contact_capacity) +
-                                   " contacts and a stack of " + std::to_string(m->nstack)});
+  warnings.push_back({d()->time, why + ": grown to " + std::to_string(contact_capacity) +
+                                     " contacts and a stack of " + std::to_string(m()->nstack)});
 }
 
 void SceneImpl::Step(int n) {
@@ -338,7 +336,10 @@ void SceneImpl::Step(int n) {
   EnsureCompiled();
   SteppingScope scope(this);
   for (int i = 0; i < n; ++i) {
-    ApplyDrives();
+    // the model and data move when a step grows MuJoCo's buffers (GrowBuffers recompiles)
+    const mjModel* m = model.mj.get();
+    mjData* d = data.mj.get();
+    ApplyDrives(model, data);
     int bad_before = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
                      d->warning[mjWARN_BADQVEL].number;
     const int full_before = d->warning[mjWARN_CONTACTFULL].number;
@@ -355,10 +356,6 @@ void SceneImpl::Step(int n) {
       --i;
       continue;
     }
-    if (d->warning[mjWARN_CONTACTFULL].number != full_before)
-      GrowBuffers(2 * m->nconmax, stack_capacity,
-                  "contacts filled MuJoCo's buffer of " + std::to_string(m->nconmax) +
-                      " (the excess was dropped for one step)");
     int bad_after = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
                     d->warning[mjWARN_BADQVEL].number;
     if (bad_after != bad_before)
@@ -366,10 +363,15 @@ void SceneImpl::Step(int n) {
                           "numerical instability (NaN or huge value in positions, "
                           "velocities or accelerations): MuJoCo reset the state to the "
                           "model's initial configuration"});
-    if (xfrc_dirty) {
+    if (data.xfrc_dirty) {
       std::fill(d->xfrc_applied, d->xfrc_applied + 6 * m->nbody, 0.0);
-      xfrc_dirty = false;
+      data.xfrc_dirty = false;
     }
+    // last: growing recompiles, and the model and data above are gone
+    if (d->warning[mjWARN_CONTACTFULL].number != full_before)
+      GrowBuffers(2 * m->nconmax, stack_capacity,
+                  "contacts filled MuJoCo's buffer of " + std::to_string(m->nconmax) +
+                      " (the excess was dropped for one step)");
   }
   Invalidate();
 }
@@ -397,18 +399,22 @@ Scene::Scene(const SceneConfig& config) : impl_(std::make_unique<Impl>()) {
 Scene::~Scene() = default;
 
 std::unique_ptr<Scene> Scene::Clone() const {
-  auto copy = std::make_unique<Scene>(impl().config);
+  Impl& s = impl();
+  s.EnsureCompiled();
+  auto copy = std::make_unique<Scene>(s.config);
   Impl& c = copy->impl();
-  c.actors = impl().actors;
-  c.articulations = impl().articulations;
-  c.next_id = impl().next_id;
-  c.next_visual_id = impl().next_visual_id;
-  c.contact_capacity = impl().contact_capacity;
-  c.stack_capacity = impl().stack_capacity;
-  c.dirty = true;
-  c.EnsureCompiled();
-  copy->Unpack(Pack());
-  c.warnings = impl().warnings;
+  // the three stages, copied: the description, the compiled model, the data
+  c.actors = s.actors;
+  c.articulations = s.articulations;
+  c.next_id = s.next_id;
+  c.next_visual_id = s.next_visual_id;
+  c.contact_capacity = s.contact_capacity;
+  c.stack_capacity = s.stack_capacity;
+  c.description_version = s.description_version;
+  c.model = s.model.Copy();
+  c.data = s.data.CopyFor(c.model);
+  c.dirty = false;
+  c.warnings = s.warnings;
   // the observers' state (cameras, lights) after the bodies it may refer to
   for (const auto& [key, attachment] : impl().attachments)
     c.attachments[key] = attachment->CloneFor(*copy);
@@ -433,13 +439,13 @@ void Scene::SetGravity(const Eigen::Vector3d& g) {
   if (!g.allFinite()) throw Error("gravity must be finite");
   impl().config.gravity = g;
   impl().EnsureCompiled();
-  for (int k = 0; k < 3; ++k) impl().m->opt.gravity[k] = g[k];
+  for (int k = 0; k < 3; ++k) impl().m()->opt.gravity[k] = g[k];
   impl().Invalidate();
 }
 
 double Scene::GetTime() const {
   impl().EnsureCompiled();
-  return impl().d->time;
+  return impl().d()->time;
 }
 
 void Scene::SetDefaultMaterial(const PhysicalMaterial& material) {
@@ -520,7 +526,7 @@ Articulation Scene::AddArticulation(const ArticulationDesc& given) {
   s.EnsureCompiled();
   // its links take the ids (segmentation entity ids) after the articulation's own
   int id = s.next_id;
-  internal::SceneImpl::ArticulationEntry entry{id, desc, {}, {}, static_cast<uint32_t>(id + 1), {}};
+  internal::SceneImpl::ArticulationEntry entry{id, desc, static_cast<uint32_t>(id + 1), {}};
   uint32_t visual_id = s.next_visual_id;
   for (const LinkDesc& l : desc.links) {
     entry.visual_id_base.push_back(visual_id);
@@ -638,17 +644,17 @@ void Scene::ClearWarnings() { impl().warnings.clear(); }
 
 const mjModel_* Scene::GetMjModel() const {
   impl().EnsureCompiled();
-  return impl().m;
+  return impl().m();
 }
 
 mjData_* Scene::GetMjData() const {
   impl().EnsureCompiled();
-  return impl().d;
+  return impl().d();
 }
 
 std::string Scene::GetMjcf() const {
   impl().EnsureCompiled();
-  return impl().mjcf;
+  return impl().model.mjcf;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -657,11 +663,11 @@ std::string Scene::GetMjcf() const {
 std::vector<Contact> Scene::GetContacts() const {
   Impl& s = impl();
   s.EnsureCompiled();
-  const mjModel* m = s.m;
-  const mjData* d = s.d;
+  const mjModel* m = s.m();
+  const mjData* d = s.d();
   auto body = [&](int geom) {
     ContactBody b;
-    const internal::GeomOwner& o = s.geom_owner[geom];
+    const internal::GeomOwner& o = s.model.geom_owner[geom];
     b.shape_index = o.shape_index;
     if (o.actor_id >= 0) {
       b.kind = ContactBody::Kind::kActor;
@@ -677,7 +683,7 @@ std::vector<Contact> Scene::GetContacts() const {
   };
   // a static actor (the ground, a wall) is body 1 when the other body can move
   auto is_static = [&](int geom) {
-    const internal::GeomOwner& o = s.geom_owner[geom];
+    const internal::GeomOwner& o = s.model.geom_owner[geom];
     return o.actor_id >= 0 && s.GetActor(o.actor_id).desc.type == ActorType::kStatic;
   };
   std::map<std::pair<int, int>, size_t> index;
@@ -718,7 +724,7 @@ std::vector<Contact> Scene::GetContacts() const {
 
 namespace {
 
-constexpr uint32_t kPackMagic = 0x50534d31;  // "PSM1"
+constexpr uint32_t kPackMagic = 0x50534d32;  // "PSM2"
 
 class Writer {
  public:
@@ -767,8 +773,8 @@ class Reader {
 std::vector<char> Scene::Pack() const {
   Impl& s = impl();
   s.EnsureCompiled();
-  const mjModel* m = s.m;
-  const mjData* d = s.d;
+  const mjModel* m = s.m();
+  const mjData* d = s.d();
   Writer w;
   w.Put(kPackMagic);
   for (int n : {m->nq, m->nv, m->nu, m->na, m->nbody, m->nmocap}) w.Put(n);
@@ -784,13 +790,14 @@ std::vector<char> Scene::Pack() const {
   w.Put(d->mocap_pos, 3 * m->nmocap);
   w.Put(d->mocap_quat, 4 * m->nmocap);
   for (const auto& a : s.articulations) {
-    for (const LinkDesc& l : a.desc.links) {
-      w.Put(l.joint.drive.target);
-      w.Put(l.joint.drive.velocity_target);
-    }
-    w.Put(static_cast<int>(a.kin_qpos.size()));
-    w.Put(a.kin_qpos.data(), static_cast<int>(a.kin_qpos.size()));
-    w.Put(a.kin_qvel.data(), static_cast<int>(a.kin_qvel.size()));
+    const internal::ArticulationData& state = s.data.articulations.at(a.id);
+    const int dof = static_cast<int>(state.drive_target.size());
+    w.Put(dof);
+    w.Put(state.drive_target.data(), dof);
+    w.Put(state.drive_velocity_target.data(), dof);
+    w.Put(static_cast<int>(state.kin_qpos.size()));
+    w.Put(state.kin_qpos.data(), static_cast<int>(state.kin_qpos.size()));
+    w.Put(state.kin_qvel.data(), static_cast<int>(state.kin_qvel.size()));
   }
   return w.buf;
 }
@@ -798,8 +805,8 @@ std::vector<char> Scene::Pack() const {
 void Scene::Unpack(const std::vector<char>& state) {
   Impl& s = impl();
   s.EnsureCompiled();
-  mjModel* m = s.m;
-  mjData* d = s.d;
+  mjModel* m = s.m();
+  mjData* d = s.d();
   Reader r(state);
   if (r.Get<uint32_t>() != kPackMagic) throw Error("unpack: not a partsim state (bad header)");
   const char* names[] = {"nq", "nv", "nu", "na", "nbody", "nmocap"};
@@ -835,18 +842,20 @@ void Scene::Unpack(const std::vector<char>& state) {
     get(d->mocap_pos, 3 * m->nmocap);
     get(d->mocap_quat, 4 * m->nmocap);
     for (auto& a : s.articulations) {
-      for (LinkDesc& l : a.desc.links) {
-        get(&l.joint.drive.target, 1);
-        get(&l.joint.drive.velocity_target, 1);
-      }
+      internal::ArticulationData& state = s.data.articulations.at(a.id);
+      int dof = r.Get<int>();
+      if (dof != state.drive_target.size())
+        throw Error("unpack: articulation '" + a.desc.name + "' has another number of dofs");
+      get(state.drive_target.data(), dof);
+      get(state.drive_velocity_target.data(), dof);
       int n = r.Get<int>();
-      if (n != a.kin_qpos.size()) throw Error("unpack: kinematic articulation size differs");
-      get(a.kin_qpos.data(), n);
-      get(a.kin_qvel.data(), n);
+      if (n != state.kin_qpos.size()) throw Error("unpack: kinematic articulation size differs");
+      get(state.kin_qpos.data(), n);
+      get(state.kin_qvel.data(), n);
     }
     if (r.pos != state.size()) throw Error("unpack: state has trailing bytes");
   }
-  s.xfrc_dirty = true;
+  s.data.xfrc_dirty = true;
   s.Invalidate();
 }
 

@@ -1,5 +1,5 @@
-// Internals of Scene: the description entries, the compiled tables that map partsim entities to
-// MuJoCo ids, and the mutable data. Not part of the public API.
+// Internals of Scene: the description entries and the two compiled stages (stages.h: the model
+// and the data), with what keeps them in step. Not part of the public API.
 #pragma once
 
 #include <mujoco/mujoco.h>
@@ -13,65 +13,12 @@
 #include <thread>
 #include <vector>
 
-#include "partsim/physics/kinematics.h"
 #include "partsim/physics/observer.h"
 #include "partsim/physics/scene.h"
+#include "physics/stages.h"
 
 namespace partsim {
 namespace internal {
-
-/// Where a MuJoCo geom came from.
-struct GeomOwner {
-  int actor_id = -1;         ///< owning actor, or -1
-  int articulation_id = -1;  ///< owning articulation, or -1
-  int link_index = -1;
-  int shape_index = -1;
-};
-
-/// Compiled form of an actor.
-struct CompiledActor {
-  int body = -1;
-  int mocap = -1;    ///< kinematic actors are MuJoCo mocap bodies
-  int qposadr = -1;  ///< dynamic actors have a free joint
-  int dofadr = -1;
-};
-
-/// Compiled form of one joint of an articulation (the joint above link i).
-struct CompiledJoint {
-  int mj_joint = -1;  ///< main MuJoCo joint (hinge or slide), -1 for fixed
-  int qposadr = -1;
-  int dofadr = -1;
-  int dof_index = -1;            ///< index in the articulation's qpos, -1 when fixed
-  int actuator = -1;             ///< drive actuator
-  int screw_slide_qposadr = -1;  ///< screw joints: the coupled slide joint
-  int screw_slide_dofadr = -1;
-};
-
-/// A coupled joint (URDF mimic): an ordinary dof that an equality constraint holds to
-/// q[dof] = multiplier * q[source_dof] + offset.
-struct CompiledCoupling {
-  int dof = -1;         ///< partsim dof index of the coupled joint
-  int source_dof = -1;  ///< partsim dof index of its source
-  double multiplier = 1.0;
-  double offset = 0.0;
-};
-
-/// Compiled form of an articulation.
-struct CompiledArticulation {
-  std::vector<int> link_body;         ///< MuJoCo body per link
-  std::vector<int> link_mocap;        ///< kinematic articulations: mocap id per link
-  std::vector<CompiledJoint> joints;  ///< per link (entry 0 unused)
-  std::vector<int> dof_links;         ///< partsim dof -> link index
-  std::vector<CompiledCoupling> couplings;
-  /// kinematic articulations: the forward kinematics that places their links
-  std::optional<KinematicModel> kinematics;
-  int root_qposadr = -1;  ///< free root joint
-  int root_dofadr = -1;
-  /// MuJoCo dofs of the articulation's joints (free root excluded), ascending.
-  std::vector<int> mj_dofs;
-  /// Maps partsim joint velocities to the MuJoCo dofs above: qvel_mj = G qvel.
-  Eigen::MatrixXd G;
-};
 
 /// Scene::Impl: description, compiled model and data.
 struct SceneImpl {
@@ -86,10 +33,9 @@ struct SceneImpl {
   };
   struct ArticulationEntry {
     int id;
+    /// The description; its drives' targets are the targets the articulation starts with (the
+    /// current ones are in the data).
     ArticulationDesc desc;
-    // kinematic articulations keep their joint state here
-    Eigen::VectorXd kin_qpos;
-    Eigen::VectorXd kin_qvel;
     uint32_t render_id_base = 0;           ///< link i has entity id render_id_base + i
     std::vector<uint32_t> visual_id_base;  ///< per link: visual j has id base + j
   };
@@ -127,36 +73,27 @@ struct SceneImpl {
   /// backend), by key; physics only owns and clones them (partsim/physics/observer.h).
   std::map<std::string, std::unique_ptr<SceneAttachment>> attachments;
 
-  // model
-  mjModel* m = nullptr;
-  std::string mjcf;
-  bool dirty = true;
-  std::map<int, CompiledActor> compiled_actors;                ///< by actor id
-  std::map<int, CompiledArticulation> compiled_articulations;  ///< by articulation id
-  std::vector<GeomOwner> geom_owner;                           ///< per MuJoCo geom
-
-  // data
-  mjData* d = nullptr;
-  bool forward_valid = false;     ///< mj_forward quantities in d match qpos/qvel
-  bool kinematics_valid = false;  ///< poses and velocities of bodies in d match qpos/qvel
-  bool xfrc_dirty = false;        ///< xfrc_applied holds forces to clear after the step
+  // the compiled stages
+  Model model;
+  bool dirty = true;  ///< the description changed since the model was compiled
+  Data data;
   std::vector<Warning> warnings;
-  std::vector<double> pending_ctrl;  ///< scratch
 
-  ~SceneImpl();
+  mjModel* m() const { return model.mj.get(); }
+  mjData* d() const { return data.mj.get(); }
 
   // description lookups; throw partsim::Error for removed entities
   ActorEntry& GetActor(int id);
   ArticulationEntry& GetArticulation(int id);
   const CompiledActor& Compiled(const ActorEntry& a);
   const CompiledArticulation& Compiled(const ArticulationEntry& a);
+  /// The state of an articulation beside MuJoCo's (drive targets, kinematic joint state).
+  ArticulationData& State(const ArticulationEntry& a);
 
   /// Compiles when the description changed, carrying over the state by name.
   void EnsureCompiled();
   /// Runs mj_forward if the state changed since the last one.
   void EnsureForward();
-  /// Writes drive controls into d->ctrl.
-  void ApplyDrives();
   /// Places the links of kinematic articulations from their qpos.
   void UpdateKinematicArticulation(ArticulationEntry& a);
   void Step(int n);
@@ -170,7 +107,7 @@ struct SceneImpl {
   /// thread other than the one holding the scene.
   void Invalidate() {
     CheckUser();
-    forward_valid = kinematics_valid = false;
+    data.Invalidate();
   }
 };
 
@@ -180,8 +117,11 @@ std::string GenerateMjcf(const SceneImpl& scene);
 /// by the user's (link, joint and actor names, mesh files), and MuJoCo's positions in the
 /// generated MJCF dropped.
 std::string DescribeMjNames(const SceneImpl& scene, const std::string& text);
-/// Fills compiled tables from a loaded model.
-void BuildTables(SceneImpl& scene);
+/// Fills the tables of `model` (its MuJoCo model loaded from GenerateMjcf(scene)) and its drive
+/// gains from the scene's description.
+void BuildTables(const SceneImpl& scene, Model& model);
+/// A drive as the engine applies it over steps of `dt` (DriveStep).
+CompiledDrive CompileDrive(const DriveDesc& drive, double dt);
 /// The step over which joint drives are backward Euler (DriveVelocityGain, DriveArmature): the
 /// implicit integrator's timestep; 0, the plain gains, for the explicit integrators.
 inline double DriveStep(const SceneConfig& config) {
@@ -191,7 +131,7 @@ inline double DriveStep(const SceneConfig& config) {
 /// Contacts a fresh scene's buffers hold (SceneImpl::contact_capacity grows from there).
 constexpr int kBaseContacts = 256;
 /// Writes a dynamic actor's velocity damping into its free joint's dofs (compiled model).
-void SyncActorDamping(SceneImpl& scene, const ActorDesc& desc, const CompiledActor& compiled);
+void SyncActorDamping(Model& model, const ActorDesc& desc, const CompiledActor& compiled);
 
 /// Name of MuJoCo elements generated for partsim entities.
 std::string ActorBodyName(int actor_id);

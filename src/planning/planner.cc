@@ -1,9 +1,7 @@
-// Motion planning with OMPL over a private clone of the scene; collisions from MuJoCo's own
-// collision pipeline (mj_kinematics + mj_collision) with the arm's geoms inflated by the
-// clearance.
+// Motion planning with OMPL over a private clone of the scene; collisions from a proximity
+// query (partsim/physics/proximity.h) with the arm's moving links inflated by the clearance.
 #include "partsim/planning/planner.h"
 
-#include <mujoco/mujoco.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/geometric/SimpleSetup.h>
 #include <ompl/geometric/planners/kpiece/KPIECE1.h>
@@ -22,8 +20,8 @@
 
 #include "partsim/core/check.h"
 #include "partsim/core/error.h"
+#include "partsim/physics/proximity.h"
 #include "partsim/robot/kinematics.h"
-#include "physics/scene_internal.h"
 
 namespace partsim {
 
@@ -44,23 +42,21 @@ struct MotionPlanner::Impl {
   Eigen::MatrixX2d limits;          ///< planned joints, (lower, upper)
   std::vector<uint64_t> link_mask;  ///< per link: bit p set when planned joint p moves it
 
-  // snapshot
-  std::unique_ptr<Scene> world;
+  // snapshot: the world as it was, with the arm's moving links as the queried shapes
+  std::unique_ptr<ProximityQuery> world;
   Articulation world_arm;
-  Eigen::VectorXd base_q;      ///< the arm's full qpos at the snapshot
-  std::vector<int> geom_link;  ///< per MuJoCo geom: arm link index, or -1
-  double margin = -1.0;        ///< clearance the arm geoms are inflated by now
+  Eigen::VectorXd base_q;    ///< the arm's full qpos at the snapshot
+  std::vector<bool> moving;  ///< per link: moved by a planned joint
 
   void Snapshot() {
-    world = arm.GetScene()->Clone();
-    world_arm = Articulation(world.get(), arm.GetId());
+    if (world)
+      world->Refresh();
+    else
+      world = std::make_unique<ProximityQuery>(arm);
+    world_arm = world->GetArticulation();
     base_q = arm.GetQpos();
-    internal::SceneImpl& s = world->impl();
-    s.EnsureCompiled();
-    geom_link.assign(s.m->ngeom, -1);
-    for (int g = 0; g < s.m->ngeom; ++g)
-      if (s.geom_owner[g].articulation_id == arm.GetId()) geom_link[g] = s.geom_owner[g].link_index;
-    margin = -1.0;
+    moving.assign(link_mask.size(), false);
+    for (size_t l = 0; l < link_mask.size(); ++l) moving[l] = link_mask[l] != 0;
   }
 
   Eigen::VectorXd Full(const Eigen::VectorXd& q) const {
@@ -69,7 +65,16 @@ struct MotionPlanner::Impl {
     return full;
   }
 
-  std::string LinkName(int link) const { return world_arm.GetLink(link).GetName(); }
+  // The name of a shape's body in the snapshot.
+  std::string BodyName(const ShapeOwner& o) const {
+    Scene& scene = world->GetScene();
+    if (o.actor_id >= 0) return "actor '" + Actor(&scene, o.actor_id).GetName() + "'";
+    const Articulation art(&scene, o.articulation_id);
+    if (o.articulation_id == arm.GetId())
+      return "link '" + art.GetLink(o.link_index).GetName() + "'";
+    return "link '" + art.GetLink(o.link_index).GetName() + "' of articulation '" + art.GetName() +
+           "'";
+  }
 
   bool Check(const Eigen::VectorXd& q, double clearance, std::string* reason) {
     for (Eigen::Index i = 0; i < q.size(); ++i)
@@ -83,49 +88,22 @@ struct MotionPlanner::Impl {
         return false;
       }
     if (!world) Snapshot();
-    internal::SceneImpl& s = world->impl();
-    mjModel* m = s.m;
-    mjData* d = s.d;
-    // inflate the moving arm geoms so that contacts appear within the clearance
-    if (margin != clearance) {
-      for (int g = 0; g < m->ngeom; ++g)
-        if (geom_link[g] >= 0 && link_mask[geom_link[g]] != 0) m->geom_margin[g] = clearance;
-      margin = clearance;
-    }
     world_arm.SetQpos(Full(q));
-    mj_kinematics(m, d);
-    mj_collision(m, d);
-    for (int i = 0; i < d->ncon; ++i) {
-      const mjContact& c = d->contact[i];
-      if (c.exclude != 0) continue;
-      int l1 = geom_link[c.geom1], l2 = geom_link[c.geom2];
-      if (l1 < 0 && l2 < 0) continue;
-      bool bad = false;
-      if (l1 >= 0 && l2 >= 0) {
-        // self: only pairs that move relative to each other, only when they penetrate
-        bad = link_mask[l1] != link_mask[l2] && c.dist < 0;
-      } else {
-        int l = l1 >= 0 ? l1 : l2;
-        bad = link_mask[l] != 0 && c.dist < clearance;
+    // the moving links against everything within the clearance, and against the arm's links
+    // that move otherwise only when they penetrate
+    for (const ShapeProximity& c : world->Query(clearance, moving)) {
+      const int l0 = c.shape0.link_index;
+      const int l1 = c.shape1.articulation_id == arm.GetId() ? c.shape1.link_index : -1;
+      const bool bad =
+          l1 >= 0 ? link_mask[l0] != link_mask[l1] && c.distance < 0 : c.distance < clearance;
+      if (!bad) continue;
+      if (reason) {
+        std::ostringstream os;
+        os << BodyName(c.shape0) << " and " << BodyName(c.shape1) << " are " << c.distance
+           << " m apart (clearance " << clearance << " m)";
+        *reason = os.str();
       }
-      if (bad) {
-        if (reason) {
-          auto what = [&](int g, int l) {
-            if (l >= 0) return "link '" + LinkName(l) + "'";
-            const internal::GeomOwner& o = s.geom_owner[g];
-            if (o.actor_id >= 0) return "actor '" + s.GetActor(o.actor_id).desc.name + "'";
-            if (o.articulation_id >= 0)
-              return "link '" + s.GetArticulation(o.articulation_id).desc.links[o.link_index].name +
-                     "' of articulation '" + s.GetArticulation(o.articulation_id).desc.name + "'";
-            return std::string("geom ") + std::to_string(g);
-          };
-          std::ostringstream os;
-          os << what(c.geom1, l1) << " and " << what(c.geom2, l2) << " are " << c.dist
-             << " m apart (clearance " << clearance << " m)";
-          *reason = os.str();
-        }
-        return false;
-      }
+      return false;
     }
     return true;
   }
