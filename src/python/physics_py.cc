@@ -297,9 +297,11 @@ void BindDescription(py::module_& m) {
       .def_readwrite("damping", &DriveDesc::damping, "Damping (N s/m or N m s/rad, >= 0).")
       .def_readwrite("force_limit", &DriveDesc::force_limit,
                      "Largest drive force (N or N m, > 0); inf: no clamp.")
-      .def_readwrite("target", &DriveDesc::target, "Position target (m or rad).")
+      .def_readwrite("target", &DriveDesc::target,
+                     "Position target the drive starts with (m or rad); the current target is "
+                     "state (Joint.get_drive_target).")
       .def_readwrite("velocity_target", &DriveDesc::velocity_target,
-                     "Velocity target (m/s or rad/s).");
+                     "Velocity target the drive starts with (m/s or rad/s).");
 
   py::class_<JointDesc>(m, "JointDesc",
                         "The joint that connects a link to its parent. The joint frame J is "

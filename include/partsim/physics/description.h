@@ -129,8 +129,10 @@ struct DriveDesc {
   double stiffness = 0.0;        ///< N/m or N m/rad, >= 0
   double damping = 0.0;          ///< N s/m or N m s/rad, >= 0
   double force_limit = kInf;     ///< N or N m, > 0
-  double target = 0.0;           ///< m or rad
-  double velocity_target = 0.0;  ///< m/s or rad/s
+  /// Position target the drive starts with, m or rad. The current target is state, in the
+  /// scene's data (Joint/Articulation::SetDriveTarget); a description does not follow it.
+  double target = 0.0;
+  double velocity_target = 0.0;  ///< velocity target it starts with, m/s or rad/s
 };
 
 /// Drives stepped by backward Euler, as PhysX's are: over a step `dt` the drive force is
