@@ -77,16 +77,40 @@ void Targets(double t, std::array<double, 8>* q) {
   (*q)[7] = kFingerTravel * c;
 }
 
+// Drives are stepped by backward Euler, as partsim does with the implicit integrator (see
+// partsim::DriveVelocityGain): over a step dt the force is kp (target - q) - c qdot with the
+// velocity gain c = kd + kp dt, of which the actuator holds only the stiffness (a velocity gain
+// there would be integrated implicitly a second time); the control written before each step
+// carries kp target - c qdot, and the joint gets dt c of armature.
+struct DriveGains {
+  double kp = 0.0;  // stiffness: N/m or N m/rad
+  double kd = 0.0;  // damping: N s/m or N m s/rad
+};
+// in joint order: x, y, z, roll, pitch, yaw, finger 1, finger 2
+constexpr std::array<DriveGains, 8> kDrives{{{kKpLinear, kKdLinear},
+                                             {kKpLinear, kKdLinear},
+                                             {kKpLinear, kKdLinear},
+                                             {kKpAngular, kKdAngular},
+                                             {kKpAngular, kKdAngular},
+                                             {kKpAngular, kKdAngular},
+                                             {kKpFinger, kKdFinger},
+                                             {kKpFinger, kKdFinger}}};
+
+/// Velocity gain of a backward-Euler drive over a step dt: c = kd + kp dt.
+double VelocityGain(const DriveGains& g) { return g.kd + g.kp * kTimestep; }
+
 // ---------------------------------------------------------------------------------------------
-// (b) raw MuJoCo: the same scene, hand-written
+// (b) raw MuJoCo: the same scene, hand-written. The driven joints' armature is dt c: 0.88 kg on
+// the base slides (c = 440 N s/m), 0.0104 kg m^2 on the base hinges (c = 5.2 N m s/rad) and
+// 0.208 kg on the fingers (c = 104 N s/m).
 
 const char* kRawMjcf = R"(
 <mujoco model="drawer_raw">
   <compiler angle="radian" inertiafromgeom="auto" boundmass="1e-6" boundinertia="1e-9"/>
   <option timestep="0.002" gravity="0 0 -9.81" iterations="50" integrator="implicit"/>
-  <size nconmax="372" njmax="2344"/>
+  <size nconmax="256" njmax="1138" nstack="1024272"/>
   <default>
-    <geom friction="0.5 0.005 0.0001" solref="0.02 1" density="600"/>
+    <geom friction="0.5 0.005 0.0001" solref="0.02 1" density="600" conaffinity="-1"/>
   </default>
   <worldbody>
     <body name="cabinet">
@@ -98,6 +122,7 @@ const char* kRawMjcf = R"(
       <geom type="box" pos="0.01 0 0.55" size="0.24 0.28 0.01"/>
       <body name="drawer" pos="0.25 0 0.67">
         <joint name="drawer" type="slide" axis="1 0 0" limited="true" range="0 0.4"
+               solreflimit="0.004 1" solimplimit="0.99 0.999 0.001 0.5 2"
                damping="0.5" frictionloss="0.1"/>
         <geom type="box" pos="-0.01 0 0" size="0.01 0.277 0.107"/>
         <geom type="box" pos="-0.245 0 -0.095" size="0.225 0.272 0.01"/>
@@ -112,32 +137,34 @@ const char* kRawMjcf = R"(
     </body>
     <body name="gripper" pos="0.345 0 0.67">
       <body name="base_x">
-        <joint name="x" type="slide" axis="1 0 0" limited="false"/>
+        <joint name="x" type="slide" axis="1 0 0" limited="false" armature="0.88"/>
         <inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/>
         <body name="base_y">
-          <joint name="y" type="slide" axis="0 1 0" limited="false"/>
+          <joint name="y" type="slide" axis="0 1 0" limited="false" armature="0.88"/>
           <inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/>
           <body name="base_z">
-            <joint name="z" type="slide" axis="0 0 1" limited="false"/>
+            <joint name="z" type="slide" axis="0 0 1" limited="false" armature="0.88"/>
             <inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/>
             <body name="base_roll">
-              <joint name="roll" type="hinge" axis="1 0 0" limited="false"/>
+              <joint name="roll" type="hinge" axis="1 0 0" limited="false" armature="0.0104"/>
               <inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/>
               <body name="base_pitch">
-                <joint name="pitch" type="hinge" axis="0 1 0" limited="false"/>
+                <joint name="pitch" type="hinge" axis="0 1 0" limited="false" armature="0.0104"/>
                 <inertial pos="0 0 0" mass="0.1" diaginertia="1e-4 1e-4 1e-4"/>
                 <body name="palm">
-                  <joint name="yaw" type="hinge" axis="0 0 1" limited="false"/>
+                  <joint name="yaw" type="hinge" axis="0 0 1" limited="false" armature="0.0104"/>
                   <geom type="box" size="0.015 0.04 0.07" density="2000"/>
                   <body name="finger_1">
                     <joint name="finger_1" type="slide" axis="0 0 -1" limited="true"
-                           range="0 0.045"/>
+                           range="0 0.045" solreflimit="0.004 1"
+                           solimplimit="0.99 0.999 0.001 0.5 2" armature="0.208"/>
                     <geom type="box" pos="-0.045 0 0.05" size="0.03 0.015 0.01" density="2000"
                           friction="1 0.005 0.0001"/>
                   </body>
                   <body name="finger_2">
                     <joint name="finger_2" type="slide" axis="0 0 1" limited="true"
-                           range="0 0.045"/>
+                           range="0 0.045" solreflimit="0.004 1"
+                           solimplimit="0.99 0.999 0.001 0.5 2" armature="0.208"/>
                     <geom type="box" pos="-0.045 0 -0.05" size="0.03 0.015 0.01" density="2000"
                           friction="1 0.005 0.0001"/>
                   </body>
@@ -149,16 +176,21 @@ const char* kRawMjcf = R"(
       </body>
     </body>
   </worldbody>
+  <contact>
+    <exclude body1="cabinet" body2="drawer"/>
+    <exclude body1="palm" body2="finger_1"/>
+    <exclude body1="palm" body2="finger_2"/>
+  </contact>
   <actuator>
-    <general joint="x" gainprm="20000" biastype="affine" biasprm="0 -20000 -400"/>
-    <general joint="y" gainprm="20000" biastype="affine" biasprm="0 -20000 -400"/>
-    <general joint="z" gainprm="20000" biastype="affine" biasprm="0 -20000 -400"/>
-    <general joint="roll" gainprm="100" biastype="affine" biasprm="0 -100 -5"/>
-    <general joint="pitch" gainprm="100" biastype="affine" biasprm="0 -100 -5"/>
-    <general joint="yaw" gainprm="100" biastype="affine" biasprm="0 -100 -5"/>
-    <general joint="finger_1" gainprm="2000" biastype="affine" biasprm="0 -2000 -100"
+    <general joint="x" gainprm="1" biastype="affine" biasprm="0 -20000 0"/>
+    <general joint="y" gainprm="1" biastype="affine" biasprm="0 -20000 0"/>
+    <general joint="z" gainprm="1" biastype="affine" biasprm="0 -20000 0"/>
+    <general joint="roll" gainprm="1" biastype="affine" biasprm="0 -100 0"/>
+    <general joint="pitch" gainprm="1" biastype="affine" biasprm="0 -100 0"/>
+    <general joint="yaw" gainprm="1" biastype="affine" biasprm="0 -100 0"/>
+    <general joint="finger_1" gainprm="1" biastype="affine" biasprm="0 -2000 0"
              forcelimited="true" forcerange="-30 30"/>
-    <general joint="finger_2" gainprm="2000" biastype="affine" biasprm="0 -2000 -100"
+    <general joint="finger_2" gainprm="1" biastype="affine" biasprm="0 -2000 0"
              forcelimited="true" forcerange="-30 30"/>
   </actuator>
 </mujoco>
@@ -205,11 +237,31 @@ struct RawRun {
   const mjModel* m = nullptr;
   mjData* d = nullptr;
   int drawer_qposadr = -1;
-  std::array<int, 8> actuator{0, 1, 2, 3, 4, 5, 6, 7};  // actuator of each gripper dof
-  std::array<double, 8> scale{1, 1, 1, 1, 1, 1, 1, 1};  // control = scale * target
+  std::array<int, 8> actuator{};  // actuator of each gripper dof
+  std::array<int, 8> dof{};       // its dof (qvel address)
+  std::array<double, 8> kp{};     // control = kp target - c qvel
+  std::array<double, 8> c{};
+
+  /// Finds the actuator and dof of each drive by its joint; `joints` in kDrives order.
+  void SetDrives(const std::array<int, 8>& joints) {
+    for (int i = 0; i < 8; ++i) {
+      actuator[i] = -1;
+      for (int k = 0; k < m->nu; ++k)
+        if (m->actuator_trntype[k] == mjTRN_JOINT && m->actuator_trnid[2 * k] == joints[i])
+          actuator[i] = k;
+      if (actuator[i] < 0) {
+        std::fprintf(stderr, "no actuator on joint %d\n", joints[i]);
+        std::exit(1);
+      }
+      dof[i] = m->jnt_dofadr[joints[i]];
+      kp[i] = kDrives[i].kp;
+      c[i] = VelocityGain(kDrives[i]);
+    }
+  }
 };
 
-/// One episode against MuJoCo directly: reset, then set controls and step.
+/// One episode against MuJoCo directly: reset, then set controls (the backward-Euler drive law,
+/// velocity targets 0) and step.
 EpisodeResult RunRawEpisode(const RawRun& run) {
   const mjModel* m = run.m;
   mjData* d = run.d;
@@ -218,7 +270,8 @@ EpisodeResult RunRawEpisode(const RawRun& run) {
   double start = Now();
   for (int k = 0; k < kSteps; ++k) {
     Targets(d->time, &q);
-    for (int i = 0; i < 8; ++i) d->ctrl[run.actuator[i]] = run.scale[i] * q[i];
+    for (int i = 0; i < 8; ++i)
+      d->ctrl[run.actuator[i]] = run.kp[i] * q[i] - run.c[i] * d->qvel[run.dof[i]];
     mj_step(m, d);
   }
   double stop = Now();
@@ -311,12 +364,10 @@ partsim::Articulation BuildGripper(partsim::Scene* scene) {
   // PD drives, in joint order x, y, z, roll, pitch, yaw, finger_1, finger_2
   std::vector<partsim::Joint> joints = gripper.GetActiveJoints();
   for (int i = 0; i < 8; ++i) {
-    if (i < 3)
-      joints[i].SetDriveProperty(kKpLinear, kKdLinear);
-    else if (i < 6)
-      joints[i].SetDriveProperty(kKpAngular, kKdAngular);
+    if (i < 6)
+      joints[i].SetDriveProperty(kDrives[i].kp, kDrives[i].kd);
     else
-      joints[i].SetDriveProperty(kKpFinger, kKdFinger, kFingerForceLimit);
+      joints[i].SetDriveProperty(kDrives[i].kp, kDrives[i].kd, kFingerForceLimit);
   }
   return gripper;
 }
@@ -382,6 +433,14 @@ int CompareModels(const mjModel* a, const mjModel* b) {
   for (int k = 0; k < 3; ++k) diff.Compare("gravity", k, a->opt.gravity[k], b->opt.gravity[k]);
   diff.Compare("nconmax", 0, a->nconmax, b->nconmax);
   diff.Compare("njmax", 0, a->njmax, b->njmax);
+  diff.Compare("nstack", 0, a->nstack, b->nstack);
+  // excluded body pairs (signature: body1 << 16 + body2)
+  if (a->nexclude != b->nexclude) {
+    diff.Compare("nexclude", 0, a->nexclude, b->nexclude);
+  } else {
+    for (int i = 0; i < a->nexclude; ++i)
+      diff.Compare("exclude_signature", i, a->exclude_signature[i], b->exclude_signature[i]);
+  }
   // world frames at qpos0
   mjData* da = mj_makeData(a);
   mjData* db = mj_makeData(b);
@@ -426,6 +485,11 @@ int CompareModels(const mjModel* a, const mjModel* b) {
     diff.Compare("jnt_limited", i, a->jnt_limited[i], b->jnt_limited[i]);
     for (int k = 0; k < 2; ++k)
       diff.Compare("jnt_range", i, a->jnt_range[2 * i + k], b->jnt_range[2 * i + k]);
+    // the limits' softness (MuJoCo's defaults where a joint has no limits)
+    for (int k = 0; k < mjNREF; ++k)
+      diff.Compare("jnt_solref", i, a->jnt_solref[mjNREF * i + k], b->jnt_solref[mjNREF * i + k]);
+    for (int k = 0; k < mjNIMP; ++k)
+      diff.Compare("jnt_solimp", i, a->jnt_solimp[mjNIMP * i + k], b->jnt_solimp[mjNIMP * i + k]);
     for (int k = 0; k < 3; ++k) {
       diff.Compare("jnt_xaxis", i, da->xaxis[3 * i + k], db->xaxis[3 * i + k]);
       diff.Compare("jnt_xanchor", i, da->xanchor[3 * i + k], db->xanchor[3 * i + k]);
@@ -436,9 +500,9 @@ int CompareModels(const mjModel* a, const mjModel* b) {
     diff.Compare("dof_frictionloss", i, a->dof_frictionloss[i], b->dof_frictionloss[i]);
     diff.Compare("dof_armature", i, a->dof_armature[i], b->dof_armature[i]);
   }
-  // drives, matched by joint: same stiffness, damping and force limit (partsim scales the
-  // control by the stiffness itself, so its gain is 1 where the raw gain is the stiffness);
-  // partsim's extra actuators (undriven joints) must exert no force
+  // drives, matched by joint: same gain (1: the control carries kp target - c qdot), bias (the
+  // stiffness; no velocity term) and force limit; partsim's extra actuators (undriven joints)
+  // must exert no force
   std::vector<int> raw_actuator_of_joint(b->njnt, -1);
   for (int k = 0; k < b->nu; ++k) raw_actuator_of_joint[b->actuator_trnid[2 * k]] = k;
   for (int k = 0; k < a->nu; ++k) {
@@ -449,11 +513,13 @@ int CompareModels(const mjModel* a, const mjModel* b) {
       continue;
     }
     const double* pb = b->actuator_biasprm + mjNBIAS * r;
-    double gain = b->actuator_gainprm[mjNGAIN * r];
-    diff.Compare("actuator gain", k, a->actuator_gainprm[mjNGAIN * k], 1.0);
-    diff.Compare("actuator stiffness", k, pa[1], pb[1]);
-    diff.Compare("actuator stiffness = gain", k, -pa[1], gain);
-    diff.Compare("actuator damping", k, pa[2], pb[2]);
+    diff.Compare("actuator gaintype", k, a->actuator_gaintype[k], b->actuator_gaintype[r]);
+    diff.Compare("actuator biastype", k, a->actuator_biastype[k], b->actuator_biastype[r]);
+    for (int c = 0; c < 3; ++c) {
+      diff.Compare("actuator gainprm", k, a->actuator_gainprm[mjNGAIN * k + c],
+                   b->actuator_gainprm[mjNGAIN * r + c]);
+      diff.Compare("actuator biasprm", k, pa[c], pb[c]);
+    }
     diff.Compare("actuator forcelimited", k, a->actuator_forcelimited[k],
                  b->actuator_forcelimited[r]);
     for (int c = 0; c < 2; ++c) {
@@ -514,6 +580,10 @@ int main(int argc, char** argv) {
   raw.m = raw_m;
   raw.d = mj_makeData(raw_m);
   raw.drawer_qposadr = raw_m->jnt_qposadr[mj_name2id(raw_m, mjOBJ_JOINT, "drawer")];
+  std::array<int, 8> drive_joints;
+  const char* drive_names[8] = {"x", "y", "z", "roll", "pitch", "yaw", "finger_1", "finger_2"};
+  for (int i = 0; i < 8; ++i) drive_joints[i] = mj_name2id(raw_m, mjOBJ_JOINT, drive_names[i]);
+  raw.SetDrives(drive_joints);
 
   // partsim; and, as a diagnostic, raw MuJoCo stepping a copy of partsim's compiled model
   // (the same physics bit for bit, so the difference is the API's own cost)
@@ -541,16 +611,10 @@ int main(int argc, char** argv) {
     same_m = mj_copyModel(nullptr, scene->GetMjModel());
     same.m = same_m;
     same.d = mj_makeData(same_m);
-    // the drawer is partsim's first joint; the gripper's drives follow in joint order, and
-    // partsim's control is stiffness * target on a unit gain
+    // the joints come in the same order in both models (CompareModels checked it): the drawer
+    // is the first, the gripper's follow; controls as partsim writes them (the same drive law)
     same.drawer_qposadr = same_m->jnt_qposadr[0];
-    for (int i = 0; i < 8; ++i) {
-      int joint = raw_m->actuator_trnid[2 * i];
-      for (int k = 0; k < same_m->nu; ++k) {
-        if (same_m->actuator_trnid[2 * k] == joint) same.actuator[i] = k;
-      }
-      same.scale[i] = -same_m->actuator_biasprm[mjNBIAS * same.actuator[i] + 1];
-    }
+    same.SetDrives(drive_joints);
   }
 
   std::printf(
@@ -603,16 +667,21 @@ int main(int argc, char** argv) {
   std::printf("\n%-28s %14s %14s %14s\n", "", "raw MuJoCo", "partsim", "raw, partsim's");
   if (raw_only) {
     std::printf("%-28s %14.0f\n", "median steps/s", raw_median);
-    std::printf("%-28s %14.4f\n", "final drawer opening [m]", raw_opening);
+    std::printf("%-28s %14.7f\n", "final drawer opening [m]", raw_opening);
   } else {
     double partsim_median = Median(partsim_rate);
     std::printf("%-28s %14.0f %14.0f %14.0f\n", "median steps/s", raw_median, partsim_median,
                 Median(same_rate));
-    std::printf("%-28s %14.4f %14.4f %14.4f\n", "final drawer opening [m]", raw_opening,
+    std::printf("%-28s %14.7f %14.7f %14.7f\n", "final drawer opening [m]", raw_opening,
                 partsim_opening, same_opening);
+    std::printf("%-28s %29.2e\n", "partsim - raw: opening [m]", partsim_opening - raw_opening);
     std::printf("%-28s %29.3f\n", "partsim / raw: of medians", partsim_median / raw_median);
     std::printf("%-28s %29.3f\n", "partsim / raw: median", Median(ratio));
     std::printf("%-28s %29.3f\n", "partsim / raw on its model", Median(same_ratio));
+    // partsim grows its contact buffers (a recompile) when a step fills them: its model would
+    // then no longer be the one compared above
+    for (const partsim::Warning& w : scene->GetWarnings())
+      std::fprintf(stderr, "partsim warning at t = %g s: %s\n", w.time, w.message.c_str());
     if (same_opening != partsim_opening) {
       std::fprintf(stderr,
                    "note: raw MuJoCo on partsim's model ended at %.9f m, partsim at %.9f m\n",
