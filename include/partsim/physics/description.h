@@ -126,9 +126,9 @@ const char* JointTypeName(JointType t);
 /// A PD drive on a joint: force = stiffness (target - q) + damping (velocity_target - qdot),
 /// clamped to +-force_limit.
 struct DriveDesc {
-  double stiffness = 0.0;        ///< N/m or N m/rad, >= 0
-  double damping = 0.0;          ///< N s/m or N m s/rad, >= 0
-  double force_limit = kInf;     ///< N or N m, > 0
+  double stiffness = 0.0;     ///< N/m or N m/rad, >= 0
+  double damping = 0.0;       ///< N s/m or N m s/rad, >= 0
+  double force_limit = kInf;  ///< N or N m, > 0
   /// Position target the drive starts with, m or rad. The current target is state, in the
   /// scene's data (Joint/Articulation::SetDriveTarget); a description does not follow it.
   double target = 0.0;
