@@ -20,7 +20,7 @@ add_library(partsim::partsim ALIAS partsim)
 # CMake's own WHOLE_ARCHIVE feature would list it twice), then the layers and their external
 # libraries as usual
 set(PARTSIM_LAYER_LIBS partsim_core partsim_physics partsim_assets partsim_render partsim_robot
-                       partsim_planning partsim_tasks partsim_server)
+                       partsim_vision partsim_planning partsim_tasks partsim_server)
 set(whole "LINKER:--whole-archive")
 foreach(lib ${PARTSIM_LAYER_LIBS})
   list(APPEND whole "$<TARGET_FILE:${lib}>")
