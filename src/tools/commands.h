@@ -32,6 +32,11 @@ int RunTasksCommand(int argc, char** argv);
 /// (arguments after "serve"). Returns the exit code (0 success, 1 failure, 2 bad command line).
 int RunServeCommand(int argc, char** argv);
 
+/// `partsim vision ...`: the perception benchmark's tools (evaluate-detection,
+/// evaluate-motion); `argv` holds the arguments after "vision". Returns the exit code (0
+/// success, 1 failure, 2 bad command line).
+int RunVisionCommand(int argc, char** argv);
+
 /// Removes the files of `dir` that an earlier run of the same command wrote: names starting with
 /// one of `prefixes` and ending with the matching entry of `suffixes` ("color_" + ".png"), so
 /// that a run with fewer views or frames leaves no stale ones beside its own. Other files stay.

@@ -1,0 +1,147 @@
+// `partsim vision ...`: the perception benchmark's tools. Each subcommand is one function over
+// the arguments after its name, listed in kSubcommands with its part of the help; a new one
+// (detection-dataset, motion-dataset, show) adds a function and a row there.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "arg_parser.h"
+#include "commands.h"
+#include "partsim/vision/evaluate.h"
+
+namespace partsim::tools {
+namespace {
+
+constexpr char kCommand[] = "partsim vision";
+
+constexpr char kEvaluateDetectionUsage[] =
+    R"(  partsim vision evaluate-detection --gt FILE --results FILE [--out DIR]
+      AP at mask IoU 0.5 per part category and their mean (mAP), COCO's protocol: --gt is a
+      COCO instances JSON (images, categories named "<object category>/<part>", annotations
+      with RLE masks, iscrowd), --results a COCO results list (image_id, category_id,
+      segmentation as RLE, score). Prints the paper's table (object category x part, AP in
+      percent); with --out, writes DIR/table.md, DIR/table.csv and DIR/metrics.json.
+)";
+
+constexpr char kEvaluateMotionUsage[] =
+    R"(  partsim vision evaluate-motion --gt FILE --predictions FILE [--out DIR]
+      The paper's Table 2 (H acc, S acc, H_o, H_a, S_a, door and drawer errors): --gt is
+      {"slider_range": R, "samples": [{"sample_id", "m": [13 numbers]}]}, --predictions
+      {"samples": [...]} with one entry per sample; m = (T_r, T_t, pivot (3), hinge axis (3),
+      slider axis (3), x_door, x_drawer) in the camera frame (docs/vision.md). Prints the
+      table; with --out, writes DIR/table.md, DIR/table.csv and DIR/metrics.json.
+)";
+
+// one subcommand: its name, its part of the help, and what runs it (the arguments after its
+// name; returns the exit code, throws UsageError for a bad command line)
+struct Subcommand {
+  const char* name;
+  const char* usage;
+  int (*run)(const std::vector<std::string>& args);
+};
+
+int RunEvaluateDetection(const std::vector<std::string>& args);
+int RunEvaluateMotion(const std::vector<std::string>& args);
+
+const Subcommand kSubcommands[] = {
+    {"evaluate-detection", kEvaluateDetectionUsage, RunEvaluateDetection},
+    {"evaluate-motion", kEvaluateMotionUsage, RunEvaluateMotion},
+};
+
+std::string Usage() {
+  std::string s = "usage:\n";
+  for (const Subcommand& c : kSubcommands) s += c.usage;
+  return s + "Exit codes: 0 success, 1 a file missing or malformed, 2 a bad command line.\n";
+}
+
+std::vector<std::string> Names() {
+  std::vector<std::string> names;
+  for (const Subcommand& c : kSubcommands) names.push_back(c.name);
+  return names;
+}
+
+// the input files and output folder of an evaluate-* subcommand
+struct EvaluateArgs {
+  std::string gt, input, out;
+};
+
+// --gt FILE, `input_flag` FILE (both required) and --out DIR
+EvaluateArgs ParseEvaluateArgs(const std::string& name, const std::string& input_flag,
+                               const std::vector<std::string>& args) {
+  EvaluateArgs a;
+  ArgParser p(std::string(kCommand) + " " + name, "partsim vision --help");
+  p.Option("--gt", [&](const FlagValue& v) { a.gt = v.NonEmpty("a file name"); });
+  p.Option(input_flag, [&](const FlagValue& v) { a.input = v.NonEmpty("a file name"); });
+  p.Option("--out", [&](const FlagValue& v) { a.out = v.NonEmpty("a folder name"); });
+  p.Parse(args);
+  if (a.gt.empty()) p.Fail("--gt FILE is required");
+  if (a.input.empty()) p.Fail(input_flag + " FILE is required");
+  return a;
+}
+
+// writes the tables and metrics into `dir` (created if missing) and says where
+void WriteOutputs(const std::string& dir, const std::string& markdown, const std::string& csv,
+                  const std::string& json) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create the folder '" + dir + "': " + ec.message());
+  for (const auto& [name, text] :
+       {std::pair<const char*, const std::string*>{"table.md", &markdown},
+        {"table.csv", &csv},
+        {"metrics.json", &json}}) {
+    const fs::path path = fs::path(dir) / name;
+    std::ofstream f(path, std::ios::binary);
+    f << *text;
+    f.close();
+    if (!f) throw std::runtime_error("cannot write '" + path.string() + "'");
+    std::printf("wrote %s\n", path.c_str());
+  }
+}
+
+int RunEvaluateDetection(const std::vector<std::string>& args) {
+  const EvaluateArgs a = ParseEvaluateArgs("evaluate-detection", "--results", args);
+  const vision::DetectionEvaluation e = vision::EvaluateDetectionFiles(a.gt, a.input);
+  const std::string markdown = vision::DetectionTableMarkdown(e);
+  std::printf("%s", markdown.c_str());
+  if (!a.out.empty())
+    WriteOutputs(a.out, markdown, vision::DetectionTableCsv(e), vision::DetectionMetricsJson(e));
+  return 0;
+}
+
+int RunEvaluateMotion(const std::vector<std::string>& args) {
+  const EvaluateArgs a = ParseEvaluateArgs("evaluate-motion", "--predictions", args);
+  const vision::MotionEvaluation e = vision::EvaluateMotionFiles(a.gt, a.input);
+  const std::string markdown = vision::MotionTableMarkdown(e);
+  std::printf("%s", markdown.c_str());
+  if (!a.out.empty())
+    WriteOutputs(a.out, markdown, vision::MotionTableCsv(e), vision::MotionMetricsJson(e));
+  return 0;
+}
+
+}  // namespace
+
+int RunVisionCommand(int argc, char** argv) {
+  const std::vector<std::string> args(argv, argv + argc);
+  if (ArgParser::AsksForHelp(args)) {
+    std::printf("%s", Usage().c_str());
+    return 0;
+  }
+  return RunWithExitCode(kCommand, "see partsim vision --help\n", [&] {
+    if (args.empty())
+      throw UsageError(std::string(kCommand) + ": expected a subcommand (" + [] {
+        std::string list;
+        for (const std::string& n : Names()) list += (list.empty() ? "" : ", ") + n;
+        return list;
+      }() + ")");
+    for (const Subcommand& c : kSubcommands)
+      if (args[0] == c.name) return c.run(std::vector<std::string>(args.begin() + 1, args.end()));
+    throw UsageError(std::string(kCommand) + ": unknown subcommand '" + args[0] + "'" +
+                     DidYouMean(args[0], Names()));
+  });
+}
+
+}  // namespace partsim::tools
