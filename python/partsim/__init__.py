@@ -15,6 +15,7 @@ from ._partsim import __version__  # noqa: F401  (the project's version, set by 
 from ._sapien import (  # noqa: F401
     Engine, KuafuRenderer, RenderBodyComponent, RenderMaterial, SapienContact, SapienRenderer,
     SceneConfig, Viewer, VulkanRenderer, physx, render, set_log_level, utils)
+from . import vision  # noqa: F401  (partsim.vision: COCO masks, the perception evaluators)
 
 
 # SAPIEN 2 scripts say `import sapien.core as sapien`: partsim.core is partsim itself

@@ -30,6 +30,9 @@ void BindControl(py::module_& m);
 void BindTasks(py::module_& m);
 /// Motion planning (planning_py.cc).
 void BindPlanning(py::module_& m);
+/// COCO masks and the perception evaluators, in the submodule `_vision` that
+/// python/partsim/vision.py re-exports as partsim.vision (vision_py.cc).
+void BindVision(py::module_& m);
 
 /// Runs `f` without the GIL while this thread holds `scene` (Scene::Use), so that other Python
 /// threads can run meanwhile but not touch that scene: their calls on it raise PartsimError, and

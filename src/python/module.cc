@@ -15,5 +15,6 @@ PYBIND11_MODULE(_partsim, m) {
   partsim::python::BindControl(m);
   partsim::python::BindTasks(m);
   partsim::python::BindPlanning(m);
+  partsim::python::BindVision(m);
   m.attr("__version__") = partsim::Version();
 }

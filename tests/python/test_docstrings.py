@@ -2,9 +2,9 @@
 pybind11 writes; the Markdown API reference made from them (docs/api, scripts/gen_api_docs.py) is
 up to date.
 
-What is walked: the public names of `partsim` and `partsim.envs`, and for each class its own
-public members (methods, static methods, properties, nested classes), recursively. A pybind11
-overloaded function needs text under every overload.
+What is walked: the public names of `partsim`, `partsim.envs` and `partsim.vision`, and for each
+class its own public members (methods, static methods, properties, nested classes), recursively.
+A pybind11 overloaded function needs text under every overload.
 
 What is not required, and why:
 - dunder and other `_`-prefixed names (pybind11 writes `__init__`, `__repr__`, ... itself);
@@ -26,9 +26,10 @@ import partsim
 import partsim._partsim as ext
 import partsim._sapien as _sapien
 import partsim.envs as envs
+import partsim.vision as vision
 from conftest import PYTHON_DIR, REPO
 
-OWN_MODULES = ("partsim._partsim", "partsim.envs", "partsim")
+OWN_MODULES = ("partsim._partsim", "partsim.envs", "partsim.vision", "partsim")
 ENUM_HELPERS = ("name", "value")
 
 # one pybind11 signature line: "name(arg: type = default) -> type"
@@ -69,7 +70,7 @@ def is_documented(doc):
 
 def is_sapien(obj):
     return getattr(obj, "__module__", None) == _sapien.__name__ or (
-        inspect.ismodule(obj) and obj.__name__ != envs.__name__)
+        inspect.ismodule(obj) and obj.__name__ not in (envs.__name__, vision.__name__))
 
 
 def binding_behind(cls, name, attr):
@@ -104,7 +105,8 @@ def walk_class(cls, qualname, out):
 def public_members():
     """[(qualified name, docstring)] of the package's public API."""
     out = []
-    for module, prefix in ((partsim, "partsim."), (envs, "partsim.envs.")):
+    for module, prefix in ((partsim, "partsim."), (envs, "partsim.envs."),
+                           (vision, "partsim.vision.")):
         out.append((module.__name__, module.__doc__))
         for name in sorted(dir(module)):
             if name.startswith("_"):
@@ -115,6 +117,8 @@ def public_members():
                 obj = getattr(ext, name, None) if module is partsim else None
                 if obj is None:
                     continue
+            if inspect.ismodule(obj):
+                continue  # a submodule: walked on its own
             if getattr(obj, "__module__", None) not in OWN_MODULES and not (
                     inspect.isbuiltin(obj) and module is partsim):
                 continue  # imported from elsewhere (numpy, gymnasium)
@@ -131,7 +135,8 @@ def test_walk_finds_the_api():
     for expected in ("partsim.Scene", "partsim.Scene.step", "partsim.Camera.get_picture",
                      "partsim.UrdfLoader.fix_root_link", "partsim.Pose.from_transformation_matrix",
                      "partsim.ActorType", "partsim.set_log_level", "partsim.envs.OpenCabinetEnv",
-                     "partsim.envs.OpenCabinetEnv.step"):
+                     "partsim.envs.OpenCabinetEnv.step", "partsim.vision.evaluate_detection",
+                     "partsim.vision.DetectionEvaluation.map"):
         assert expected in names, expected
     assert not any(n.startswith(("partsim.core", "partsim.physx", "partsim.Engine"))
                    for n in names)
