@@ -3,12 +3,13 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cmath>
-#include <cstdio>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "core/number_text.h"
+#include "partsim/core/check.h"
 #include "partsim/core/constants.h"
 #include "partsim/core/error.h"
 
@@ -35,15 +36,9 @@ struct MassProps {
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
 };
 
-std::string Num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.9g", std::abs(x) < 1e-12 ? 0.0 : x);
-  return buf;
-}
-
-std::string Vec(const Eigen::Vector3d& v) {
-  return Num(v.x()) + " " + Num(v.y()) + " " + Num(v.z());
-}
+// numbers in the URDF text read back bit-exact
+using internal::Num;
+using internal::Vec;
 
 Eigen::Matrix3d RotationFromRpy(const Eigen::Vector3d& rpy) {
   return (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
@@ -125,7 +120,7 @@ void WriteLink(std::ostringstream& out, const std::string& name, const std::vect
 void Require(bool ok, const std::string& option, const std::string& rule, double value) {
   if (!ok) {
     throw Error("MakeCabinetUrdf: CabinetOptions." + option + " must be " + rule + " (got " +
-                Num(value) + ")");
+                FormatNumber(value) + ")");
   }
 }
 
@@ -229,7 +224,7 @@ std::string MakeCabinetUrdf(const CabinetOptions& opts) {
   const double box_h = drawer_h - 0.02;
   const double box_z = -drawer_h / 2 + 0.005 + box_h / 2;
   Require(o.drawer_travel > 0 && o.drawer_travel <= box_d, "drawer_travel",
-          "in (0, " + Num(box_d) + "] m (the drawer's depth)", o.drawer_travel);
+          "in (0, " + FormatNumber(box_d) + "] m (the drawer's depth)", o.drawer_travel);
 
   // body: back, sides, top, bottom and the shelf divider
   std::vector<Part> body;

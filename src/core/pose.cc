@@ -1,7 +1,8 @@
 #include "partsim/core/pose.h"
 
 #include <cmath>
-#include <sstream>
+
+#include "partsim/core/check.h"
 
 namespace partsim {
 
@@ -26,10 +27,7 @@ bool Pose::IsValid() const {
 }
 
 std::string Pose::ToString() const {
-  std::ostringstream s;
-  s << "Pose([" << p.x() << ", " << p.y() << ", " << p.z() << "], [" << q.w() << ", " << q.x()
-    << ", " << q.y() << ", " << q.z() << "])";
-  return s.str();
+  return "Pose(" + FormatVector(p) + ", " + FormatVector(Wxyz()) + ")";
 }
 
 }  // namespace partsim

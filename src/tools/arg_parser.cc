@@ -10,16 +10,11 @@
 #include <exception>
 #include <limits>
 
+#include "partsim/core/check.h"
+
 namespace partsim::tools {
 
 namespace {
-
-// A number as messages print it: 0.002, 1e+09, inf.
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
 
 // "A, B or C".
 std::string Alternatives(const std::vector<std::string>& words) {
@@ -131,8 +126,8 @@ double FlagValue::Number() const {
 double FlagValue::Number(double lo, bool inclusive, double hi) const {
   double v = 0;
   if (!ReadNumber(text_, &v) || (inclusive ? v < lo : v <= lo) || v > hi) {
-    const std::string range = std::string(inclusive ? ">= " : "> ") + Num(lo) +
-                              (std::isinf(hi) ? "" : " and <= " + Num(hi));
+    const std::string range = std::string(inclusive ? ">= " : "> ") + FormatNumber(lo) +
+                              (std::isinf(hi) ? "" : " and <= " + FormatNumber(hi));
     Fail(flag_ + " expects a number " + range + ", got '" + text_ + "'");
   }
   return v;

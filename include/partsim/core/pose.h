@@ -38,6 +38,8 @@ struct Pose {
   Eigen::Vector4d Wxyz() const { return {q.w(), q.x(), q.y(), q.z()}; }
   /// True when p and q hold only finite numbers and q has unit norm (within 1e-3).
   bool IsValid() const;
+  /// "Pose([x, y, z], [w, x, y, z])", each number as FormatNumber writes it: the shortest text
+  /// that reads back to the same double (0.1, 1e-07, 0.30000000000000004).
   std::string ToString() const;
 };
 
