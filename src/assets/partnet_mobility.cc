@@ -11,6 +11,7 @@
 
 #include "core/file_read.h"
 #include "core/json_parse.h"
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/physics/kinematics.h"
 
@@ -281,12 +282,12 @@ void CheckLink(const PartNetLink& e, const ArticulationDesc& desc, const std::ve
     const JointDesc& r = desc.links[li].joint;
     const JointType rot = e.no_rotation_limit ? JointType::kContinuous : JointType::kRevolute;
     if (r.type != rot) {
-      notes.Warn(json_file,
-                 where + ": the turn is " + JointTypeName(rot) +
-                     (e.no_rotation_limit
-                          ? std::string()
-                          : " over [0, " + std::to_string(e.rotation_limit) + "] degrees") +
-                     ", mobility.urdf's joint '" + r.name + "' is " + JointTypeName(r.type));
+      notes.Warn(
+          json_file,
+          where + ": the turn is " + JointTypeName(rot) +
+              (e.no_rotation_limit ? std::string()
+                                   : " over [0, " + FormatNumber(e.rotation_limit) + "] degrees") +
+              ", mobility.urdf's joint '" + r.name + "' is " + JointTypeName(r.type));
     } else if (!e.no_rotation_limit &&
                (std::abs(r.lower) > kLimitTolerance ||
                 std::abs(r.upper - Radians(e.rotation_limit)) > kLimitTolerance)) {

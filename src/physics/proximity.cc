@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "physics/scene_internal.h"
 
@@ -47,7 +48,7 @@ Scene& ProximityQuery::GetScene() { return *impl_->world; }
 std::vector<ShapeProximity> ProximityQuery::Query(double margin, const std::vector<bool>& links) {
   Impl& p = *impl_;
   if (!(margin >= 0) || !std::isfinite(margin))
-    throw Error("ProximityQuery: margin must be finite and >= 0, got " + std::to_string(margin));
+    throw Error("ProximityQuery: margin must be finite and >= 0, got " + FormatNumber(margin));
   const size_t nlinks = p.arm.GetDesc().links.size();
   if (!links.empty() && links.size() != nlinks)
     throw Error("ProximityQuery: links has " + std::to_string(links.size()) +

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <map>
 
+#include "partsim/core/check.h"
 #include "physics/dynamics.h"
 #include "physics/scene_internal.h"
 
@@ -387,7 +388,7 @@ using internal::CompiledArticulation;
 Scene::Scene(const SceneConfig& config) : impl_(std::make_unique<Impl>()) {
   if (!(config.timestep > 0) || !std::isfinite(config.timestep))
     throw Error("SceneConfig.timestep must be finite and > 0, got " +
-                std::to_string(config.timestep));
+                FormatNumber(config.timestep));
   if (!config.gravity.allFinite()) throw Error("SceneConfig.gravity must be finite");
   if (config.solver_iterations < 1)
     throw Error("SceneConfig.solver_iterations must be >= 1, got " +
@@ -426,7 +427,7 @@ double Scene::GetTimestep() const { return impl().config.timestep; }
 
 void Scene::SetTimestep(double dt) {
   if (!(dt > 0) || !std::isfinite(dt))
-    throw Error("timestep must be finite and > 0, got " + std::to_string(dt));
+    throw Error("timestep must be finite and > 0, got " + FormatNumber(dt));
   impl().config.timestep = dt;
   // constraint time constants are derived from the timestep: recompile, keeping the state
   impl().dirty = true;
@@ -462,8 +463,7 @@ Actor Scene::AddGround(double altitude, const std::optional<PhysicalMaterial>& m
   if (!std::isfinite(altitude)) throw Error("add_ground: altitude must be finite");
   if (!(render_half_size.minCoeff() > 0) || !render_half_size.allFinite())
     throw Error("add_ground: render_half_size must be finite and > 0, got (" +
-                std::to_string(render_half_size[0]) + ", " + std::to_string(render_half_size[1]) +
-                ")");
+                FormatNumber(render_half_size[0]) + ", " + FormatNumber(render_half_size[1]) + ")");
   ActorDesc desc;
   desc.name = name;
   desc.type = ActorType::kStatic;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "core/number_text.h"
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "render/picture_internal.h"
 
@@ -27,12 +27,12 @@ void CheckCamera(const RenderBackend& backend, const CameraParams& camera) {
                       std::to_string(camera.height));
   if (!camera.K.allFinite() || !(camera.K(0, 0) > 0) || !(camera.K(1, 1) > 0))
     Fail(backend, "camera.K must be finite with focal lengths > 0, got fx = " +
-                      internal::Num(camera.K(0, 0)) + ", fy = " + internal::Num(camera.K(1, 1)));
+                      FormatNumber(camera.K(0, 0)) + ", fy = " + FormatNumber(camera.K(1, 1)));
   if (!std::isfinite(camera.near) || !(camera.near > 0))
-    Fail(backend, "camera.near must be finite and > 0 (m), got " + internal::Num(camera.near));
+    Fail(backend, "camera.near must be finite and > 0 (m), got " + FormatNumber(camera.near));
   if (!std::isfinite(camera.far) || !(camera.far > camera.near))
-    Fail(backend, "camera.far must be finite and > near (" + internal::Num(camera.near) +
-                      " m), got " + internal::Num(camera.far));
+    Fail(backend, "camera.far must be finite and > near (" + FormatNumber(camera.near) +
+                      " m), got " + FormatNumber(camera.far));
   if (!camera.X_WC.IsValid())
     Fail(backend, "camera.X_WC must hold finite numbers and a unit quaternion, got " +
                       camera.X_WC.ToString());
@@ -51,6 +51,8 @@ void RenderBackend::Render(const RenderWorld& world, const CameraParams& camera,
          "Segmentation (PictureOutput bits 1 to 31), got " +
              std::to_string(outputs));
   CheckCamera(*this, camera);
+  // the picture holds nothing until DoRender has filled it
+  out->outputs = 0;
   DoRender(world, camera, out, outputs);
   // outputs not asked for are dropped whatever the backend filled
   internal::KeepOutputs(outputs, out);

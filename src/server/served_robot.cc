@@ -9,6 +9,7 @@
 #include <map>
 #include <thread>
 
+#include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
@@ -173,9 +174,9 @@ struct ServedRobot::Impl {
     if (t <= goal->end - goal->start) {
       const int w = worst(goal->path_tolerance);
       if (w >= 0) {
-        std::string msg = "joint '" + joint_names[w] + "' is " + std::to_string(err[w]) +
-                          " from the trajectory at t = " + std::to_string(t) +
-                          " s (path tolerance " + std::to_string(goal->path_tolerance[w]) + ")";
+        std::string msg = "joint '" + joint_names[w] + "' is " + FormatNumber(err[w]) +
+                          " from the trajectory at t = " + FormatNumber(t) + " s (path tolerance " +
+                          FormatNumber(goal->path_tolerance[w]) + ")";
         Finish(TrajectoryOutcome::kPathToleranceViolated, msg);
         return Hold();
       }
@@ -184,10 +185,10 @@ struct ServedRobot::Impl {
     const int w = worst(goal->goal_tolerance);
     if (w < 0) return Finish(TrajectoryOutcome::kSucceeded, "");
     if (t > goal->end - goal->start + goal->goal_time_tolerance) {
-      std::string msg = "joint '" + joint_names[w] + "' is " + std::to_string(err[w]) +
-                        " from its goal " + std::to_string(goal->goal_time_tolerance) +
+      std::string msg = "joint '" + joint_names[w] + "' is " + FormatNumber(err[w]) +
+                        " from its goal " + FormatNumber(goal->goal_time_tolerance) +
                         " s after the trajectory's end (goal tolerance " +
-                        std::to_string(goal->goal_tolerance[w]) + ")";
+                        FormatNumber(goal->goal_tolerance[w]) + ")";
       Finish(TrajectoryOutcome::kGoalToleranceViolated, msg);
       Hold();
     }
@@ -344,7 +345,7 @@ void ServedRobot::CheckTrajectory(const TrajectoryCommand& c, const std::string&
     if (!std::isfinite(c.times[k]) || c.times[k] < 0 || c.times[k] > kMaxTrajectorySeconds)
       throw Error(p + ": time_from_start must be from 0 to " +
                   std::to_string(static_cast<int>(kMaxTrajectorySeconds)) + " s, got " +
-                  std::to_string(c.times[k]));
+                  FormatNumber(c.times[k]));
     if (k > 0 && !(c.times[k] > c.times[k - 1]))
       throw Error(p + ": time_from_start does not come after the previous point's");
     CheckValues(c.positions[k], index.size(), p + " positions");
@@ -444,7 +445,7 @@ void ServedRobot::Plan(const PlanRequest& request, PlanCallback on_result, DoneC
   if (opt.time_limit > kMaxPlanSeconds)
     throw Error("plan: time_limit must be at most " +
                 std::to_string(static_cast<int>(kMaxPlanSeconds)) + " s, got " +
-                std::to_string(opt.time_limit));
+                FormatNumber(opt.time_limit));
   {
     std::lock_guard<std::mutex> lock(m->jobs_mutex);
     if (m->stopping) throw Error("plan: the server is shutting down");
