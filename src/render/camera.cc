@@ -13,7 +13,6 @@
 #include "partsim/core/constants.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
-#include "render/picture_internal.h"
 #include "render/render_state.h"
 
 namespace partsim {
@@ -226,10 +225,7 @@ void Camera::ClearParent(bool keep_pose) { Remount(Entry(scene_, id_), Pose(), k
 
 void Camera::TakePicture(unsigned outputs) {
   CameraEntry& c = Entry(scene_, id_);
-  if (outputs == 0 || (outputs & ~unsigned{kAllOutputs}) != 0)
-    throw Error("camera '" + c.name + "': take_picture outputs must name at least one of " +
-                "Color, Albedo, Normal, Position, Segmentation (PictureOutput bits 1 to 31), got " +
-                std::to_string(outputs));
+  // the backend's Render checks `outputs` and the camera, for every backend
   internal::RenderState& s = RenderOf(*scene_);
   // the first picture of a scene needs a render world: build it now
   if (!s.render_world_built) scene_->UpdateRender();
@@ -243,13 +239,12 @@ void Camera::TakePicture(unsigned outputs) {
   try {
     backend.Render(s.render_world, params, picture.get(), outputs);
   } catch (...) {
-    // a half-written picture is not the last picture
-    if (picture == c.picture) c.picture.reset();
+    // a half-written picture (Render marks it as holding no outputs) is not the last picture; a
+    // refused argument leaves the last picture as it was
+    if (picture == c.picture && picture->outputs == 0) c.picture.reset();
     throw;
   }
-  // a backend that fills the wrong sizes is a bug: refuse its picture; outputs not asked for
-  // are dropped whatever the backend filled
-  internal::KeepOutputs(outputs, picture.get());
+  // a backend that fills the wrong sizes is a bug: refuse its picture
   size_t n = static_cast<size_t>(c.width) * static_cast<size_t>(c.height);
   auto sized = [&](const auto& v, unsigned bit, size_t channels) {
     return !(outputs & bit) || v.size() == channels * n;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
@@ -316,6 +318,47 @@ TEST_F(CameraTest, SharedPictureSurvivesTheNextPicture) {
   const Picture* current = &cam.GetPictureData();
   cam.TakePicture();
   EXPECT_EQ(&cam.GetPictureData(), current);
+}
+
+// PlaneBackend that, when `fail` is set, overwrites part of the picture and then throws
+class FailingBackend : public PlaneBackend {
+ public:
+  bool fail = false;
+
+ protected:
+  void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
+                unsigned outputs) override {
+    PlaneBackend::DoRender(world, camera, out, outputs);
+    if (!fail) return;
+    out->color.assign(out->color.size(), -1.0f);
+    throw Error("test backend lost its device");
+  }
+};
+
+TEST_F(CameraTest, RefusedOutputsKeepTheLastPictureAndAFailedRenderDropsIt) {
+  auto backend = std::make_unique<FailingBackend>();
+  FailingBackend* failing = backend.get();
+  scene_.SetRenderBackend(std::move(backend));
+  Camera cam = scene_.AddCamera("c", 4, 3, 1.0, 0.1, 10.0);
+  cam.TakePicture(kColor);
+  const std::vector<float> color = cam.GetFloatPicture("Color");
+  // the backend's Render refuses the outputs before it renders: the last picture stays
+  for (unsigned outputs : {0u, 64u}) {
+    try {
+      cam.TakePicture(outputs);
+      ADD_FAILURE() << "no error for outputs " << outputs;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("outputs must name at least one of"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(failing->renders, 1);
+  EXPECT_EQ(cam.GetFloatPicture("Color"), color);
+  // the backend fails halfway through the reused picture: no picture rather than a torn one
+  failing->fail = true;
+  EXPECT_THROW(cam.TakePicture(kColor), Error);
+  EXPECT_EQ(failing->renders, 2);
+  EXPECT_THROW(cam.GetPictureData(), Error);
 }
 
 TEST_F(CameraTest, RemovedCameraHandleThrows) {

@@ -106,7 +106,8 @@ class RenderBackend {
   /// partsim::Error naming the argument when `out` is null, `outputs` names no output or unknown
   /// bits, or `camera` is unusable: width or height outside [1, kMaxPictureSize] pixels, K not
   /// finite or a focal length <= 0, near not finite and > 0, far not finite and > near, X_WC not
-  /// finite with a unit quaternion, view or projection not finite.
+  /// finite with a unit quaternion, view or projection not finite; `out` is then untouched. When
+  /// the backend throws while rendering, out->outputs is 0 (the picture holds nothing usable).
   void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
               unsigned outputs = kAllOutputs);
 
