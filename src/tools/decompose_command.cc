@@ -1,15 +1,23 @@
 // `partsim assets decompose`: convex decomposition of a mesh file from the command line.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <string>
+#include <vector>
 
+#include "arg_parser.h"
+#include "commands.h"
 #include "partsim/assets/convex_decomposition.h"
-#include "partsim/core/error.h"
-#include "tools/commands.h"
+#include "partsim/core/constants.h"
 
 namespace partsim {
 namespace {
+
+using tools::ArgParser;
+using tools::FlagValue;
+using tools::RunWithExitCode;
 
 constexpr const char* kUsage =
     "usage: partsim assets decompose MESH --out DIR [--concavity C] [--max-pieces N]\n"
@@ -23,78 +31,45 @@ constexpr const char* kUsage =
     "  --max-hull-vertices N simplify each piece to N vertices (default: full hulls)\n"
     "  --name BASENAME       file name prefix (default: MESH's file stem)\n";
 
-struct UsageError : Error {
-  using Error::Error;
-};
-
-double ParseNumber(const std::string& flag, const std::string& text) {
-  try {
-    size_t used = 0;
-    double v = std::stod(text, &used);
-    if (used == text.size()) return v;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(flag + " expects a number, got '" + text + "'");
-}
-
-int ParseInt(const std::string& flag, const std::string& text) {
-  try {
-    size_t used = 0;
-    int v = std::stoi(text, &used);
-    if (used == text.size()) return v;
-  } catch (const std::exception&) {
-  }
-  throw UsageError(flag + " expects an integer, got '" + text + "'");
-}
-
 }  // namespace
 
 int RunDecomposeCommand(int argc, char** argv) {
-  std::string mesh, out, name;
-  ConvexDecompositionOptions options;
-  try {
-    // arguments after the command's name
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw UsageError(arg + " needs a value");
-        return argv[++i];
-      };
-      if (arg == "-h" || arg == "--help") {
-        std::fputs(kUsage, stdout);
-        return 0;
-      } else if (arg == "--out") {
-        out = value();
-      } else if (arg == "--concavity") {
-        options.concavity = ParseNumber(arg, value());
-        if (!(options.concavity > 0)) throw UsageError("--concavity must be > 0");
-      } else if (arg == "--max-pieces") {
-        options.max_pieces = ParseInt(arg, value());
-      } else if (arg == "--min-pieces") {
-        options.min_pieces = ParseInt(arg, value());
-      } else if (arg == "--max-hull-vertices") {
-        options.max_hull_vertices = ParseInt(arg, value());
-      } else if (arg == "--name") {
-        name = value();
-      } else if (!arg.empty() && arg[0] == '-') {
-        throw UsageError("unknown option " + arg);
-      } else if (mesh.empty()) {
-        mesh = arg;
-      } else {
-        throw UsageError("unexpected argument '" + arg + "' (one MESH only)");
-      }
-    }
-    if (mesh.empty()) throw UsageError("MESH is missing");
-    if (out.empty()) throw UsageError("--out DIR is missing");
-    if (options.min_pieces > options.max_pieces && options.max_pieces >= 1) {
-      throw UsageError("--min-pieces must not exceed --max-pieces");
-    }
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "decompose: %s\n%s", e.what(), kUsage);
-    return 2;
+  // argv[0] is "decompose"
+  const std::vector<std::string> args(argv + std::min(argc, 1), argv + argc);
+  if (ArgParser::AsksForHelp(args)) {
+    std::fputs(kUsage, stdout);
+    return 0;
   }
+  return RunWithExitCode("partsim assets decompose", kUsage, [&] {
+    std::string mesh, out, name;
+    ConvexDecompositionOptions options;
+    ArgParser p("partsim assets decompose");
+    p.Positional([&](const FlagValue& v) {
+      if (!mesh.empty()) v.Fail("unexpected argument '" + v.Text() + "' (one MESH only)");
+      mesh = v.Text();
+    });
+    p.Option("--out", [&](const FlagValue& v) { out = v.NonEmpty("a folder name"); });
+    p.Option("--concavity",
+             [&](const FlagValue& v) { options.concavity = v.Number(0, false, kInf); });
+    p.Option("--max-pieces", [&](const FlagValue& v) {
+      options.max_pieces = static_cast<int>(v.Integer(1, std::numeric_limits<int>::max()));
+    });
+    p.Option("--min-pieces", [&](const FlagValue& v) {
+      options.min_pieces = static_cast<int>(v.Integer(1, std::numeric_limits<int>::max()));
+    });
+    p.Option("--max-hull-vertices", [&](const FlagValue& v) {
+      options.max_hull_vertices = static_cast<int>(v.Integer(0, std::numeric_limits<int>::max()));
+      if (options.max_hull_vertices > 0 && options.max_hull_vertices < 4)
+        v.Fail("--max-hull-vertices expects 0 (full hulls) or at least 4, got '" + v.Text() + "'");
+    });
+    p.Option("--name", [&](const FlagValue& v) { name = v.Text(); });
+    p.Switch("--help", [] {});  // answered above; declared to be suggested
+    p.Parse(args);
+    if (mesh.empty()) p.Fail("MESH is missing");
+    if (out.empty()) p.Fail("--out DIR is missing");
+    if (options.min_pieces > options.max_pieces)
+      p.Fail("--min-pieces must not exceed --max-pieces");
 
-  try {
     if (name.empty()) name = std::filesystem::path(mesh).stem().string();
     const auto start = std::chrono::steady_clock::now();
     ConvexDecompositionResult r = DecomposeConvexFile(mesh, options);
@@ -111,10 +86,7 @@ int RunDecomposeCommand(int argc, char** argv) {
                 r.mesh_volume);
     std::printf("  wrote %zu pieces and %s\n", r.pieces.size(), files.back().c_str());
     return 0;
-  } catch (const Error& e) {
-    std::fprintf(stderr, "decompose: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 }  // namespace partsim

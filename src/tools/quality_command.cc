@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <set>
@@ -15,16 +16,20 @@
 #include <thread>
 #include <vector>
 
+#include "arg_parser.h"
+#include "commands.h"
 #include "core/progress.h"
 #include "partsim/assets/generator.h"
 #include "partsim/assets/quality.h"
-#include "partsim/core/error.h"
 #include "partsim/render/visibility.h"
-#include "tools/commands.h"
 
 namespace partsim {
 
 namespace {
+
+using tools::ArgParser;
+using tools::FlagValue;
+using tools::RunWithExitCode;
 
 constexpr const char* kCheckUsage =
     "usage: partsim assets check DIR [--jobs J] [--no-visibility] [--backend "
@@ -35,11 +40,6 @@ constexpr const char* kCheckUsage =
     "moves; each movable part covers its range without jamming; each shows in some view. Prints\n"
     "the failures, a summary and the models/parts table beside the SAPIEN paper's.\n"
     "Exit code: 0 all passed, 1 some failed, 2 bad command line.\n";
-
-int Usage(const std::string& error) {
-  std::cerr << "partsim assets check: " << error << "\n" << kCheckUsage;
-  return 2;
-}
 
 // A generate run was stopped while writing this object: it fails without being loaded.
 ObjectQualityReport PartialReport(const std::string& folder) {
@@ -54,43 +54,38 @@ ObjectQualityReport PartialReport(const std::string& folder) {
 }  // namespace
 
 int RunQualityCommand(int argc, char** argv) {
+  const std::vector<std::string> args(argv, argv + argc);
+  if (ArgParser::AsksForHelp(args)) {
+    std::cout << kCheckUsage;
+    return 0;
+  }
   std::string dir, report_path;
   int jobs = 2;
-  long limit = -1;
+  long long limit = -1;  // no limit
   QualityOptions options;
-  for (int i = 0; i < argc; ++i) {
-    std::string a = argv[i];
-    auto value = [&](const char* flag) -> std::string {
-      if (i + 1 >= argc) throw Error(std::string(flag) + " needs a value");
-      return argv[++i];
-    };
-    try {
-      if (a == "--help" || a == "-h") {
-        std::cout << kCheckUsage;
-        return 0;
-      } else if (a == "--jobs") {
-        jobs = std::stoi(value("--jobs"));
-        if (jobs < 1) return Usage("--jobs must be >= 1");
-      } else if (a == "--no-visibility") {
-        options.check_visibility = false;
-      } else if (a == "--backend") {
-        options.render_backend = value("--backend");
-      } else if (a == "--report") {
-        report_path = value("--report");
-      } else if (a == "--limit") {
-        limit = std::stol(value("--limit"));
-      } else if (!a.empty() && a[0] == '-') {
-        return Usage("unknown option '" + a + "'");
-      } else if (dir.empty()) {
-        dir = a;
-      } else {
-        return Usage("unexpected argument '" + a + "'");
-      }
-    } catch (const std::exception& e) {
-      return Usage(std::string("bad value for ") + a + ": " + e.what());
-    }
-  }
-  if (dir.empty()) return Usage("no DIR given");
+  const int parsed = RunWithExitCode("partsim assets check", kCheckUsage, [&] {
+    ArgParser p("partsim assets check");
+    p.Positional([&](const FlagValue& v) {
+      if (!dir.empty()) v.Fail("unexpected argument '" + v.Text() + "' (one DIR only)");
+      dir = v.Text();
+    });
+    p.Option("--jobs", [&](const FlagValue& v) {
+      jobs = static_cast<int>(v.Integer(1, std::numeric_limits<int>::max()));
+    });
+    p.Switch("--no-visibility", [&] { options.check_visibility = false; });
+    p.Option("--backend", [&](const FlagValue& v) {
+      options.render_backend = v.Choice({"rasterizer", "pathtracer"}, {"null"});
+    });
+    p.Option("--report", [&](const FlagValue& v) { report_path = v.NonEmpty("a file name"); });
+    p.Option("--limit", [&](const FlagValue& v) {
+      limit = v.Integer(0, std::numeric_limits<long long>::max());
+    });
+    p.Switch("--help", [] {});  // answered above; declared to be suggested
+    p.Parse(args);
+    if (dir.empty()) p.Fail("no DIR given");
+    return 0;
+  });
+  if (parsed != 0) return parsed;
   if (!std::filesystem::is_directory(dir)) {
     std::cerr << "partsim assets check: '" << dir << "' is not a folder\n";
     return 1;
@@ -106,7 +101,8 @@ int RunQualityCommand(int argc, char** argv) {
       found.insert(e.path().parent_path().string());
   }
   std::vector<std::string> folders(found.begin(), found.end());
-  if (limit >= 0 && static_cast<long>(folders.size()) > limit) folders.resize(limit);
+  if (limit >= 0 && static_cast<long long>(folders.size()) > limit)
+    folders.resize(static_cast<size_t>(limit));
   if (folders.empty()) {
     std::cerr << "partsim assets check: no object folder (with mobility_v2.json) under '" << dir
               << "'\n";

@@ -1,5 +1,5 @@
-// `partsim assets`: unknown categories are a bad command line with a suggestion; progress in a
-// log file or a pipe is plain lines.
+// `partsim assets`: unknown categories and flags are a bad command line with a suggestion;
+// progress in a log file or a pipe is plain lines.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -64,6 +64,43 @@ TEST_F(AssetsCommandTest, AnUnknownCategoryIsABadCommandLineWithASuggestion) {
   r = RunAssets("generte --out x");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_TRUE(Contains(r.err, "did you mean 'generate'?")) << r.err;
+}
+
+// check and decompose read their flags with the commands' parser: a typo is a bad command line
+// (exit code 2) with the closest flag or value as suggestion and the command's usage
+TEST_F(AssetsCommandTest, CheckAndDecomposeRefuseUnknownOptionsWithASuggestion) {
+  const std::string dir = "'" + dir_.string() + "'";
+  RunResult r = RunAssets("check " + dir + " --no-visibilty");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(Contains(r.err,
+                       "partsim assets check: unknown option '--no-visibilty' (did you "
+                       "mean '--no-visibility'?)"))
+      << r.err;
+  EXPECT_TRUE(Contains(r.err, "usage: partsim assets check DIR")) << r.err;
+  r = RunAssets("check " + dir + " --backend rasterzer");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(Contains(r.err, "did you mean 'rasterizer'?")) << r.err;
+  r = RunAssets("check " + dir + " --jobs 0");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(Contains(r.err, "--jobs expects an integer from 1")) << r.err;
+  r = RunAssets("check " + dir + " other");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(Contains(r.err, "unexpected argument 'other'")) << r.err;
+
+  r = RunAssets("decompose mesh.obj --out " + dir + " --max-piece 4");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(Contains(r.err,
+                       "partsim assets decompose: unknown option '--max-piece' (did you "
+                       "mean '--max-pieces'?)"))
+      << r.err;
+  EXPECT_TRUE(Contains(r.err, "usage: partsim assets decompose MESH")) << r.err;
+  r = RunAssets("decompose mesh.obj --out " + dir + " --concavity -1");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(Contains(r.err, "--concavity expects a number > 0, got '-1'")) << r.err;
+  r = RunAssets("decompose mesh.obj --out " + dir + " --min-pieces 5 --max-pieces 4");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(Contains(r.err, "--min-pieces must not exceed --max-pieces")) << r.err;
+  EXPECT_FALSE(fs::exists(dir_)) << "nothing is written for a bad command line";
 }
 
 TEST_F(AssetsCommandTest, ProgressInAPipeIsPlainLinesAtABoundedRate) {
