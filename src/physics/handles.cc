@@ -549,6 +549,12 @@ struct ArtRef {
   std::string owner() const { return "articulation '" + a.desc.name + "'"; }
 };
 
+// CheckVector for an articulation's dofs; the owner's name is only built for the message.
+void CheckDofVector(const Eigen::VectorXd& v, const ArtRef& r, const char* what) {
+  if (v.size() == r.dof() && v.allFinite()) return;
+  CheckVector(v, r.dof(), what, r.owner());
+}
+
 ArtRef GetArt(Scene* scene, int id) {
   SceneImpl& s = S(scene);
   auto& a = s.GetArticulation(id);
@@ -656,7 +662,7 @@ Eigen::VectorXd Articulation::GetQpos() const {
 
 void Articulation::SetQpos(const Eigen::VectorXd& qpos) {
   ArtRef r = GetArt(scene_, id_);
-  CheckVector(qpos, r.dof(), "qpos", r.owner());
+  CheckDofVector(qpos, r, "qpos");
   // coupled joints follow their sources, so that the coupling holds from the start
   const Eigen::VectorXd values = WithCouplings(r, qpos, true);
   if (r.a.desc.kinematic) {
@@ -682,7 +688,7 @@ Eigen::VectorXd Articulation::GetQvel() const {
 
 void Articulation::SetQvel(const Eigen::VectorXd& qvel) {
   ArtRef r = GetArt(scene_, id_);
-  CheckVector(qvel, r.dof(), "qvel", r.owner());
+  CheckDofVector(qvel, r, "qvel");
   if (r.a.desc.kinematic) {
     r.s.State(r.a).kin_qvel = WithCouplings(r, qvel, false);
     return;
@@ -699,7 +705,7 @@ Eigen::VectorXd Articulation::GetQacc() const {
 
 void Articulation::SetQacc(const Eigen::VectorXd& qacc) {
   ArtRef r = DynamicArt(scene_, id_, "set_qacc");
-  CheckVector(qacc, r.dof(), "qacc", r.owner());
+  CheckDofVector(qacc, r, "qacc");
   ScatterDofs(r, qacc, r.s.d()->qacc);
   ScatterDofs(r, qacc, r.s.d()->qacc_warmstart);
 }
@@ -713,7 +719,7 @@ Eigen::VectorXd Articulation::GetQf() const {
 
 void Articulation::SetQf(const Eigen::VectorXd& qf) {
   ArtRef r = DynamicArt(scene_, id_, "set_qf");
-  CheckVector(qf, r.dof(), "qf", r.owner());
+  CheckDofVector(qf, r, "qf");
   for (int mj : r.c.mj_dofs) r.s.d()->qfrc_applied[mj] = 0;
   for (int k = 0; k < r.dof(); ++k)
     r.s.d()->qfrc_applied[r.c.joints[r.c.dof_links[k]].dofadr] = qf[k];
@@ -802,14 +808,14 @@ void Articulation::SetRootAngularVelocity(const Eigen::Vector3d& w) {
 
 void Articulation::SetDriveTarget(const Eigen::VectorXd& target) {
   ArtRef r = GetArt(scene_, id_);
-  CheckVector(target, r.dof(), "drive target", r.owner());
+  CheckDofVector(target, r, "drive target");
   r.s.State(r.a).drive_target = target;
   r.s.Invalidate();
 }
 
 void Articulation::SetDriveVelocityTarget(const Eigen::VectorXd& velocity) {
   ArtRef r = GetArt(scene_, id_);
-  CheckVector(velocity, r.dof(), "drive velocity target", r.owner());
+  CheckDofVector(velocity, r, "drive velocity target");
   r.s.State(r.a).drive_velocity_target = velocity;
   r.s.Invalidate();
 }
@@ -837,14 +843,14 @@ Eigen::VectorXd Articulation::ComputePassiveForce(bool gravity, bool coriolis,
 
 Eigen::VectorXd Articulation::ComputeForwardDynamics(const Eigen::VectorXd& qf) const {
   ArtRef r = DynamicArt(scene_, id_, "compute_forward_dynamics");
-  CheckVector(qf, r.dof(), "qf", r.owner());
+  CheckDofVector(qf, r, "qf");
   r.s.EnsureForward();
   return internal::ForwardDynamics(r.s.model, r.s.data, id_, qf);
 }
 
 Eigen::VectorXd Articulation::ComputeInverseDynamics(const Eigen::VectorXd& qacc) const {
   ArtRef r = DynamicArt(scene_, id_, "compute_inverse_dynamics");
-  CheckVector(qacc, r.dof(), "qacc", r.owner());
+  CheckDofVector(qacc, r, "qacc");
   r.s.EnsureForward();
   return internal::InverseDynamics(r.s.model, r.s.data, id_, qacc);
 }

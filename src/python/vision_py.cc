@@ -79,8 +79,8 @@ std::pair<bool, std::string> Document(const py::object& value) {
 }  // namespace
 
 void BindVision(py::module_& m) {
-  py::module_ v = m.def_submodule(
-      "_vision", "COCO masks and RLE, and the perception benchmark's evaluators.");
+  py::module_ v =
+      m.def_submodule("_vision", "COCO masks and RLE, and the perception benchmark's evaluators.");
   // the names its classes and functions report: where python/partsim/vision.py exports them
   v.attr("__name__") = "partsim.vision";
 

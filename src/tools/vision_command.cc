@@ -1,7 +1,9 @@
 // `partsim vision ...`: the perception benchmark's tools. Each subcommand is one function over
 // the arguments after its name, listed in kSubcommands with its part of the help; a new one
 // (detection-dataset, motion-dataset, show) adds a function and a row there.
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -10,12 +12,34 @@
 
 #include "arg_parser.h"
 #include "commands.h"
+#include "partsim/core/check.h"
+#include "partsim/vision/dataset.h"
 #include "partsim/vision/evaluate.h"
 
 namespace partsim::tools {
 namespace {
 
 constexpr char kCommand[] = "partsim vision";
+
+constexpr char kDetectionDatasetUsage[] =
+    R"(  partsim vision detection-dataset --dataset ROOT --out DIR [--views 20] [--size 512]
+                 [--seed S] [--split 0.75] [--jobs J] [--shard i/N] [--backend B]
+                 [--no-point-clouds] [--merge-only] [--quiet]
+      Movable-part detection data from the PartNet-Mobility folders under ROOT: per object,
+      --views pictures (RGB PNG, depth as 16-bit mm PNG and float NPY, a 16-bit PNG of part
+      instances, the partial point cloud as NPZ, cameras in views.json) and the COCO files
+      DIR/instances_train.json and instances_test.json (RLE masks; categories
+      "<object category>/<part label>"), split by object within each category. Same seed,
+      same bytes, whatever --jobs and --shard; objects already done are skipped
+      (docs/vision.md).
+)";
+
+constexpr char kMotionDatasetUsage[] =
+    R"(  partsim vision motion-dataset --dataset ROOT --out DIR [the options above]
+      Motion-attribute data: per door (hinge) and drawer (slider) of the objects under ROOT,
+      --views samples (RGB, depth, the part's mask) and DIR/motion_train.json and
+      motion_test.json with the label vector m in the camera frame, as evaluate-motion reads.
+)";
 
 constexpr char kEvaluateDetectionUsage[] =
     R"(  partsim vision evaluate-detection --gt FILE --results FILE [--out DIR]
@@ -43,10 +67,14 @@ struct Subcommand {
   int (*run)(const std::vector<std::string>& args);
 };
 
+int RunDetectionDataset(const std::vector<std::string>& args);
+int RunMotionDataset(const std::vector<std::string>& args);
 int RunEvaluateDetection(const std::vector<std::string>& args);
 int RunEvaluateMotion(const std::vector<std::string>& args);
 
 const Subcommand kSubcommands[] = {
+    {"detection-dataset", kDetectionDatasetUsage, RunDetectionDataset},
+    {"motion-dataset", kMotionDatasetUsage, RunMotionDataset},
     {"evaluate-detection", kEvaluateDetectionUsage, RunEvaluateDetection},
     {"evaluate-motion", kEvaluateMotionUsage, RunEvaluateMotion},
 };
@@ -100,6 +128,79 @@ void WriteOutputs(const std::string& dir, const std::string& markdown, const std
     if (!f) throw std::runtime_error("cannot write '" + path.string() + "'");
     std::printf("wrote %s\n", path.c_str());
   }
+}
+
+// the options of detection-dataset and motion-dataset
+vision::DatasetOptions ParseDatasetArgs(const std::string& name, vision::DatasetKind kind,
+                                        const std::vector<std::string>& args) {
+  vision::DatasetOptions o;
+  o.kind = kind;
+  ArgParser p(std::string(kCommand) + " " + name, "partsim vision --help");
+  p.Option("--dataset", [&](const FlagValue& v) { o.dataset_root = v.NonEmpty("a folder name"); });
+  p.Option("--out", [&](const FlagValue& v) { o.out = v.NonEmpty("a folder name"); });
+  p.Option("--views", [&](const FlagValue& v) { o.views = static_cast<int>(v.Integer(1, 10000)); });
+  p.Option("--size", [&](const FlagValue& v) { o.size = static_cast<int>(v.Integer(16, 4096)); });
+  p.Option("--seed", [&](const FlagValue& v) { o.seed = v.Unsigned(); });
+  p.Option("--split", [&](const FlagValue& v) { o.split = v.Number(0, true, 1); });
+  p.Option("--jobs", [&](const FlagValue& v) { o.jobs = static_cast<int>(v.Integer(1, 256)); });
+  p.Option("--shard", [&](const FlagValue& v) {
+    const std::string& t = v.Text();
+    const size_t slash = t.find('/');
+    char* end = nullptr;
+    long i = -1, n = -1;
+    if (slash != std::string::npos) {
+      i = std::strtol(t.c_str(), &end, 10);
+      if (end != t.c_str() + slash) i = -1;
+      n = std::strtol(t.c_str() + slash + 1, &end, 10);
+      if (*end != '\0') n = -1;
+    }
+    if (!(n >= 1 && i >= 0 && i < n))
+      p.Fail("--shard wants i/N with 0 <= i < N (e.g. 0/4), got '" + t + "'");
+    o.shard_index = static_cast<int>(i);
+    o.shard_count = static_cast<int>(n);
+  });
+  p.Option("--backend", [&](const FlagValue& v) {
+    o.backend = v.Choice({"rasterizer", "pathtracer"});
+  });
+  p.Switch("--no-point-clouds", [&] { o.point_clouds = false; });
+  p.Switch("--merge-only", [&] { o.merge_only = true; });
+  p.Switch("--quiet", [&] { o.progress = false; });
+  p.Parse(args);
+  if (o.dataset_root.empty()) p.Fail("--dataset ROOT is required");
+  if (o.out.empty()) p.Fail("--out DIR is required");
+  return o;
+}
+
+int RunDataset(const std::string& name, vision::DatasetKind kind,
+               const std::vector<std::string>& args) {
+  const vision::DatasetOptions o = ParseDatasetArgs(name, kind, args);
+  const vision::DatasetSummary s = vision::GenerateDataset(o);
+  const bool detection = kind == vision::DatasetKind::kDetection;
+  std::printf("%d objects (%d rendered now, %d already done, %d failed), %ld pictures in %s s",
+              s.objects, s.rendered, s.skipped, s.failed, s.views,
+              FormatNumber(std::round(s.seconds * 10) / 10).c_str());
+  if (s.views > 0 && s.seconds > 0)
+    std::printf(" (%s per second)",
+                FormatNumber(std::round(s.views / s.seconds * 10) / 10).c_str());
+  std::printf("\ntrain: %d objects, %ld %s; test: %d objects, %ld %s", s.train_objects,
+              s.train_images, detection ? "images" : "samples", s.test_objects, s.test_images,
+              detection ? "images" : "samples");
+  if (detection)
+    std::printf("; %ld part instances\n", s.annotations);
+  else
+    std::printf("; slider range %s m\n", FormatNumber(s.slider_range).c_str());
+  std::printf("wrote %s/%s\n", o.out.c_str(),
+              detection ? "instances_{train,test}.json" : "motion_{train,test}.json");
+  for (const std::string& e : s.errors) std::fprintf(stderr, "failed: %s\n", e.c_str());
+  return s.failed > 0 ? 1 : 0;
+}
+
+int RunDetectionDataset(const std::vector<std::string>& args) {
+  return RunDataset("detection-dataset", vision::DatasetKind::kDetection, args);
+}
+
+int RunMotionDataset(const std::vector<std::string>& args) {
+  return RunDataset("motion-dataset", vision::DatasetKind::kMotion, args);
 }
 
 int RunEvaluateDetection(const std::vector<std::string>& args) {

@@ -107,7 +107,7 @@ TEST_F(VisionCommandTest, BadCommandLinesExitWith2) {
   int code = -1;
   std::string out = Run("", &code);
   EXPECT_EQ(code, 2);
-  EXPECT_TRUE(Contains(out, "expected a subcommand (evaluate-detection, evaluate-motion)")) << out;
+  EXPECT_TRUE(Contains(out, "expected a subcommand (detection-dataset, motion-dataset, evaluate-detection, evaluate-motion)")) << out;
   out = Run("evaluate-detections --gt gt.json", &code);
   EXPECT_EQ(code, 2);
   EXPECT_TRUE(Contains(out, "did you mean 'evaluate-detection'?")) << out;

@@ -1,0 +1,798 @@
+// GenerateDataset: the detection and motion-attribute datasets (partsim/vision/dataset.h).
+#include "partsim/vision/dataset.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "core/file_read.h"
+#include "core/json_parse.h"
+#include "core/progress.h"
+#include "core/worker_pool.h"
+#include "partsim/assets/partnet_mobility.h"
+#include "partsim/core/check.h"
+#include "partsim/core/constants.h"
+#include "partsim/core/error.h"
+#include "partsim/render/camera.h"
+#include "partsim/render/image_io.h"
+#include "partsim/vision/coco.h"
+#include "vision/npz.h"
+
+namespace partsim::vision {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr const char* kDone = "DONE";
+constexpr std::uint64_t kMaxDatasetFileBytes = std::uint64_t{1} << 30;
+
+// ---------------------------------------------------------------------------------------------
+// the objects of a dataset
+
+// A link that is a door (a hinge whose label names a door) or a drawer (a slider whose label
+// names a drawer): the targets of the motion dataset.
+enum class Target { kNone, kDoor, kDrawer };
+
+Target TargetOf(const PartNetLink& link) {
+  const std::string& label = link.semantic_label;
+  const JointType type = PartNetMobilityObject::MotionJointType(link);
+  if ((type == JointType::kRevolute || type == JointType::kContinuous) &&
+      label.find("door") != std::string::npos)
+    return Target::kDoor;
+  if (type == JointType::kPrismatic && label.find("drawer") != std::string::npos)
+    return Target::kDrawer;
+  return Target::kNone;
+}
+
+struct ObjectInfo {
+  std::string folder;
+  std::string name;                 // unique in the dataset: its path under the root, '/' -> '_'
+  std::string category;             // meta.json model_cat, "Unknown" when absent
+  std::vector<std::string> labels;  // "Category/label" of its labelled links
+  int doors = 0, drawers = 0;
+  double max_slider_range = 0;  // of its drawers, m
+  bool train = true;
+};
+
+std::string CategoryOf(const PartNetMobilityObject& o) {
+  return o.category.empty() ? std::string("Unknown") : o.category;
+}
+
+std::string PartCategory(const std::string& category, const PartNetLink& link) {
+  return category + "/" + link.semantic_label;
+}
+
+// SplitMix64: the stream of every random draw (seeded per object, so that the draws do not
+// depend on which worker renders the object or in which order).
+std::uint64_t Mix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+std::uint64_t Hash(std::uint64_t seed, const std::string& text) {
+  std::uint64_t h = Mix(seed);
+  for (unsigned char c : text) h = Mix(h ^ c);
+  return h;
+}
+
+class Random {
+ public:
+  explicit Random(std::uint64_t seed) : state_(seed) {}
+  double Uniform(double lo, double hi) {
+    state_ = Mix(state_);
+    return lo + (hi - lo) * static_cast<double>(state_ >> 11) * 0x1.0p-53;
+  }
+
+ private:
+  std::uint64_t state_;
+};
+
+std::vector<std::string> FindObjectFolders(const std::string& root) {
+  if (!fs::is_directory(root))
+    throw Error("vision dataset: --dataset '" + root + "' is not a folder");
+  std::vector<std::string> folders;
+  for (const auto& e : fs::recursive_directory_iterator(root))
+    if (e.is_regular_file() && e.path().filename() == "mobility.urdf")
+      folders.push_back(e.path().parent_path().string());
+  std::sort(folders.begin(), folders.end());
+  if (folders.empty())
+    throw Error("vision dataset: no PartNet-Mobility object (a folder with mobility.urdf) under '" +
+                root + "'");
+  return folders;
+}
+
+std::string ObjectName(const std::string& root, const std::string& folder) {
+  std::string rel = fs::relative(folder, root).generic_string();
+  if (rel.empty() || rel == ".") rel = fs::path(folder).filename().string();
+  std::replace(rel.begin(), rel.end(), '/', '_');
+  return rel;
+}
+
+// ---------------------------------------------------------------------------------------------
+// files
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+  if (!f) throw Error("vision dataset: cannot write '" + path + "'");
+}
+
+// Writes `text` to path.partial and renames it into place: a reader never sees half a file.
+void WriteTextAtomic(const std::string& path, const std::string& text) {
+  WriteText(path + ".partial", text);
+  fs::rename(path + ".partial", path);
+}
+
+std::string Two(int i) {
+  char buf[16];
+  std::snprintf(buf, sizeof(buf), "%02d", i);
+  return buf;
+}
+
+json PoseJson(const Pose& p) {
+  return {{"p", {p.p.x(), p.p.y(), p.p.z()}}, {"q", {p.q.w(), p.q.x(), p.q.y(), p.q.z()}}};
+}
+
+json MatrixJson(const Eigen::MatrixXd& m) {
+  json rows = json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    json row = json::array();
+    for (Eigen::Index c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// ---------------------------------------------------------------------------------------------
+// rendering one object
+
+// Bounds of everything the scene renders, in the world, from the meshes' vertex bounds.
+void RenderBounds(const RenderWorld& world, Eigen::Vector3d* lo, Eigen::Vector3d* hi) {
+  *lo = Eigen::Vector3d::Constant(kInf);
+  *hi = Eigen::Vector3d::Constant(-kInf);
+  for (const RenderInstance& inst : world.instances) {
+    if (!inst.mesh || inst.mesh->vertices.empty()) continue;
+    Eigen::Vector3f mlo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
+    Eigen::Vector3f mhi = -mlo;
+    for (const Eigen::Vector3f& v : inst.mesh->vertices) {
+      mlo = mlo.cwiseMin(v);
+      mhi = mhi.cwiseMax(v);
+    }
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector4d corner((k & 1) ? mhi.x() : mlo.x(), (k & 2) ? mhi.y() : mlo.y(),
+                                   (k & 4) ? mhi.z() : mlo.z(), 1.0);
+      const Eigen::Vector3d w = (inst.X_WV * corner).head<3>();
+      *lo = lo->cwiseMin(w);
+      *hi = hi->cwiseMax(w);
+    }
+  }
+  if (!(lo->array() <= hi->array()).all()) *lo = *hi = Eigen::Vector3d::Zero();
+}
+
+// What one rendered view holds, in pixels and in the OpenCV camera frame.
+struct View {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgb;       // h x w x 3
+  std::vector<float> depth;            // h x w, m
+  std::vector<int> link;               // h x w: link index of our articulation seen, -1 none
+  std::vector<Eigen::Vector3f> point;  // h x w: OpenCV camera-frame position (0 if none)
+  Eigen::Matrix3d K;
+  Eigen::Matrix<double, 3, 4> extrinsic;  // world -> OpenCV camera
+  Pose X_WC;
+  Eigen::VectorXd qpos;
+};
+
+class ObjectRenderer {
+ public:
+  ObjectRenderer(const DatasetOptions& options, const std::string& folder)
+      : options_(options), scene_(std::make_unique<Scene>()) {
+    scene_->SetRenderBackend(options.backend);
+    PartNetMobilityLoader loader(scene_.get());
+    object_ = loader.Parse(folder);
+    articulation_ = scene_->AddArticulation(object_.articulation);
+    const double fovy = options.fovy_degrees * kPi / 180.0;
+    camera_ = scene_->AddCamera("dataset", options.size, options.size, fovy, 0.01, 100.0);
+    // ambient light and one directional light from above the object's front, no shadows
+    scene_->SetAmbientLight(Eigen::Vector3f::Constant(0.35f));
+    const Eigen::Vector3d front = Front();
+    scene_->AddDirectionalLight((-front - Eigen::Vector3d(0, 0, 1.5)).normalized(),
+                                Eigen::Vector3f::Constant(2.2f), false);
+    for (const RenderEntityInfo& e : scene_->GetRenderEntities())
+      if (e.is_link && e.articulation_id == articulation_.GetId())
+        entity_link_[e.id] = e.link_index;
+    limits_ = articulation_.GetQlimits();
+  }
+
+  const PartNetMobilityObject& Object() const { return object_; }
+
+  // The object's front in the world: mobility.urdf turns the meshes' front (+z of the
+  // annotation frame) to -x of the root.
+  Eigen::Vector3d Front() const {
+    return articulation_.GetRootPose().q * -Eigen::Vector3d::UnitX();
+  }
+  Articulation& GetArticulation() { return articulation_; }
+
+  // Joint positions drawn per view: each dof uniformly between its limits; a dof without
+  // limits (continuous) uniformly in [-pi, pi).
+  Eigen::VectorXd DrawJointPositions(Random* rng) const {
+    Eigen::VectorXd q(limits_.rows());
+    for (Eigen::Index k = 0; k < q.size(); ++k) {
+      const double lo = std::isfinite(limits_(k, 0)) ? limits_(k, 0) : -kPi;
+      const double hi = std::isfinite(limits_(k, 1)) ? limits_(k, 1) : kPi;
+      q[k] = rng->Uniform(lo, hi);
+    }
+    return q;
+  }
+
+  // Places the camera on the upper hemisphere around the object at joint positions `q`: azimuth
+  // within 90 degrees either side of the object's front (Front), elevation 10 to 60
+  // degrees, looking at the centre of its bounds from a distance that keeps the bounding sphere
+  // in frame (1.0 to 1.3 times the nearest such distance).
+  View Render(const Eigen::VectorXd& q, Random* rng) {
+    articulation_.SetQpos(q);
+    scene_->UpdateRender();
+    Eigen::Vector3d lo, hi;
+    RenderBounds(scene_->GetRenderWorld(), &lo, &hi);
+    const Eigen::Vector3d centre = 0.5 * (lo + hi);
+    const double radius = std::max(0.5 * (hi - lo).norm(), 1e-3);
+    const Eigen::Vector3d front = Front();
+    const double front_azimuth = std::atan2(front.y(), front.x());
+    const double azimuth = front_azimuth + rng->Uniform(-0.5 * kPi, 0.5 * kPi);
+    const double elevation = rng->Uniform(10.0, 60.0) * kPi / 180.0;
+    const double half_fov = 0.5 * options_.fovy_degrees * kPi / 180.0;
+    const double distance = radius / std::sin(half_fov) * rng->Uniform(1.0, 1.3);
+    const Eigen::Vector3d dir(std::cos(elevation) * std::cos(azimuth),
+                              std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+    const Eigen::Vector3d eye = centre + distance * dir;
+    camera_.LookAt(eye, centre);
+    scene_->UpdateRender();
+    camera_.TakePicture(kColor | kPosition | kSegmentation);
+    const Picture& pic = camera_.GetPictureData();
+
+    View v;
+    v.width = pic.width;
+    v.height = pic.height;
+    v.K = camera_.GetIntrinsicMatrix();
+    v.extrinsic = camera_.GetExtrinsicMatrix();
+    v.X_WC = camera_.GetPose();
+    v.qpos = q;
+    const std::size_t n = static_cast<std::size_t>(pic.width) * pic.height;
+    const std::vector<std::uint8_t> rgba = ToRgba8(pic.color);
+    v.rgb.resize(3 * n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) v.rgb[3 * i + c] = rgba[4 * i + c];
+    v.depth = DepthImage(pic);
+    v.link.assign(n, -1);
+    v.point.assign(n, Eigen::Vector3f::Zero());
+    for (std::size_t i = 0; i < n; ++i) {
+      auto it = entity_link_.find(pic.segmentation[2 * i + 1]);
+      if (it != entity_link_.end()) v.link[i] = it->second;
+      if (v.depth[i] > 0)  // OpenGL camera frame (x right, y up, z back) -> OpenCV
+        v.point[i] = Eigen::Vector3f(pic.position[4 * i], -pic.position[4 * i + 1],
+                                     -pic.position[4 * i + 2]);
+    }
+    return v;
+  }
+
+ private:
+  const DatasetOptions& options_;
+  std::unique_ptr<Scene> scene_;
+  PartNetMobilityObject object_;
+  Articulation articulation_;
+  Camera camera_;
+  std::map<std::uint32_t, int> entity_link_;  // render entity id -> link index
+  Eigen::MatrixX2d limits_;
+};
+
+// Link index -> its PartNet entry (only labelled links of the file).
+std::map<int, const PartNetLink*> LabelledLinks(const PartNetMobilityObject& o) {
+  std::map<int, const PartNetLink*> out;
+  for (const PartNetLink& l : o.links) {
+    if (l.semantic_label.empty()) continue;
+    try {
+      out[o.LinkIndex(l.id)] = &l;
+    } catch (const Error&) {
+      // an entry of mobility_v2.json without a link in mobility.urdf: nothing to annotate
+    }
+  }
+  return out;
+}
+
+void WriteViewPictures(const std::string& dir, const std::string& stem, const View& v) {
+  WritePng(dir + "/rgb/" + stem + ".png", v.width, v.height, 3, v.rgb.data());
+  WriteDepthPng(dir + "/depth/" + stem + ".png", v.width, v.height, v.depth.data());
+  WriteNpy(dir + "/depth/" + stem + ".npy", v.depth.data(),
+           {static_cast<std::size_t>(v.height), static_cast<std::size_t>(v.width)});
+}
+
+json CameraJson(const View& v) {
+  return {{"K", MatrixJson(v.K)},
+          {"extrinsic", MatrixJson(v.extrinsic)},
+          {"pose", PoseJson(v.X_WC)},
+          {"width", v.width},
+          {"height", v.height}};
+}
+
+json RleJson(const Rle& rle) {
+  return {{"size", {rle.height, rle.width}}, {"counts", CompressRleCounts(rle.counts)}};
+}
+
+Mask MaskOf(const View& v, int link) {
+  Mask m(v.width, v.height, 0);
+  for (std::size_t i = 0; i < v.link.size(); ++i) m.data[i] = v.link[i] == link ? 1 : 0;
+  return m;
+}
+
+// The detection views of one object into `dir`; returns views.json.
+json RenderDetectionObject(const DatasetOptions& options, const std::string& folder,
+                           const std::string& name, const std::map<std::string, int>& category_ids,
+                           const std::string& dir, long* views_rendered) {
+  ObjectRenderer r(options, folder);
+  const PartNetMobilityObject& o = r.Object();
+  const std::string category = CategoryOf(o);
+  const std::map<int, const PartNetLink*> labelled = LabelledLinks(o);
+  for (const char* sub : {"rgb", "depth", "instances", "cloud"})
+    fs::create_directories(dir + "/" + sub);
+  Random rng(Hash(options.seed, name));
+  const double min_pixels = options.min_area_fraction * options.size * options.size;
+  json views = json::array();
+  for (int k = 0; k < options.views; ++k) {
+    const Eigen::VectorXd q = r.DrawJointPositions(&rng);
+    const View v = r.Render(q, &rng);
+    ++*views_rendered;
+    const std::string stem = Two(k);
+    WriteViewPictures(dir, stem, v);
+    // pixel counts of the labelled links seen; instances numbered in link order
+    std::map<int, long> pixels;
+    for (int l : v.link)
+      if (l >= 0 && labelled.count(l)) ++pixels[l];
+    std::map<int, int> instance_of;  // link -> instance number (1-based)
+    json instances = json::array();
+    for (const auto& [link, count] : pixels) {
+      if (static_cast<double>(count) < min_pixels) continue;
+      const PartNetLink& pl = *labelled.at(link);
+      const int number = static_cast<int>(instance_of.size()) + 1;
+      instance_of[link] = number;
+      const Rle rle = EncodeMask(MaskOf(v, link));
+      const std::array<double, 4> box = RleBoundingBox(rle);
+      instances.push_back({{"instance", number},
+                           {"link", r.GetArticulation().GetLink(link).GetName()},
+                           {"label", pl.semantic_label},
+                           {"category", PartCategory(category, pl)},
+                           {"joint", pl.joint},
+                           {"area", RleArea(rle)},
+                           {"bbox", {box[0], box[1], box[2], box[3]}},
+                           {"segmentation", RleJson(rle)}});
+    }
+    const std::size_t n = v.link.size();
+    std::vector<std::uint16_t> instance_map(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      auto it = instance_of.find(v.link[i]);
+      if (it != instance_of.end()) instance_map[i] = static_cast<std::uint16_t>(it->second);
+    }
+    WritePng16(dir + "/instances/" + stem + ".png", v.width, v.height, instance_map.data());
+    if (options.point_clouds) {
+      std::vector<float> xyz;
+      std::vector<std::uint8_t> rgb;
+      std::vector<std::int32_t> instance, label;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!(v.depth[i] > 0)) continue;
+        for (int c = 0; c < 3; ++c) {
+          xyz.push_back(v.point[i][c]);
+          rgb.push_back(v.rgb[3 * i + c]);
+        }
+        auto it = instance_of.find(v.link[i]);
+        instance.push_back(it == instance_of.end() ? 0 : it->second);
+        int id = 0;
+        if (it != instance_of.end())
+          id = category_ids.at(PartCategory(category, *labelled.at(v.link[i])));
+        label.push_back(id);
+      }
+      const std::size_t m = instance.size();
+      internal::WriteNpz(
+          dir + "/cloud/" + stem + ".npz",
+          {internal::MakeNpyArray("xyz", xyz, {m, 3}), internal::MakeNpyArray("rgb", rgb, {m, 3}),
+           internal::MakeNpyArray("instance", instance, {m}),
+           internal::MakeNpyArray("label", label, {m})});
+    }
+    views.push_back({{"view", k},
+                     {"rgb", "rgb/" + stem + ".png"},
+                     {"depth", "depth/" + stem + ".png"},
+                     {"depth_npy", "depth/" + stem + ".npy"},
+                     {"instances_png", "instances/" + stem + ".png"},
+                     {"cloud", options.point_clouds ? "cloud/" + stem + ".npz" : ""},
+                     {"camera", CameraJson(v)},
+                     {"qpos", std::vector<double>(q.data(), q.data() + q.size())},
+                     {"instances", instances}});
+  }
+  return {{"object", name}, {"category", category}, {"views", views}};
+}
+
+// The motion samples of one object into `dir`; returns views.json. Per door or drawer, `views`
+// samples; a sample whose camera does not see the part (fewer pixels than the threshold) is
+// drawn again, at most 10 times, then left out.
+json RenderMotionObject(const DatasetOptions& options, const std::string& folder,
+                        const std::string& name, const std::string& dir, long* views_rendered) {
+  ObjectRenderer r(options, folder);
+  const PartNetMobilityObject& o = r.Object();
+  Articulation& art = r.GetArticulation();
+  for (const char* sub : {"rgb", "depth", "mask"}) fs::create_directories(dir + "/" + sub);
+  Random rng(Hash(options.seed, name));
+  const double min_pixels = options.min_area_fraction * options.size * options.size;
+  json samples = json::array();
+  for (const auto& [link, pl] : LabelledLinks(o)) {
+    const Target target = TargetOf(*pl);
+    if (target == Target::kNone) continue;
+    const Joint joint = art.GetJoint(link);
+    const int dof = joint.GetDofIndex();
+    if (dof < 0) continue;
+    for (int k = 0; k < options.views; ++k) {
+      bool seen = false;
+      View v;
+      for (int attempt = 0; attempt < 10 && !seen; ++attempt) {
+        v = r.Render(r.DrawJointPositions(&rng), &rng);
+        ++*views_rendered;
+        long count = std::count(v.link.begin(), v.link.end(), link);
+        seen = static_cast<double>(count) >= min_pixels;
+      }
+      if (!seen) continue;
+      const std::string stem = art.GetLink(link).GetName() + "_" + Two(k);
+      WriteViewPictures(dir, stem, v);
+      std::vector<std::uint8_t> mask(v.link.size());
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      long count = 0;
+      for (std::size_t i = 0; i < v.link.size(); ++i) {
+        mask[i] = v.link[i] == link ? 255 : 0;
+        if (mask[i] && v.depth[i] > 0) {
+          centroid += v.point[i].cast<double>();
+          ++count;
+        }
+      }
+      if (count > 0) centroid /= static_cast<double>(count);
+      WritePng(dir + "/mask/" + stem + ".png", v.width, v.height, 1, mask.data());
+      // the joint's axis in the OpenCV camera frame; the pivot is the point of the axis nearest
+      // the centroid of the part's visible points
+      art.SetQpos(v.qpos);
+      const Pose X_WJ = joint.GetGlobalPose();
+      const Eigen::Matrix3d R = v.extrinsic.leftCols<3>();
+      const Eigen::Vector3d t = v.extrinsic.col(3);
+      const Eigen::Vector3d origin = R * X_WJ.p + t;
+      const Eigen::Vector3d axis = (R * (X_WJ.q * Eigen::Vector3d::UnitX())).normalized();
+      const Eigen::Vector3d pivot = origin + axis * axis.dot(centroid - origin);
+      const double lower = joint.GetLimits()[0];
+      const double state = v.qpos[dof] - (std::isfinite(lower) ? lower : 0.0);
+      samples.push_back(
+          {{"sample_id", name + "/" + stem},
+           {"link", art.GetLink(link).GetName()},
+           {"label", pl->semantic_label},
+           {"type", target == Target::kDoor ? "hinge" : "slider"},
+           {"rgb", "rgb/" + stem + ".png"},
+           {"depth", "depth/" + stem + ".png"},
+           {"depth_npy", "depth/" + stem + ".npy"},
+           {"mask", "mask/" + stem + ".png"},
+           {"camera", CameraJson(v)},
+           {"qpos", std::vector<double>(v.qpos.data(), v.qpos.data() + v.qpos.size())},
+           {"pivot", {pivot.x(), pivot.y(), pivot.z()}},
+           {"axis", {axis.x(), axis.y(), axis.z()}},
+           {"state", state}});
+    }
+  }
+  return {{"object", name}, {"category", CategoryOf(o)}, {"samples", samples}};
+}
+
+// ---------------------------------------------------------------------------------------------
+// the split files
+
+void Merge(const DatasetOptions& options, const std::vector<ObjectInfo>& objects,
+           const std::vector<std::string>& categories, double slider_range,
+           DatasetSummary* summary) {
+  const std::string objects_dir = options.out + "/objects";
+  json split[2];  // train, test
+  std::set<std::string> objects_in[2];
+  long annotation_id = 0;
+  if (options.kind == DatasetKind::kDetection) {
+    for (json& s : split) {
+      s["info"] = {{"description", "partsim movable-part detection"},
+                   {"seed", options.seed},
+                   {"views", options.views}};
+      s["images"] = json::array();
+      s["annotations"] = json::array();
+      s["categories"] = json::array();
+      for (std::size_t c = 0; c < categories.size(); ++c) {
+        const std::string& n = categories[c];
+        s["categories"].push_back(
+            {{"id", c + 1}, {"name", n}, {"supercategory", n.substr(0, n.find('/'))}});
+      }
+    }
+  } else {
+    for (json& s : split) {
+      s["slider_range"] = slider_range;
+      s["samples"] = json::array();
+    }
+  }
+  std::map<std::string, std::size_t> category_id;
+  for (std::size_t c = 0; c < categories.size(); ++c) category_id[categories[c]] = c + 1;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    const ObjectInfo& info = objects[i];
+    const std::string dir = objects_dir + "/" + info.name;
+    if (!fs::exists(dir + "/" + kDone)) continue;
+    const int s = info.train ? 0 : 1;
+    objects_in[s].insert(info.name);
+    const json doc = partsim::internal::ParseJsonBounded(partsim::internal::ReadWholeFile(
+        dir + "/views.json", "vision dataset", kMaxDatasetFileBytes));
+    const std::string prefix = "objects/" + info.name + "/";
+    if (options.kind == DatasetKind::kDetection) {
+      for (const json& v : doc.at("views")) {
+        const long image_id = static_cast<long>(i) * options.views + v.at("view").get<long>() + 1;
+        split[s]["images"].push_back({{"id", image_id},
+                                      {"file_name", prefix + v.at("rgb").get<std::string>()},
+                                      {"width", v.at("camera").at("width")},
+                                      {"height", v.at("camera").at("height")},
+                                      {"object", info.name},
+                                      {"view", v.at("view")}});
+        for (const json& inst : v.at("instances")) {
+          split[s]["annotations"].push_back(
+              {{"id", ++annotation_id},
+               {"image_id", image_id},
+               {"category_id", category_id.at(inst.at("category").get<std::string>())},
+               {"segmentation", inst.at("segmentation")},
+               {"area", inst.at("area")},
+               {"bbox", inst.at("bbox")},
+               {"iscrowd", 0}});
+        }
+      }
+    } else {
+      for (const json& smp : doc.at("samples")) {
+        const bool hinge = smp.at("type") == "hinge";
+        const std::vector<double> pivot = smp.at("pivot"), axis = smp.at("axis");
+        const double state = smp.at("state");
+        std::vector<double> m(13, 0.0);
+        m[hinge ? 0 : 1] = 1;
+        if (hinge) {
+          for (int c = 0; c < 3; ++c) m[2 + c] = pivot[c], m[5 + c] = axis[c];
+          m[11] = state / (2 * kPi);
+        } else {
+          for (int c = 0; c < 3; ++c) m[8 + c] = axis[c];
+          m[12] = slider_range > 0 ? state / slider_range : 0.0;
+        }
+        json entry = smp;
+        for (const char* key : {"rgb", "depth", "depth_npy", "mask"})
+          entry[key] = prefix + smp.at(key).get<std::string>();
+        entry["object"] = info.name;
+        entry["category"] = info.category;
+        entry["m"] = m;
+        split[s]["samples"].push_back(entry);
+      }
+    }
+  }
+  const bool detection = options.kind == DatasetKind::kDetection;
+  const char* names[2] = {detection ? "instances_train.json" : "motion_train.json",
+                          detection ? "instances_test.json" : "motion_test.json"};
+  for (int s = 0; s < 2; ++s) WriteTextAtomic(options.out + "/" + names[s], split[s].dump());
+  summary->train_objects = static_cast<int>(objects_in[0].size());
+  summary->test_objects = static_cast<int>(objects_in[1].size());
+  const char* key = detection ? "images" : "samples";
+  summary->train_images = static_cast<long>(split[0][key].size());
+  summary->test_images = static_cast<long>(split[1][key].size());
+  summary->annotations = annotation_id;
+  summary->slider_range = slider_range;
+}
+
+void CheckOptions(const DatasetOptions& o) {
+  PARTSIM_THROW_UNLESS(!o.dataset_root.empty(), "vision dataset: --dataset is required");
+  PARTSIM_THROW_UNLESS(!o.out.empty(), "vision dataset: --out is required");
+  PARTSIM_THROW_UNLESS(
+      o.views >= 1 && o.views <= 10000,
+      "vision dataset: --views must be in [1, 10000], got " + std::to_string(o.views));
+  PARTSIM_THROW_UNLESS(
+      o.size >= 16 && o.size <= 4096,
+      "vision dataset: --size must be in [16, 4096], got " + std::to_string(o.size));
+  PARTSIM_THROW_UNLESS(o.split >= 0 && o.split <= 1,
+                       "vision dataset: --split must be in [0, 1], got " + FormatNumber(o.split));
+  PARTSIM_THROW_UNLESS(o.jobs >= 1 && o.jobs <= 256,
+                       "vision dataset: --jobs must be in [1, 256], got " + std::to_string(o.jobs));
+  PARTSIM_THROW_UNLESS(o.shard_count >= 1 && o.shard_index >= 0 && o.shard_index < o.shard_count,
+                       "vision dataset: --shard i/N needs 0 <= i < N, got " +
+                           std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count));
+  PARTSIM_THROW_UNLESS(
+      o.backend == "rasterizer" || o.backend == "pathtracer",
+      "vision dataset: --backend must be rasterizer or pathtracer, got '" + o.backend + "'");
+  PARTSIM_THROW_UNLESS(o.min_area_fraction >= 0 && o.min_area_fraction < 1,
+                       "vision dataset: the minimum area fraction must be in [0, 1)");
+  PARTSIM_THROW_UNLESS(o.fovy_degrees > 1 && o.fovy_degrees < 170,
+                       "vision dataset: the field of view must be in (1, 170) degrees");
+}
+
+// The options that decide the bytes of a dataset, as dataset.json records them; a run into an
+// existing dataset must agree with them.
+json DefiningOptions(const DatasetOptions& o) {
+  return {{"kind", o.kind == DatasetKind::kDetection ? "detection" : "motion"},
+          {"views", o.views},
+          {"size", o.size},
+          {"seed", o.seed},
+          {"split", o.split},
+          {"backend", o.backend},
+          {"min_area_fraction", o.min_area_fraction},
+          {"fovy_degrees", o.fovy_degrees},
+          {"point_clouds", o.point_clouds}};
+}
+
+std::string Duration(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  return buf;
+}
+
+}  // namespace
+
+DatasetSummary GenerateDataset(const DatasetOptions& options) {
+  CheckOptions(options);
+  const auto start = std::chrono::steady_clock::now();
+  DatasetSummary summary;
+  const std::vector<std::string> folders = FindObjectFolders(options.dataset_root);
+  fs::create_directories(options.out + "/objects");
+
+  // the dataset as a whole: every object's category, labels and targets (for the split, the
+  // category ids and the slider range), whichever shard renders it
+  std::vector<ObjectInfo> objects;
+  PartNetMobilityLoader loader;
+  for (const std::string& folder : folders) {
+    ObjectInfo info;
+    info.folder = folder;
+    info.name = ObjectName(options.dataset_root, folder);
+    try {
+      const PartNetMobilityObject o = loader.Parse(folder);
+      info.category = CategoryOf(o);
+      for (const auto& [link, pl] : LabelledLinks(o)) {
+        info.labels.push_back(PartCategory(info.category, *pl));
+        const Target t = TargetOf(*pl);
+        if (t == Target::kDoor) ++info.doors;
+        if (t == Target::kDrawer) {
+          ++info.drawers;
+          const JointDesc& j = o.articulation.links[link].joint;
+          if (std::isfinite(j.upper - j.lower))
+            info.max_slider_range = std::max(info.max_slider_range, j.upper - j.lower);
+        }
+      }
+    } catch (const Error& e) {
+      summary.errors.push_back(folder + ": " + e.what());
+      ++summary.failed;
+      continue;
+    }
+    if (options.kind == DatasetKind::kMotion && info.doors + info.drawers == 0) continue;
+    objects.push_back(std::move(info));
+  }
+  if (objects.empty())
+    throw Error("vision dataset: none of the " + std::to_string(folders.size()) +
+                " objects under '" + options.dataset_root + "' can be used" +
+                (options.kind == DatasetKind::kMotion
+                     ? " (the motion dataset needs doors or drawers)"
+                     : "") +
+                (summary.errors.empty() ? "" : "; first error: " + summary.errors.front()));
+  summary.objects = static_cast<int>(objects.size());
+
+  // the split: per category, objects ordered by a hash of the seed and their name; the first
+  // round(split * n) train, at most n - 1 when n >= 2
+  std::map<std::string, std::vector<std::size_t>> by_category;
+  for (std::size_t i = 0; i < objects.size(); ++i) by_category[objects[i].category].push_back(i);
+  for (auto& [category, members] : by_category) {
+    std::sort(members.begin(), members.end(), [&](std::size_t a, std::size_t b) {
+      return Hash(options.seed, objects[a].name) < Hash(options.seed, objects[b].name);
+    });
+    auto train = static_cast<std::size_t>(std::lround(options.split * members.size()));
+    // a category of two or more objects keeps one for testing (unless split is 1)
+    if (members.size() >= 2 && options.split < 1) train = std::min(train, members.size() - 1);
+    for (std::size_t k = 0; k < members.size(); ++k) objects[members[k]].train = k < train;
+  }
+  std::set<std::string> category_set;
+  double slider_range = 0;
+  for (const ObjectInfo& o : objects) {
+    category_set.insert(o.labels.begin(), o.labels.end());
+    slider_range = std::max(slider_range, o.max_slider_range);
+  }
+  const std::vector<std::string> categories(category_set.begin(), category_set.end());
+  std::map<std::string, int> category_ids;
+  for (std::size_t c = 0; c < categories.size(); ++c)
+    category_ids[categories[c]] = static_cast<int>(c) + 1;
+
+  // dataset.json: the options that decide the bytes; another run into the folder must agree
+  const std::string manifest = options.out + "/dataset.json";
+  const json defining = DefiningOptions(options);
+  if (fs::exists(manifest)) {
+    const json old = partsim::internal::ParseJsonBounded(
+        partsim::internal::ReadWholeFile(manifest, "vision dataset", kMaxDatasetFileBytes));
+    if (old.value("options", json()) != defining)
+      throw Error("vision dataset: '" + options.out +
+                  "' holds a dataset made with other options (" +
+                  old.value("options", json()).dump() + "; this run: " + defining.dump() +
+                  "): use another --out, or the same options to resume");
+  }
+  json split_json = json::object();
+  for (const ObjectInfo& o : objects) split_json[o.name] = o.train ? "train" : "test";
+  WriteTextAtomic(manifest, json({{"options", defining},
+                                  {"categories", categories},
+                                  {"slider_range", slider_range},
+                                  {"split", split_json}})
+                                .dump(1));
+
+  // this shard's objects that are not done yet
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    if (static_cast<int>(i % options.shard_count) != options.shard_index) continue;
+    if (fs::exists(options.out + "/objects/" + objects[i].name + "/" + kDone)) {
+      ++summary.skipped;
+      continue;
+    }
+    todo.push_back(i);
+  }
+  if (!options.merge_only && !todo.empty()) {
+    std::mutex mutex;
+    long done = 0;
+    partsim::internal::ProgressLine progress(stderr);
+    partsim::internal::WorkerPool pool(std::min<int>(options.jobs, static_cast<int>(todo.size())));
+    pool.Start(static_cast<int>(todo.size()), [&](int part) {
+      const ObjectInfo& info = objects[todo[static_cast<std::size_t>(part)]];
+      const std::string final_dir = options.out + "/objects/" + info.name;
+      const std::string dir = final_dir + ".partial";
+      long views = 0;
+      std::string error;
+      try {
+        fs::remove_all(dir);  // a torn earlier attempt
+        fs::remove_all(final_dir);
+        fs::create_directories(dir);
+        const json doc =
+            options.kind == DatasetKind::kDetection
+                ? RenderDetectionObject(options, info.folder, info.name, category_ids, dir, &views)
+                : RenderMotionObject(options, info.folder, info.name, dir, &views);
+        WriteText(dir + "/views.json", doc.dump(1));
+        WriteText(dir + "/" + kDone, "");
+        fs::rename(dir, final_dir);
+      } catch (const std::exception& e) {
+        error = info.folder + ": " + e.what();
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      summary.views += views;
+      if (error.empty()) {
+        ++summary.rendered;
+      } else {
+        ++summary.failed;
+        summary.errors.push_back(error);
+      }
+      ++done;
+      if (options.progress) {
+        const double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double rate = summary.views / std::max(elapsed, 1e-9);
+        const double eta = elapsed / static_cast<double>(done) *
+                           static_cast<double>(static_cast<long>(todo.size()) - done);
+        std::ostringstream text;
+        text << "[" << done << "/" << todo.size() << "] " << info.name << "  "
+             << FormatNumber(std::round(rate * 10) / 10) << " views/s  elapsed "
+             << Duration(elapsed) << "  eta " << Duration(eta);
+        progress.Update(done, static_cast<long>(todo.size()), text.str());
+      }
+    });
+    pool.Wait();
+    progress.Break();
+  }
+  std::sort(summary.errors.begin(), summary.errors.end());
+  Merge(options, objects, categories, slider_range, &summary);
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace partsim::vision

@@ -1,0 +1,233 @@
+// The perception datasets: same bytes whatever the jobs and shards, resume, the split, the
+// COCO files read back by partsim's own COCO reader, bad options.
+#include "partsim/vision/dataset.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "partsim/assets/generator.h"
+#include "partsim/core/error.h"
+#include "partsim/vision/coco_dataset.h"
+#include "partsim/vision/evaluate.h"
+
+namespace partsim::vision {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Removes this process's folders when it ends.
+struct RemoveTempFolders {
+  ~RemoveTempFolders() {
+    const std::string prefix = "partsim_dataset_test_" + std::to_string(::getpid()) + "_";
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(fs::temp_directory_path(), ec))
+      if (e.path().filename().string().rfind(prefix, 0) == 0) fs::remove_all(e.path(), ec);
+  }
+} remove_temp_folders;
+
+// A fresh folder of this process (ctest runs the tests of this file in parallel processes).
+std::string Temp(const std::string& name) {
+  const std::string dir = (fs::temp_directory_path() /
+                           ("partsim_dataset_test_" + std::to_string(::getpid()) + "_" + name))
+                              .string();
+  fs::remove_all(dir);
+  return dir;
+}
+
+// A small generated tree: two cabinets (doors and drawers), a refrigerator and a faucet.
+std::string MakeTree() {
+  static const std::string root = [] {
+    const std::string dir = Temp("tree");
+    int i = 0;
+    for (const char* category :
+         {"StorageFurniture", "StorageFurniture", "Refrigerator", "Faucet"}) {
+      const GeneratedObject o = GenerateObject(category, i++, 3);
+      WriteObject(o, dir + "/" + o.anno_id);
+    }
+    return dir;
+  }();
+  return root;
+}
+
+DatasetOptions SmallOptions(const std::string& out, DatasetKind kind) {
+  DatasetOptions o;
+  o.dataset_root = MakeTree();
+  o.out = out;
+  o.kind = kind;
+  o.views = 2;
+  o.size = 64;
+  o.seed = 5;
+  o.progress = false;
+  return o;
+}
+
+// Every file under `dir` (relative path -> bytes).
+std::map<std::string, std::string> Files(const std::string& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    std::ifstream f(e.path(), std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    out[fs::relative(e.path(), dir).generic_string()] = s.str();
+  }
+  return out;
+}
+
+TEST(DatasetTest, DetectionDatasetIsTheSameWhateverTheJobsAndShards) {
+  const std::string one = Temp("one"), two = Temp("two"), sharded = Temp("sharded");
+  DatasetOptions o = SmallOptions(one, DatasetKind::kDetection);
+  const DatasetSummary s1 = GenerateDataset(o);
+  EXPECT_EQ(s1.objects, 4);
+  EXPECT_EQ(s1.rendered, 4);
+  EXPECT_EQ(s1.failed, 0) << (s1.errors.empty() ? "" : s1.errors.front());
+  EXPECT_EQ(s1.views, 8);
+  EXPECT_EQ(s1.train_images + s1.test_images, 8);
+  EXPECT_GT(s1.annotations, 0);
+  o.out = two;
+  o.jobs = 2;
+  GenerateDataset(o);
+  EXPECT_EQ(Files(one), Files(two));
+  o.out = sharded;
+  o.jobs = 1;
+  o.shard_count = 2;
+  o.shard_index = 1;
+  const DatasetSummary half = GenerateDataset(o);
+  EXPECT_EQ(half.rendered, 2);
+  o.shard_index = 0;
+  GenerateDataset(o);
+  EXPECT_EQ(Files(one), Files(sharded));
+  // read back by the COCO reader, which checks ids, sizes and RLE
+  const CocoDataset train = LoadCocoDataset(one + "/instances_train.json");
+  const CocoDataset test = LoadCocoDataset(one + "/instances_test.json");
+  EXPECT_EQ(train.images.size() + test.images.size(), 8u);
+  EXPECT_EQ(train.categories.size(), test.categories.size());
+  bool door = false;
+  for (const CocoCategory& c : train.categories) {
+    EXPECT_NE(c.name.find('/'), std::string::npos) << c.name;
+    door = door || c.name == "StorageFurniture/drawer";
+  }
+  EXPECT_TRUE(door);
+  for (const CocoAnnotation& a : train.annotations) {
+    EXPECT_EQ(a.area, static_cast<double>(RleArea(a.segmentation)));
+    EXPECT_GE(a.area, 64.0 * 64.0 / 4096.0);
+  }
+  // the ground truth scores 100 against itself
+  std::vector<CocoDetection> perfect;
+  for (const CocoAnnotation& a : train.annotations)
+    perfect.push_back({a.image_id, a.category_id, a.segmentation, 1.0});
+  EXPECT_NEAR(EvaluateDetection(train, perfect).map, 1.0, 1e-12);
+}
+
+TEST(DatasetTest, SplitIsByObjectWithinEachCategory) {
+  const std::string out = Temp("split");
+  DatasetOptions o = SmallOptions(out, DatasetKind::kDetection);
+  o.views = 1;
+  GenerateDataset(o);
+  std::ifstream f(out + "/dataset.json");
+  std::stringstream text;
+  text << f.rdbuf();
+  // two cabinets: round(0.75 * 2) = 2, at most 1 of 2 train; one refrigerator, one faucet:
+  // round(0.75) = 1 train
+  const std::string s = text.str();
+  EXPECT_EQ(s.find("\"test\""), s.rfind("\"test\"")) << s;
+  EXPECT_NE(s.find("\"test\""), std::string::npos) << s;
+  o.split = 0.5;
+  o.out = Temp("split_half");
+  const DatasetSummary half = GenerateDataset(o);
+  // 0.5 of two cabinets: one in each split; round(0.5) = 1 (half away from zero) for the others
+  EXPECT_EQ(half.test_objects, 1);
+  EXPECT_EQ(half.train_objects, 3);
+}
+
+TEST(DatasetTest, ResumeSkipsDoneObjectsAndRedoesTornOnes) {
+  const std::string out = Temp("resume");
+  DatasetOptions o = SmallOptions(out, DatasetKind::kDetection);
+  o.views = 1;
+  GenerateDataset(o);
+  const auto before = Files(out);
+  // one object torn: its DONE marker gone and a stale partial folder beside it
+  std::string torn;
+  for (const auto& e : fs::directory_iterator(out + "/objects")) torn = e.path().string();
+  fs::remove(torn + "/DONE");
+  fs::create_directories(torn + ".partial/rgb");
+  const DatasetSummary again = GenerateDataset(o);
+  EXPECT_EQ(again.skipped, 3);
+  EXPECT_EQ(again.rendered, 1);
+  EXPECT_FALSE(fs::exists(torn + ".partial"));
+  EXPECT_EQ(Files(out), before);
+  // other options into the same folder are refused, naming what differs
+  o.views = 3;
+  try {
+    GenerateDataset(o);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("other options"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DatasetTest, MotionDatasetHasDoorsAndDrawersWithUnitAxes) {
+  const std::string out = Temp("motion");
+  DatasetOptions o = SmallOptions(out, DatasetKind::kMotion);
+  o.views = 1;
+  const DatasetSummary s = GenerateDataset(o);
+  EXPECT_EQ(s.objects, 3);  // the faucet has neither
+  EXPECT_GT(s.slider_range, 0);
+  const MotionGroundTruth train = LoadMotionGroundTruth(out + "/motion_train.json");
+  EXPECT_EQ(train.slider_range, s.slider_range);
+  int hinges = 0, sliders = 0;
+  for (const MotionSample& m : train.samples) {
+    const bool hinge = m.m[kMotionHinge] == 1;
+    hinges += hinge;
+    sliders += !hinge;
+    const int axis = hinge ? kMotionHingeAxis : kMotionSliderAxis;
+    EXPECT_NEAR(std::hypot(m.m[axis], m.m[axis + 1], m.m[axis + 2]), 1.0, 1e-9);
+    const double state = hinge ? m.m[kMotionDoorState] : m.m[kMotionDrawerState];
+    EXPECT_GE(state, -1e-9);
+    EXPECT_LE(state, 1.0 + 1e-9);
+  }
+  EXPECT_GT(hinges, 0);
+  EXPECT_GT(sliders, 0);
+  // the ground truth scores perfectly against itself
+  const MotionEvaluation e = EvaluateMotion(train, train.samples);
+  EXPECT_EQ(e.hinge_accuracy, 1.0);
+  EXPECT_NEAR(e.hinge_axis_error, 0.0, 1e-6);
+  EXPECT_NEAR(e.hinge_origin_error, 0.0, 1e-9);
+}
+
+TEST(DatasetTest, BadOptionsAreRefusedByName) {
+  DatasetOptions o = SmallOptions(Temp("bad"), DatasetKind::kDetection);
+  auto refused = [&](DatasetOptions bad, const std::string& word) {
+    try {
+      GenerateDataset(bad);
+      ADD_FAILURE() << "expected an error naming " << word;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what();
+    }
+  };
+  DatasetOptions b = o;
+  b.views = 0;
+  refused(b, "--views");
+  b = o;
+  b.shard_index = 2;
+  b.shard_count = 2;
+  refused(b, "--shard");
+  b = o;
+  b.backend = "vulkan";
+  refused(b, "--backend");
+  b = o;
+  b.split = 1.5;
+  refused(b, "--split");
+  b = o;
+  b.dataset_root = Temp("empty");
+  fs::create_directories(b.dataset_root);
+  refused(b, "no PartNet-Mobility object");
+}
+
+}  // namespace
+}  // namespace partsim::vision
