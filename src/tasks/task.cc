@@ -268,6 +268,31 @@ TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
   ee_link = robot.FindLinkByName(robot_model.ee_link).GetIndex();
   for (const Link& l : robot.GetLinks())
     if (l.GetName().find("finger") != std::string::npos) finger_links.push_back(l.GetIndex());
+  // gravity compensation's tables: the links below each dof's joint (parents come first)
+  const std::vector<LinkDesc>& rlinks = robot_model.articulation.links;
+  for (size_t i = 0; i < rlinks.size(); ++i)
+    robot_link_mass.push_back(robot.GetLink(static_cast<int>(i)).GetMass());
+  for (const Joint& j : robot.GetActiveJoints()) {
+    GravityJoint g;
+    g.joint = j.GetIndex();
+    const JointType type = j.GetType();
+    if (type != JointType::kPrismatic && type != JointType::kRevolute &&
+        type != JointType::kContinuous) {
+      gravity_joints.clear();  // GravityCompensation falls back to ComputePassiveForce
+      break;
+    }
+    g.revolute = type != JointType::kPrismatic;
+    std::vector<bool> below(rlinks.size(), false);
+    below[static_cast<size_t>(g.joint)] = true;
+    for (size_t i = 0; i < rlinks.size(); ++i) {
+      const int parent = rlinks[i].parent;
+      if (parent >= 0 && below[static_cast<size_t>(parent)]) below[i] = true;
+      if (!below[i]) continue;
+      g.links.push_back(static_cast<int>(i));
+      g.mass += robot_link_mass[i];
+    }
+    gravity_joints.push_back(g);
+  }
 
   // render ids of the candidates and their handles
   for (const RenderEntityInfo& e : scene->GetRenderEntities())
@@ -475,6 +500,33 @@ void TaskImpl::ApplyAction(const Eigen::VectorXd& action) {
   SetGripper(0.5 * (std::clamp(action[6], -1.0, 1.0) + 1.0));
 }
 
+Eigen::VectorXd TaskImpl::GravityCompensation() const {
+  if (gravity_joints.empty() && robot.Dof() > 0) return robot.ComputePassiveForce(true, false);
+  const Eigen::Vector3d g = scene->GetGravity();
+  // mass-weighted centres of mass of the robot's links (world)
+  std::vector<Eigen::Vector3d> mc(robot_link_mass.size());
+  for (size_t i = 0; i < mc.size(); ++i)
+    mc[i] = robot_link_mass[i] * robot.GetLink(static_cast<int>(i)).GetCMassPose().p;
+  Eigen::VectorXd out(static_cast<Eigen::Index>(gravity_joints.size()));
+  for (size_t k = 0; k < gravity_joints.size(); ++k) {
+    const GravityJoint& gj = gravity_joints[k];
+    const Pose X_WJ = robot.GetJoint(gj.joint).GetGlobalPose();
+    const Eigen::Vector3d axis = X_WJ.q * Eigen::Vector3d::UnitX();
+    // gravity's generalized force on the dof: sum over the moved links of m J^T g, J the
+    // Jacobian of the link's centre of mass (axis, or axis x (c - p) for a turning joint)
+    double f = 0.0;
+    if (gj.revolute) {
+      Eigen::Vector3d moment = -gj.mass * X_WJ.p;
+      for (int i : gj.links) moment += mc[static_cast<size_t>(i)];
+      f = axis.cross(moment).dot(g);
+    } else {
+      f = gj.mass * axis.dot(g);
+    }
+    out[static_cast<Eigen::Index>(k)] = -f;
+  }
+  return out;
+}
+
 void TaskImpl::StepControl() {
   const double dt = scene->GetTimestep();
   const double before = Progress();
@@ -504,7 +556,7 @@ void TaskImpl::StepControl() {
     robot.SetDriveTarget(target);
     robot.SetDriveVelocityTarget(vtarget);
     // gravity compensation of the hand (the paper's flying gripper ignores gravity)
-    robot.SetQf(robot.ComputePassiveForce(true, false));
+    robot.SetQf(GravityCompensation());
     scene->Step();
   }
   // reward

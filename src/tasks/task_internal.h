@@ -56,6 +56,11 @@ struct TaskImpl {
   bool TouchesTarget() const;
   void ApplyAction(const Eigen::VectorXd& action);
   void StepControl();
+  /// Generalized force that cancels gravity on the robot's dofs (what
+  /// Articulation::ComputePassiveForce(true, false, false) returns) from the links' centres of
+  /// mass and the joints' world frames: the forward kinematics only, no mj_forward (no collision
+  /// detection, no constraint solve) as ComputePassiveForce needs.
+  Eigen::VectorXd GravityCompensation() const;
   void TakePictures();
   Eigen::VectorXd RobotState() const;
   Eigen::VectorXd RawObservation() const;
@@ -81,6 +86,16 @@ struct TaskImpl {
   std::map<int, std::vector<uint32_t>> handle_visuals;
   std::vector<int> arm_dofs, finger_dofs, finger_links;
   int ee_link = -1;
+  /// Per robot dof (qpos order): the joint index, whether it turns, and the robot's links moved
+  /// by it (the child's subtree) with their total mass.
+  struct GravityJoint {
+    int joint = -1;
+    bool revolute = false;
+    std::vector<int> links;
+    double mass = 0.0;
+  };
+  std::vector<GravityJoint> gravity_joints;
+  std::vector<double> robot_link_mass;
   std::vector<Camera> cameras;
   std::optional<Camera> video_camera;  // TaskOptions::video_width
   std::vector<char> initial_state;
