@@ -20,6 +20,10 @@ JSON file::
     item = train[0]          # rgb, depth, instance, masks, labels, boxes, K, extrinsic, ...
     cloud = train.point_cloud(0)
     motion = vision.MotionDataset("motion_out", "test").torch()  # (5 x H x W, m) pairs
+
+show draws one picture of such a dataset with its annotations, as `partsim vision show` does::
+
+    picture = vision.show("out", 3, "check.png")  # (H, W, 3) uint8, also written to check.png
 """
 
 import json as _json
@@ -42,11 +46,13 @@ evaluate_motion = _ext.evaluate_motion
 rle_area = _ext.rle_area
 rle_bbox = _ext.rle_bbox
 rle_iou = _ext.rle_iou
+show = _ext.show
 
 __all__ = [
     "CategoryAp", "DetectionDataset", "DetectionEvaluation", "MotionDataset", "MotionEvaluation",
     "compress_rle_counts", "decode_rle", "decompress_rle_counts", "encode_mask",
     "evaluate_detection", "evaluate_motion", "load_coco", "rle_area", "rle_bbox", "rle_iou",
+    "show",
 ]
 
 

@@ -1,6 +1,7 @@
-// Python bindings of the vision layer: COCO masks and RLE, and the detection and motion
-// evaluators. They live in the extension's submodule `_vision`, named partsim.vision, which
-// python/partsim/vision.py re-exports beside its pure-Python parts.
+// Python bindings of the vision layer: COCO masks and RLE, the detection and motion
+// evaluators, and a dataset's picture with its annotations drawn (show). They live in the
+// extension's submodule `_vision`, named partsim.vision, which python/partsim/vision.py
+// re-exports beside its pure-Python parts.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "partsim/vision/coco.h"
 #include "partsim/vision/coco_dataset.h"
 #include "partsim/vision/evaluate.h"
+#include "partsim/vision/show.h"
 
 namespace partsim::python {
 namespace {
@@ -254,6 +257,46 @@ void BindVision(py::module_& m) {
       "ground_truth: a file (path) or dict {'slider_range': R, 'samples': [{'sample_id', 'm': "
       "[13 numbers]}]}; predictions: a file or dict {'samples': [...]}, one per sample. m = "
       "(T_r, T_t, pivot (3), hinge axis (3), slider axis (3), x_door, x_drawer), camera frame.");
+
+  v.def(
+      "show",
+      [](const py::object& dir, long long index, const py::object& out, const std::string& split,
+         const std::optional<std::string>& kind) {
+        py::module_ os = py::module_::import("os");
+        vision::ShowOptions o;
+        o.dir = os.attr("fspath")(dir).cast<std::string>();
+        o.index = index;
+        o.split = split;
+        if (kind) {
+          const std::string& k = *kind;
+          if (k != "detection" && k != "motion")
+            throw Error("show: kind must be 'detection', 'motion' or None, got '" + k + "'");
+          o.kind =
+              k == "detection" ? vision::DatasetKind::kDetection : vision::DatasetKind::kMotion;
+        }
+        const std::string path =
+            out.is_none() ? std::string() : os.attr("fspath")(out).cast<std::string>();
+        vision::ShownImage image;
+        {
+          py::gil_scoped_release release;
+          image = path.empty() ? vision::ShowDatasetImage(o) : vision::WriteShowPng(o, path);
+        }
+        py::array_t<std::uint8_t> rgb({image.height, image.width, 3});
+        std::copy(image.rgb.begin(), image.rgb.end(), rgb.mutable_data());
+        return rgb;
+      },
+      py::arg("dir"), py::arg("index") = 0, py::arg("out") = py::none(), py::arg("split") = "train",
+      py::arg("kind") = py::none(),
+      "The picture of a dataset that partsim vision detection-dataset or motion-dataset wrote "
+      "into dir, with its annotations drawn (partsim vision show): detection, the COCO image "
+      "index of instances_<split>.json (file order) with every part's mask blended in its own "
+      "colour, outlined, and labelled; motion, sample index of motion_<split>.json with the "
+      "target's mask and label, the axis projected with the camera's K (a hinge's line through "
+      "the pivot dot, a slider's arrow from the mask's centroid) and a caption with type and "
+      "state. kind: 'detection', 'motion' or None (the kind whose split files dir holds). "
+      "Returns the picture as a (height, width, 3) uint8 array and, when out is a path, writes "
+      "it there as a PNG. Raises PartsimError for a folder without dataset files, an index out "
+      "of range (giving the range) or a picture that cannot be read.");
 }
 
 }  // namespace partsim::python

@@ -1,6 +1,6 @@
 // `partsim vision ...`: the perception benchmark's tools. Each subcommand is one function over
 // the arguments after its name, listed in kSubcommands with its part of the help; a new one
-// (detection-dataset, motion-dataset, show) adds a function and a row there.
+// adds a function and a row there.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,6 +15,7 @@
 #include "partsim/core/check.h"
 #include "partsim/vision/dataset.h"
 #include "partsim/vision/evaluate.h"
+#include "partsim/vision/show.h"
 
 namespace partsim::tools {
 namespace {
@@ -59,6 +60,17 @@ constexpr char kEvaluateMotionUsage[] =
       table; with --out, writes DIR/table.md, DIR/table.csv and DIR/metrics.json.
 )";
 
+constexpr char kShowUsage[] =
+    R"(  partsim vision show DIR --out FILE.png [--index 0] [--split train|test]
+                 [--kind detection|motion]
+      One picture of the dataset in DIR with its annotations drawn, what to check first:
+      detection, COCO image K of instances_SPLIT.json (file order), every part's mask in its
+      own colour, outlined, with its label; motion, sample K of motion_SPLIT.json, the target
+      part's mask and label, the axis (a hinge's line through the pivot, drawn as a dot; a
+      slider's arrow from the mask's centroid) and a caption with the type and state. --kind
+      defaults to the kind whose split files DIR holds.
+)";
+
 // one subcommand: its name, its part of the help, and what runs it (the arguments after its
 // name; returns the exit code, throws UsageError for a bad command line)
 struct Subcommand {
@@ -71,12 +83,14 @@ int RunDetectionDataset(const std::vector<std::string>& args);
 int RunMotionDataset(const std::vector<std::string>& args);
 int RunEvaluateDetection(const std::vector<std::string>& args);
 int RunEvaluateMotion(const std::vector<std::string>& args);
+int RunShow(const std::vector<std::string>& args);
 
 const Subcommand kSubcommands[] = {
     {"detection-dataset", kDetectionDatasetUsage, RunDetectionDataset},
     {"motion-dataset", kMotionDatasetUsage, RunMotionDataset},
     {"evaluate-detection", kEvaluateDetectionUsage, RunEvaluateDetection},
     {"evaluate-motion", kEvaluateMotionUsage, RunEvaluateMotion},
+    {"show", kShowUsage, RunShow},
 };
 
 std::string Usage() {
@@ -220,6 +234,33 @@ int RunEvaluateMotion(const std::vector<std::string>& args) {
   std::printf("%s", markdown.c_str());
   if (!a.out.empty())
     WriteOutputs(a.out, markdown, vision::MotionTableCsv(e), vision::MotionMetricsJson(e));
+  return 0;
+}
+
+int RunShow(const std::vector<std::string>& args) {
+  vision::ShowOptions o;
+  std::string out;
+  ArgParser p(std::string(kCommand) + " show", "partsim vision --help");
+  p.Positional([&](const FlagValue& v) {
+    if (!o.dir.empty())
+      v.Fail("one dataset folder expected, got '" + o.dir + "' and '" + v.Text() + "'");
+    o.dir = v.NonEmpty("a folder name");
+  });
+  p.Option("--index", [&](const FlagValue& v) { o.index = v.Integer(0, 1000000000000LL); });
+  p.Option("--out", [&](const FlagValue& v) { out = v.NonEmpty("a file name"); });
+  p.Option("--split", [&](const FlagValue& v) { o.split = v.Choice({"train", "test"}); });
+  p.Option("--kind", [&](const FlagValue& v) {
+    o.kind = v.Choice({"detection", "motion"}) == "detection" ? vision::DatasetKind::kDetection
+                                                              : vision::DatasetKind::kMotion;
+  });
+  p.Parse(args);
+  if (o.dir.empty()) p.Fail("the dataset folder DIR is required");
+  if (out.empty()) p.Fail("--out FILE.png is required");
+  const vision::ShownImage s = vision::WriteShowPng(o, out);
+  std::printf("%s of %s/%s: %s, %zu %s\n", s.title.c_str(), o.dir.c_str(), s.split_file.c_str(),
+              s.rgb_file.c_str(), s.instances.size(), s.instances.size() == 1 ? "part" : "parts");
+  if (!s.caption.empty()) std::printf("%s\n", s.caption.c_str());
+  std::printf("wrote %s\n", out.c_str());
   return 0;
 }
 

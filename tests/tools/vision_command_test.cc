@@ -8,6 +8,8 @@
 #include <sstream>
 #include <string>
 
+#include "partsim/render/image_io.h"
+#include "partsim/render/image_read.h"
 #include "server/process_util.h"
 
 #ifndef PARTSIM_CLI_PATH
@@ -107,7 +109,10 @@ TEST_F(VisionCommandTest, BadCommandLinesExitWith2) {
   int code = -1;
   std::string out = Run("", &code);
   EXPECT_EQ(code, 2);
-  EXPECT_TRUE(Contains(out, "expected a subcommand (detection-dataset, motion-dataset, evaluate-detection, evaluate-motion)")) << out;
+  EXPECT_TRUE(Contains(out,
+                       "expected a subcommand (detection-dataset, motion-dataset, "
+                       "evaluate-detection, evaluate-motion, show)"))
+      << out;
   out = Run("evaluate-detections --gt gt.json", &code);
   EXPECT_EQ(code, 2);
   EXPECT_TRUE(Contains(out, "did you mean 'evaluate-detection'?")) << out;
@@ -138,6 +143,53 @@ TEST_F(VisionCommandTest, BadFilesExitWith1AndNameTheEntry) {
   out = Run("evaluate-detection --gt missing.json --results results.json", &code);
   EXPECT_EQ(code, 1);
   EXPECT_TRUE(Contains(out, "missing.json")) << out;
+}
+
+// a detection dataset of one 8 x 6 picture (every pixel grey 100) whose 2 x 2 part at (3, 2) is a
+// drawer
+TEST_F(VisionCommandTest, ShowDrawsTheMaskAndRefusesBadIndicesAndFlags) {
+  fs::create_directories(Path("data/rgb"));
+  const std::vector<uint8_t> grey(8 * 6 * 3, 100);
+  WritePng(Path("data/rgb/00.png"), 8, 6, 3, grey.data());
+  // column-major runs: columns 0-2 (18 pixels) and rows 0-1 of column 3 background, then 2
+  // foreground, ...
+  Write("data/instances_train.json", R"({
+    "images": [{"id": 1, "width": 8, "height": 6, "file_name": "rgb/00.png"}],
+    "categories": [{"id": 1, "name": "Cabinet/drawer"}],
+    "annotations": [{"id": 1, "image_id": 1, "category_id": 1,
+                     "segmentation": {"size": [6, 8], "counts": [20, 2, 4, 2, 20]}}]})");
+  int code = -1;
+  std::string out = Run("show data --index 0 --out shown.png", &code);
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_TRUE(Contains(out, "image 0 (id 1) of data/instances_train.json: rgb/00.png, 1 part"))
+      << out;
+  EXPECT_TRUE(Contains(out, "wrote shown.png")) << out;
+  int w = 0, h = 0;
+  const std::vector<uint8_t> shown = ReadPng(Path("shown.png"), 3, &w, &h);
+  ASSERT_EQ(w, 8);
+  ASSERT_EQ(h, 6);
+  EXPECT_NE(shown, grey);  // the mask (and its label, on a picture this small) drawn
+  out = Run("show data --index 1 --out shown.png", &code);
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_TRUE(Contains(out, "index 1 is out of range: instances_train.json holds 1 image (0 to 0)"))
+      << out;
+  out = Run("show data --out shown.png --split test", &code);
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_TRUE(Contains(out, "has no instances_test.json")) << out;
+  out = Run("show . --out shown.png", &code);
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_TRUE(Contains(out, "holds no dataset files")) << out;
+  out = Run("show data --indx 0 --out shown.png", &code);
+  EXPECT_EQ(code, 2) << out;
+  EXPECT_TRUE(Contains(out, "did you mean '--index'?")) << out;
+  out = Run("show data --kind motions --out shown.png", &code);
+  EXPECT_EQ(code, 2) << out;
+  EXPECT_TRUE(Contains(out, "motion")) << out;
+  out = Run("show data", &code);
+  EXPECT_EQ(code, 2) << out;
+  EXPECT_TRUE(Contains(out, "--out FILE.png is required")) << out;
+  out = Run("show data --index -1 --out shown.png", &code);
+  EXPECT_EQ(code, 2) << out;
 }
 
 }  // namespace
