@@ -62,7 +62,16 @@ void BindTasks(py::module_& m) {
                      "recording (get_video_camera, SolverOptions.video_path); 0 (default) for "
                      "none. The episode's dynamics do not change.")
       .def_readwrite("video_height", &TaskOptions::video_height,
-                     "Height in pixels of the 'video' camera (see video_width); 0 for none.");
+                     "Height in pixels of the 'video' camera (see video_width); 0 for none.")
+      .def_readwrite("filter_collisions", &TaskOptions::filter_collisions,
+                     "The cabinet's links never collide with each other (its base is fixed, its "
+                     "parts move along their joints); the gripper collides with all of them. "
+                     "Default True: most of the collision detection's cost, no effect on the "
+                     "tasks.")
+      .def_readwrite("box_primitives", &TaskOptions::box_primitives,
+                     "The cabinet's collision meshes that are axis-aligned boxes collide as "
+                     "boxes (the engine's box collider); masses and inertias unchanged. Default "
+                     "True.");
 
   m.def("find_task_objects", &FindTaskObjects, py::arg("type"), py::arg("count"),
         py::arg("dataset_seed") = 0,

@@ -66,6 +66,51 @@ std::string EnsureObjectFolder(const GeneratedObject& object, const std::string&
   return dir.string();
 }
 
+void DisableCollisionsWithin(ArticulationDesc& articulation) {
+  const std::vector<LinkDesc>& links = articulation.links;
+  for (size_t a = 0; a < links.size(); ++a)
+    for (size_t b = a + 1; b < links.size(); ++b)
+      if (!links[a].collisions.empty() && !links[b].collisions.empty())
+        articulation.disabled_collisions.emplace_back(links[a].name, links[b].name);
+}
+
+std::optional<CollisionShape> BoxOfMesh(const CollisionShape& shape) {
+  if (shape.type != ShapeType::kConvexMesh || !shape.mesh || shape.mesh->vertices.empty())
+    return std::nullopt;
+  Eigen::Vector3f lo = shape.mesh->vertices.front(), hi = lo;
+  for (const Eigen::Vector3f& v : shape.mesh->vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  const Eigen::Vector3d size = (hi - lo).cast<double>();
+  if (!(size.minCoeff() > 1e-6)) return std::nullopt;
+  // every vertex a corner, and all 8 corners present: the hull is the box
+  const double tol = 1e-6 * size.maxCoeff();
+  int corners = 0;
+  for (const Eigen::Vector3f& v : shape.mesh->vertices) {
+    int bits = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(double(v[k]) - double(lo[k])) <= tol) continue;
+      if (std::abs(double(v[k]) - double(hi[k])) > tol) return std::nullopt;
+      bits |= 1 << k;
+    }
+    corners |= 1 << bits;
+  }
+  if (corners != 0xFF) return std::nullopt;
+  CollisionShape box = shape;
+  box.type = ShapeType::kBox;
+  box.mesh.reset();
+  box.half_size = 0.5 * size;
+  box.pose = shape.pose * Pose(0.5 * (lo + hi).cast<double>());
+  return box;
+}
+
+void BoxesForBoxMeshes(ArticulationDesc& articulation) {
+  for (LinkDesc& l : articulation.links)
+    for (CollisionShape& s : l.collisions)
+      if (std::optional<CollisionShape> box = BoxOfMesh(s)) s = *box;
+}
+
 // --- flying gripper kinematics in closed form -------------------------------------------------
 
 Eigen::Vector3d EulerZyx(const Eigen::Matrix3d& R, const Eigen::Vector3d& near) {
@@ -239,6 +284,9 @@ TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
                 std::to_string(targets.size()) + " " + TaskTypeName(o.type) +
                 (targets.size() == 1 ? "" : "s"));
 
+  if (o.box_primitives) internal::BoxesForBoxMeshes(obj.articulation);
+  if (o.filter_collisions) internal::DisableCollisionsWithin(obj.articulation);
+
   SceneConfig cfg;
   cfg.timestep = o.timestep;
   scene = std::make_shared<Scene>(cfg);
@@ -270,8 +318,14 @@ TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
     if (l.GetName().find("finger") != std::string::npos) finger_links.push_back(l.GetIndex());
   // gravity compensation's tables: the links below each dof's joint (parents come first)
   const std::vector<LinkDesc>& rlinks = robot_model.articulation.links;
-  for (size_t i = 0; i < rlinks.size(); ++i)
-    robot_link_mass.push_back(robot.GetLink(static_cast<int>(i)).GetMass());
+  robot_kinematics = KinematicModel::FromArticulation(robot);
+  for (size_t i = 0; i < rlinks.size(); ++i) {
+    const Link l = robot.GetLink(static_cast<int>(i));
+    robot_link_mass.push_back(l.GetMass());
+    robot_link_com.push_back(l.GetPose().Inverse().Transform(l.GetCMassPose().p));
+    robot_joint_in_child.push_back(i == 0 ? Pose()
+                                          : robot.GetJoint(static_cast<int>(i)).GetPoseInChild());
+  }
   for (const Joint& j : robot.GetActiveJoints()) {
     GravityJoint g;
     g.joint = j.GetIndex();
@@ -503,14 +557,16 @@ void TaskImpl::ApplyAction(const Eigen::VectorXd& action) {
 Eigen::VectorXd TaskImpl::GravityCompensation() const {
   if (gravity_joints.empty() && robot.Dof() > 0) return robot.ComputePassiveForce(true, false);
   const Eigen::Vector3d g = scene->GetGravity();
+  const std::vector<Pose> X_WL = robot_kinematics->ForwardKinematics(robot.GetQpos());
   // mass-weighted centres of mass of the robot's links (world)
   std::vector<Eigen::Vector3d> mc(robot_link_mass.size());
   for (size_t i = 0; i < mc.size(); ++i)
-    mc[i] = robot_link_mass[i] * robot.GetLink(static_cast<int>(i)).GetCMassPose().p;
+    mc[i] = robot_link_mass[i] * X_WL[i].Transform(robot_link_com[i]);
   Eigen::VectorXd out(static_cast<Eigen::Index>(gravity_joints.size()));
   for (size_t k = 0; k < gravity_joints.size(); ++k) {
     const GravityJoint& gj = gravity_joints[k];
-    const Pose X_WJ = robot.GetJoint(gj.joint).GetGlobalPose();
+    const Pose X_WJ =
+        X_WL[static_cast<size_t>(gj.joint)] * robot_joint_in_child[static_cast<size_t>(gj.joint)];
     const Eigen::Vector3d axis = X_WJ.q * Eigen::Vector3d::UnitX();
     // gravity's generalized force on the dof: sum over the moved links of m J^T g, J the
     // Jacobian of the link's centre of mass (axis, or axis x (c - p) for a turning joint)

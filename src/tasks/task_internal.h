@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "partsim/assets/generator.h"
+#include "partsim/physics/kinematics.h"
 #include "partsim/tasks/tasks.h"
 
 namespace partsim::internal {
@@ -19,6 +20,14 @@ constexpr double kMaxAngularSpeed = 3.0;  // rad/s
 std::vector<int> TargetLinks(const GeneratedObject& object, TaskType type);
 /// The object's PartNet-Mobility folder under asset_dir, written if missing.
 std::string EnsureObjectFolder(const GeneratedObject& object, const std::string& asset_dir);
+/// TaskOptions::filter_collisions: every pair of links with collision shapes never collides.
+void DisableCollisionsWithin(ArticulationDesc& articulation);
+/// The box a convex mesh collision shape is, when its vertices are exactly the corners of an
+/// axis-aligned box in the shape's frame (a kBox shape, same pose of the volume, material,
+/// density, groups and name); nullopt otherwise.
+std::optional<CollisionShape> BoxOfMesh(const CollisionShape& shape);
+/// TaskOptions::box_primitives: BoxOfMesh for every collision shape of the articulation.
+void BoxesForBoxMeshes(ArticulationDesc& articulation);
 /// Z-Y-X Euler angles (yaw, pitch, roll) of R nearest to `near`.
 Eigen::Vector3d EulerZyx(const Eigen::Matrix3d& R, const Eigen::Vector3d& near);
 /// Matrix mapping Euler angle rates to angular velocity.
@@ -96,6 +105,11 @@ struct TaskImpl {
   };
   std::vector<GravityJoint> gravity_joints;
   std::vector<double> robot_link_mass;
+  std::vector<Eigen::Vector3d> robot_link_com;  ///< centre of mass in the link frame
+  std::vector<Pose> robot_joint_in_child;       ///< per robot link: its joint in the link
+  /// The robot's forward kinematics: its link poses from its qpos alone (the scene's
+  /// kinematics would place every body of the scene).
+  std::optional<KinematicModel> robot_kinematics;
   std::vector<Camera> cameras;
   std::optional<Camera> video_camera;  // TaskOptions::video_width
   std::vector<char> initial_state;

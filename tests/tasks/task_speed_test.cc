@@ -1,6 +1,10 @@
 // The task's speed-ups (issue 18) change nothing that matters: the gravity compensation from
-// the forward kinematics equals ComputePassiveForce's.
+// the robot's forward kinematics equals ComputePassiveForce's; box meshes become the same boxes;
+// the cabinet's links do not collide with each other, the gripper with all of them.
 #include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
 
 #include "partsim/tasks/tasks.h"
 #include "tasks/task_internal.h"
@@ -30,6 +34,71 @@ TEST(TaskSpeedTest, GravityCompensationIsThePassiveForce) {
     for (Eigen::Index k = 0; k < fast.size(); ++k)
       EXPECT_NEAR(fast[k], slow[k], 1e-9 * (1.0 + std::abs(slow[k]))) << "dof " << k;
   }
+}
+
+CollisionShape MeshShape(const std::vector<Eigen::Vector3f>& vertices) {
+  auto mesh = std::make_shared<MeshData>();
+  mesh->vertices = vertices;
+  CollisionShape s;
+  s.type = ShapeType::kConvexMesh;
+  s.mesh = mesh;
+  s.pose = Pose(Eigen::Vector3d(1, 2, 3), Eigen::Quaterniond(0.5, 0.5, 0.5, 0.5));
+  s.density = 321.0;
+  s.name = "panel";
+  return s;
+}
+
+TEST(TaskSpeedTest, BoxMeshesBecomeTheSameBoxes) {
+  // a box mesh as the generator writes it: each corner repeated on its three faces
+  std::vector<Eigen::Vector3f> v;
+  for (int rep = 0; rep < 3; ++rep)
+    for (int c = 0; c < 8; ++c)
+      v.emplace_back(c & 1 ? 0.5f : 0.1f, c & 2 ? 0.3f : -0.2f, c & 4 ? 0.02f : 0.01f);
+  std::optional<CollisionShape> box = internal::BoxOfMesh(MeshShape(v));
+  ASSERT_TRUE(box.has_value());
+  EXPECT_EQ(box->type, ShapeType::kBox);
+  EXPECT_EQ(box->mesh, nullptr);
+  EXPECT_EQ(box->name, "panel");
+  EXPECT_EQ(box->density, 321.0);
+  EXPECT_TRUE(box->half_size.isApprox(Eigen::Vector3d(0.2, 0.25, 0.005), 1e-6));
+  // the box's centre, in the body, is where the mesh's was
+  const Eigen::Vector3d centre(0.3, 0.05, 0.015);
+  EXPECT_TRUE(box->pose.p.isApprox(MeshShape(v).pose.Transform(centre), 1e-6));
+  EXPECT_TRUE(box->pose.q.isApprox(MeshShape(v).pose.q));
+
+  // a corner missing (a wedge), a vertex inside, a flat box: stay meshes
+  std::vector<Eigen::Vector3f> wedge(v.begin(), v.begin() + 7);
+  EXPECT_FALSE(internal::BoxOfMesh(MeshShape(wedge)).has_value());
+  std::vector<Eigen::Vector3f> inner = v;
+  inner.emplace_back(0.3f, 0.0f, 0.015f);
+  EXPECT_FALSE(internal::BoxOfMesh(MeshShape(inner)).has_value());
+  std::vector<Eigen::Vector3f> flat = v;
+  for (Eigen::Vector3f& p : flat) p.z() = 0.01f;
+  EXPECT_FALSE(internal::BoxOfMesh(MeshShape(flat)).has_value());
+}
+
+TEST(TaskSpeedTest, TheCabinetsLinksDoNotCollideWithEachOther) {
+  TaskOptions o = Options(TaskType::kPullDrawer);
+  ArticulationTask fast(o);
+  o.filter_collisions = false;
+  o.box_primitives = false;
+  ArticulationTask slow(o);
+  const std::string fast_mjcf = fast.GetScene().GetMjcf(), slow_mjcf = slow.GetScene().GetMjcf();
+  EXPECT_NE(fast_mjcf.find("type=\"box\""), std::string::npos);
+  const ArticulationDesc& cabinet = fast.GetObject().GetDesc();
+  int with_shapes = 0;
+  for (const LinkDesc& l : cabinet.links) with_shapes += l.collisions.empty() ? 0 : 1;
+  EXPECT_EQ(cabinet.disabled_collisions.size(),
+            static_cast<size_t>(with_shapes * (with_shapes - 1) / 2));
+  EXPECT_TRUE(slow.GetObject().GetDesc().disabled_collisions.empty());
+  for (const LinkDesc& l : slow.GetObject().GetDesc().links)
+    for (const CollisionShape& s : l.collisions) EXPECT_NE(s.type, ShapeType::kBox);
+  // the gripper still grasps: the episode starts with it on the handle
+  o = Options(TaskType::kPullDrawer);
+  o.init_on_handle = true;
+  ArticulationTask grasped(o);
+  grasped.Reset(0);
+  EXPECT_TRUE(grasped.GripperTouchesTarget());
 }
 
 }  // namespace

@@ -54,6 +54,16 @@ struct TaskOptions {
   /// solvers do not perceive through it.
   int video_width = 0;
   int video_height = 0;
+  /// The cabinet's links never collide with each other: its base is fixed and its doors and
+  /// drawers move along their joints only, so such contacts cannot matter, yet their collision
+  /// pairs (neighbouring panels' bounding volumes overlap) cost most of the collision detection.
+  /// The gripper still collides with every link. On by default (the tasks' speed, issue 18).
+  bool filter_collisions = true;
+  /// Collision meshes of the cabinet whose vertices are the corners of an axis-aligned box (the
+  /// generator's panels, frames and bar handles) collide as boxes: the engine's box collider
+  /// instead of the general convex one. Masses and inertias are the links' own (the URDF's),
+  /// unchanged. On by default (the tasks' speed, issue 18).
+  bool box_primitives = true;
 };
 
 /// Candidate objects: the first `count` StorageFurniture indices (from 0) whose object has at
