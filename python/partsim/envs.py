@@ -367,9 +367,12 @@ class OpenCabinetEnv(_ClosedByContext):
         if not np.all(np.isfinite(a)):
             bad = int(np.flatnonzero(~np.isfinite(a))[0])
             raise ValueError(f"action entry {bad} is not finite ({a[bad]})")
-        # np.minimum / np.maximum: np.clip's Python wrapper costs more than the rest of this
-        self._task.apply_action(np.minimum(np.maximum(a, -1.0), 1.0) * _ACTION_SCALE)
+        self._task.apply_action(_task_action(a))
         self._task.step()
+        return self._after_step()
+
+    def _after_step(self):
+        """step's result once the task has stepped."""
         self._steps += 1
         reward = float(self._task.get_reward())
         terminated = bool(self._task.is_success() or self._task.is_failure())
@@ -472,6 +475,13 @@ def _stack(items):
     return np.stack(items)
 
 
+def _task_action(a):
+    """The task's action for actions in [-1, 1] (clipped), one per row: TCP twist in m/s and
+    rad/s, gripper command."""
+    # np.minimum / np.maximum: np.clip's Python wrapper costs more than the rest of this
+    return np.minimum(np.maximum(a, -1.0), 1.0) * _ACTION_SCALE
+
+
 def _warn_no_render_mode(cls_name):
     warnings.warn(
         f"{cls_name}.render() returns None: the environment was made without a render mode; "
@@ -487,7 +497,10 @@ class VectorOpenCabinetEnv(_ClosedByContext):
     (default: one per copy; the simulation releases the GIL, so the copies run in parallel on
     several cores). Copy i always runs on thread ``i % workers``: the rasterizer's OpenGL context
     stays current on the thread that last rendered with it, so a scene cannot move between
-    threads.
+    threads. Copies without cameras (state observations, no render mode) have no such context:
+    ``step`` advances their physics in one ``step_tasks`` call, a thread per copy without the
+    GIL, which saves a hand-off to a worker per copy and step; their resets still run on the
+    workers.
 
     Follows Gymnasium's vector API: ``reset`` returns batched observations and an info dict of
     arrays; ``step(actions)`` with actions of shape (num_envs, 7) returns batched
@@ -516,6 +529,8 @@ class VectorOpenCabinetEnv(_ClosedByContext):
             for _ in range(workers)
         ]
         self._needs_reset = np.zeros(self.num_envs, dtype=bool)
+        # cameras (visual observations, rgb_array rendering) tie each copy to its thread
+        self._gl = any(e._options[0].cameras for e in self.envs)
         self._closed = False
 
     def _check_open(self):
@@ -524,8 +539,12 @@ class VectorOpenCabinetEnv(_ClosedByContext):
 
     def _map(self, fn):
         """[fn(i) for each sub-environment i], each on its own thread."""
+        return self._map_some(fn, range(self.num_envs))
+
+    def _map_some(self, fn, indices):
+        """[fn(i) for i in indices], each on sub-environment i's thread."""
         n = len(self._threads)
-        futures = [self._threads[i % n].submit(fn, i) for i in range(self.num_envs)]
+        futures = [self._threads[int(i) % n].submit(fn, int(i)) for i in indices]
         return [f.result() for f in futures]
 
     def reset(self, *, seed=None, options=None):
@@ -565,7 +584,24 @@ class VectorOpenCabinetEnv(_ClosedByContext):
                 return obs, 0.0, False, False, info
             return env.step(actions[i])
 
-        results = self._map(one)
+        if self._gl:
+            results = self._map(one)
+        else:
+            # no OpenGL context to keep on its thread: the resets on the workers, then every
+            # other copy's physics in one call that steps them on a thread each
+            results = [None] * self.num_envs
+            resets = np.flatnonzero(self._needs_reset)
+            if len(resets):
+                for i, r in zip(resets, self._map_some(one, resets)):
+                    results[i] = r
+            rest = np.flatnonzero(~self._needs_reset)
+            if len(rest):
+                envs = [self.envs[i] for i in rest]
+                if any(e._task is None for e in envs):
+                    raise RuntimeError("step called before reset")
+                _ps.step_tasks([e._task for e in envs], _task_action(actions[rest]))
+                for i, e in zip(rest, envs):
+                    results[i] = e._after_step()
         terminated = np.array([r[2] for r in results], dtype=bool)
         truncated = np.array([r[3] for r in results], dtype=bool)
         self._needs_reset = terminated | truncated
