@@ -4,14 +4,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <exception>
-#include <string>
-#include <thread>
-#include <vector>
-
 #include "bindings.h"
 #include "partsim/core/check.h"
-#include "partsim/core/error.h"
 #include "partsim/tasks/tasks.h"
 
 namespace partsim::python {
@@ -231,48 +225,13 @@ void BindTasks(py::module_& m) {
   solver("solve_task", &SolveTask,
          "solve_pull_drawer or solve_open_door, by the task's type. Returns a SolverResult.");
 
-  m.def(
-      "step_tasks",
-      [](const std::vector<ArticulationTask*>& tasks, const Eigen::MatrixXd& actions) {
-        const size_t n = tasks.size();
-        if (actions.rows() != static_cast<Eigen::Index>(n) || actions.cols() != 7)
-          throw Error("step_tasks: actions must have shape (" + std::to_string(n) + ", 7), got (" +
-                      std::to_string(actions.rows()) + ", " + std::to_string(actions.cols()) + ")");
-        if (!actions.allFinite()) throw Error("step_tasks: actions hold NaN or infinite values");
-        for (size_t i = 0; i < n; ++i)
-          for (size_t j = 0; j < i; ++j)
-            if (tasks[i] == tasks[j])
-              throw Error("step_tasks: task " + std::to_string(i) + " is task " +
-                          std::to_string(j) + " again");
-        // task 0 on this thread, the others on one thread each: a task's scene is held by the
-        // thread that steps it (Scene::Use), and the GIL is released meanwhile
-        std::vector<std::exception_ptr> errors(n);
-        {
-          py::gil_scoped_release release;
-          auto run = [&](size_t i) {
-            try {
-              const Scene::Use use(tasks[i]->GetScene());
-              tasks[i]->ApplyAction(actions.row(static_cast<Eigen::Index>(i)).transpose());
-              tasks[i]->Step();
-            } catch (...) {
-              errors[i] = std::current_exception();
-            }
-          };
-          std::vector<std::thread> threads;
-          threads.reserve(n > 0 ? n - 1 : 0);
-          for (size_t i = 1; i < n; ++i) threads.emplace_back(run, i);
-          if (n > 0) run(0);
-          for (std::thread& t : threads) t.join();
-        }
-        for (const std::exception_ptr& e : errors)
-          if (e) std::rethrow_exception(e);
-      },
-      py::arg("tasks"), py::arg("actions"),
-      "apply_action(actions[i]) and step() of every task in `tasks` (distinct tasks), in "
-      "parallel: one thread per task, the GIL released. `actions` has shape (len(tasks), 7); a "
-      "wrong shape or a non-finite entry raises PartsimError before any task moves. Used by "
-      "partsim.envs.VectorOpenCabinetEnv: one call per vector step instead of a hand-off to "
-      "a worker thread per environment.");
+  m.def("step_tasks", &StepTasks, py::call_guard<py::gil_scoped_release>(), py::arg("tasks"),
+        py::arg("actions"),
+        "apply_action(actions[i]) and step() of every task in `tasks` (distinct tasks), in "
+        "parallel: one thread per task, the GIL released. `actions` has shape (len(tasks), 7); a "
+        "wrong shape or a non-finite entry raises PartsimError before any task moves. Used by "
+        "partsim.envs.VectorOpenCabinetEnv: one call per vector step instead of a hand-off to "
+        "a worker thread per environment.");
 }
 
 }  // namespace partsim::python

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -238,6 +239,38 @@ Eigen::VectorXd ArticulationTask::GetMobilityObservation() const {
   return impl_->MobilityObservation();
 }
 double ArticulationTask::GetReward() const { return impl_->last_reward; }
+
+void StepTasks(const std::vector<ArticulationTask*>& tasks, const Eigen::MatrixXd& actions) {
+  const size_t n = tasks.size();
+  if (actions.rows() != static_cast<Eigen::Index>(n) || actions.cols() != 7)
+    throw Error("step_tasks: actions must have shape (" + std::to_string(n) + ", 7), got (" +
+                std::to_string(actions.rows()) + ", " + std::to_string(actions.cols()) + ")");
+  if (!actions.allFinite()) throw Error("step_tasks: actions hold NaN or infinite values");
+  for (size_t i = 0; i < n; ++i) {
+    if (tasks[i] == nullptr) throw Error("step_tasks: task " + std::to_string(i) + " is None");
+    for (size_t j = 0; j < i; ++j)
+      if (tasks[i] == tasks[j])
+        throw Error("step_tasks: task " + std::to_string(i) + " is task " + std::to_string(j) +
+                    " again");
+  }
+  std::vector<std::exception_ptr> errors(n);
+  auto run = [&](size_t i) {
+    try {
+      const Scene::Use use(tasks[i]->GetScene());
+      tasks[i]->ApplyAction(actions.row(static_cast<Eigen::Index>(i)).transpose());
+      tasks[i]->Step();
+    } catch (...) {
+      errors[i] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  threads.reserve(n > 0 ? n - 1 : 0);
+  for (size_t i = 1; i < n; ++i) threads.emplace_back(run, i);
+  if (n > 0) run(0);
+  for (std::thread& t : threads) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+}
 
 // --- Impl ----------------------------------------------------------------------------------
 

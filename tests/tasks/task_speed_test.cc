@@ -3,9 +3,11 @@
 // the cabinet's links do not collide with each other, the gripper with all of them.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <string>
 
+#include "partsim/core/error.h"
 #include "partsim/tasks/tasks.h"
 #include "tasks/task_internal.h"
 
@@ -99,6 +101,35 @@ TEST(TaskSpeedTest, TheCabinetsLinksDoNotCollideWithEachOther) {
   ArticulationTask grasped(o);
   grasped.Reset(0);
   EXPECT_TRUE(grasped.GripperTouchesTarget());
+}
+
+TEST(TaskSpeedTest, StepTasksEqualsSteppingOneByOne) {
+  TaskOptions o = Options(TaskType::kPullDrawer);
+  o.control_rate = 25.0;
+  ArticulationTask a(o), b(o), c(o), d(o);
+  for (ArticulationTask* t : {&a, &b, &c, &d}) t->Reset(4);
+  Eigen::MatrixXd actions(2, 7);
+  actions << 0.2, -0.1, 0.05, 0.3, 0.0, -0.4, 0.5, -0.1, 0.2, 0.0, 0.0, 0.6, 0.1, -1.0;
+  for (int k = 0; k < 5; ++k) {
+    StepTasks({&a, &b}, actions);
+    c.ApplyAction(actions.row(0).transpose());
+    c.Step();
+    d.ApplyAction(actions.row(1).transpose());
+    d.Step();
+  }
+  EXPECT_EQ(a.GetMobilityObservation(), c.GetMobilityObservation());
+  EXPECT_EQ(b.GetMobilityObservation(), d.GetMobilityObservation());
+  EXPECT_EQ(a.GetReward(), c.GetReward());
+
+  // bad input moves nothing
+  const Eigen::VectorXd before = a.GetMobilityObservation();
+  EXPECT_THROW(StepTasks({&a}, actions), Error);
+  Eigen::MatrixXd nan = actions.topRows(1);
+  nan(0, 3) = std::nan("");
+  EXPECT_THROW(StepTasks({&a}, nan), Error);
+  EXPECT_THROW(StepTasks({&a, &a}, actions), Error);
+  EXPECT_EQ(a.GetMobilityObservation(), before);
+  StepTasks({}, Eigen::MatrixXd(0, 7));
 }
 
 }  // namespace

@@ -169,6 +169,13 @@ class ArticulationTask {
   std::unique_ptr<Impl> impl_;
 };
 
+/// ApplyAction(actions.row(i)) and Step() of every task, in parallel: task 0 on the calling
+/// thread, each other on a thread of its own, each holding its scene (Scene::Use) meanwhile.
+/// `actions` is tasks.size() x 7; a wrong shape, a non-finite entry or a task given twice
+/// throws partsim::Error before any task moves. Call it from a thread that holds none of the
+/// tasks' scenes.
+void StepTasks(const std::vector<ArticulationTask*>& tasks, const Eigen::MatrixXd& actions);
+
 /// Outcome of a heuristic solver run.
 struct SolverResult {
   bool success = false;
