@@ -2,6 +2,9 @@
 
 Measures, on the drawer task with the gripper starting on the handle:
 
+* the physics alone: ``scene.step(20)`` (one control period) on a task's scene, the
+  gripper's drives holding their last targets (no task layer: no controller, gravity
+  compensation or reward);
 * the bare ``ArticulationTask`` loop (``apply_action`` + ``step``, no observation): the
   reference;
 * ``OpenCabinetEnv.step`` with mobility, raw and visual observations (visual: the front camera
@@ -59,6 +62,31 @@ class Bare:
         self.k += 1
         if self.k % EPISODE == 0:
             self.task.reset(self.k)
+
+    def close(self):
+        self.env.close()
+
+
+class Physics:
+    """scene.step(20) per environment step on the task's scene: what the physics costs without
+    the task layer (the gripper's drives keep their targets; gravity is not compensated)."""
+
+    name = "physics only: scene.step(20)"
+    num_envs = 1
+
+    def __init__(self):
+        self.env = envs.OpenCabinetEnv(max_episode_steps=EPISODE)
+        self.env.reset(seed=0)
+        self.scene = self.env.task.scene
+        rate = self.env.task.options.control_rate
+        self.substeps = round(1.0 / (rate * self.scene.get_timestep()))
+        self.k = 0
+
+    def step(self, a):
+        self.scene.step(self.substeps)
+        self.k += 1
+        if self.k % EPISODE == 0:
+            self.env.task.reset(self.k)
 
     def close(self):
         self.env.close()
@@ -122,7 +150,7 @@ def main():
         f"{np.__version__}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}"
     )
     t0 = time.perf_counter()
-    runners = [Bare(), Single("mobility"), Single("raw"), Single("visual")]
+    runners = [Bare(), Physics(), Single("mobility"), Single("raw"), Single("visual")]
     runners += [Vector(n) for n in (1, 2, 4)]
     print(f"built {len(runners)} configurations in {time.perf_counter() - t0:.0f} s", flush=True)
     # the configurations take turns within each repeat, so that changes of the machine's load
