@@ -65,9 +65,11 @@ void BindTasks(py::module_& m) {
                      "Height in pixels of the 'video' camera (see video_width); 0 for none.")
       .def_readwrite("filter_collisions", &TaskOptions::filter_collisions,
                      "The cabinet's links never collide with each other (its base is fixed, its "
-                     "parts move along their joints); the gripper collides with all of them. "
-                     "Default True: most of the collision detection's cost, no effect on the "
-                     "tasks.")
+                     "parts move along their joints and stop at joint limits); the gripper "
+                     "collides with all of them. Default True: it saves most of the collision "
+                     "detection and leaves the heuristic solvers' results on generated "
+                     "cabinets unchanged; set False for an object where one part blocks "
+                     "another (a drawer behind a closed door), which would pass through.")
       .def_readwrite("box_primitives", &TaskOptions::box_primitives,
                      "The cabinet's collision meshes that are axis-aligned boxes collide as "
                      "boxes (the engine's box collider); masses and inertias unchanged. Default "

@@ -55,9 +55,12 @@ struct TaskOptions {
   int video_width = 0;
   int video_height = 0;
   /// The cabinet's links never collide with each other: its base is fixed and its doors and
-  /// drawers move along their joints only, so such contacts cannot matter, yet their collision
-  /// pairs (neighbouring panels' bounding volumes overlap) cost most of the collision detection.
-  /// The gripper still collides with every link. On by default (the tasks' speed, issue 18).
+  /// drawers move along their joints only (joint limits, not contacts, stop them), yet their
+  /// collision pairs (neighbouring panels' bounding volumes overlap) cost most of the collision
+  /// detection. The gripper still collides with every link. One thing it does change: a part
+  /// that another part blocks (a drawer behind a closed door, in some real objects) passes
+  /// through it; set false for such objects. On by default (the tasks' speed, issue 18); the
+  /// heuristic solvers' results on the generated cabinets are the same either way.
   bool filter_collisions = true;
   /// Collision meshes of the cabinet whose vertices are the corners of an axis-aligned box (the
   /// generator's panels, frames and bar handles) collide as boxes: the engine's box collider
