@@ -78,7 +78,14 @@ void CheckPicture(const char* what, const Picture& p, unsigned needs) {
 
 // writes rows of `bit_depth`-bit samples; 16-bit rows hold native uint16 values
 void WritePngRows(const std::string& path, int width, int height, int color_type, int bit_depth,
-                  int bytes_per_pixel, const uint8_t* data, const char* what) {
+                  int bytes_per_pixel, const uint8_t* data, const PngCompression& compression,
+                  const char* what) {
+  if (compression.level < -1 || compression.level > 9)
+    throw Error(std::string(what) + ": compression level must be in [-1, 9], got " +
+                std::to_string(compression.level) + " (writing '" + path + "')");
+  if (compression.filter < -1 || compression.filter > 4)
+    throw Error(std::string(what) + ": PNG filter must be in [-1, 4], got " +
+                std::to_string(compression.filter) + " (writing '" + path + "')");
   File file(path, what);
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
@@ -96,6 +103,10 @@ void WritePngRows(const std::string& path, int width, int height, int color_type
     throw Error(std::string(what) + ": libpng failed writing '" + path + "'");
   }
   png_init_io(png, file.get());
+  if (compression.level >= 0) png_set_compression_level(png, compression.level);
+  // PNG_FILTER_NONE ... PNG_FILTER_PAETH are the bits 0x08 << filter number
+  if (compression.filter >= 0)
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, 0x08 << compression.filter);
   png_set_IHDR(png, info, width, height, bit_depth, color_type, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   png_write_info(png, info);
@@ -266,7 +277,8 @@ std::array<uint8_t, 3> SegmentationColor(uint32_t id) {
           static_cast<uint8_t>(std::lround(c[2] * 255))};
 }
 
-void WritePng(const std::string& path, int width, int height, int channels, const uint8_t* pixels) {
+void WritePng(const std::string& path, int width, int height, int channels, const uint8_t* pixels,
+              const PngCompression& compression) {
   const char* what = "write_png";
   CheckSize(what, width, height);
   int type;
@@ -287,14 +299,15 @@ void WritePng(const std::string& path, int width, int height, int channels, cons
       throw Error(std::string(what) + ": channels must be 1, 2, 3 or 4, got " +
                   std::to_string(channels) + " (writing '" + path + "')");
   }
-  WritePngRows(path, width, height, type, 8, channels, pixels, what);
+  WritePngRows(path, width, height, type, 8, channels, pixels, compression, what);
 }
 
-void WritePng16(const std::string& path, int width, int height, const uint16_t* pixels) {
+void WritePng16(const std::string& path, int width, int height, const uint16_t* pixels,
+                const PngCompression& compression) {
   const char* what = "write_png16";
   CheckSize(what, width, height);
   WritePngRows(path, width, height, PNG_COLOR_TYPE_GRAY, 16, 2,
-               reinterpret_cast<const uint8_t*>(pixels), what);
+               reinterpret_cast<const uint8_t*>(pixels), compression, what);
 }
 
 void WriteColorPng(const std::string& path, const Picture& picture) {
@@ -303,7 +316,8 @@ void WriteColorPng(const std::string& path, const Picture& picture) {
   WritePng(path, picture.width, picture.height, 4, rgba.data());
 }
 
-void WriteDepthPng(const std::string& path, int width, int height, const float* depth) {
+void WriteDepthPng(const std::string& path, int width, int height, const float* depth,
+                   const PngCompression& compression) {
   CheckSize("write_depth_png", width, height);
   size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
   std::vector<uint16_t> mm(n);
@@ -312,7 +326,7 @@ void WriteDepthPng(const std::string& path, int width, int height, const float* 
     double v = depth[i] > 0 ? std::round(1000.0 * depth[i]) : 0.0;
     mm[i] = static_cast<uint16_t>(std::min(v, 65535.0));
   }
-  WritePng16(path, width, height, mm.data());
+  WritePng16(path, width, height, mm.data(), compression);
 }
 
 void WriteDepthPng(const std::string& path, const Picture& picture) {

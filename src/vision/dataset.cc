@@ -2,10 +2,13 @@
 #include "partsim/vision/dataset.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -13,6 +16,8 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <unordered_map>
+#include <utility>
 
 #include "core/file_read.h"
 #include "core/json_parse.h"
@@ -156,21 +161,106 @@ json MatrixJson(const Eigen::MatrixXd& m) {
   return rows;
 }
 
+// Runs part(0) ... part(count - 1) on `jobs` threads in all: this one and jobs - 1 more (a
+// WorkerPool's Wait runs parts on the calling thread too). `part` must not throw.
+void RunParts(int jobs, int count, const std::function<void(int)>& part) {
+  jobs = std::min(jobs, count);
+  if (jobs <= 1) {
+    for (int i = 0; i < count; ++i) part(i);
+    return;
+  }
+  partsim::internal::WorkerPool pool(jobs - 1);
+  pool.Start(count, part);
+  pool.Wait();
+}
+
 // ---------------------------------------------------------------------------------------------
 // rendering one object
 
+// Rasterizers kept from object to object: a new one per object costs a GL context, its programs
+// and, on llvmpipe, the shader variants compiled at its first picture (about 45 ms per object
+// on the 2-core machine, two to three views' time). A worker takes one for an object and puts it
+// back when the object is done, so there are never more than the workers. Other backends are
+// made per object.
+class BackendShelf {
+ public:
+  explicit BackendShelf(std::string name) : name_(std::move(name)) {}
+
+  // a kept rasterizer, a new one when none is free, null for other backends
+  std::unique_ptr<RenderBackend> Take() {
+    if (name_ != "rasterizer") return nullptr;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!free_.empty()) {
+        std::unique_ptr<RenderBackend> b = std::move(free_.back());
+        free_.pop_back();
+        return b;
+      }
+    }
+    return MakeRasterBackend();
+  }
+  // gives back a backend whose object was rendered whole (one that threw is not kept)
+  void Put(std::unique_ptr<RenderBackend> backend) {
+    if (!backend) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(std::move(backend));
+  }
+
+ private:
+  std::string name_;
+  std::mutex mutex_;
+  std::vector<std::unique_ptr<RenderBackend>> free_;
+};
+
+// A kept backend lent to one object's scene, which owns this and forwards every picture to it.
+// Every scene counts its geometry versions from the same start, so that the rasterizer would
+// not see a new object as new geometry (and would keep the earlier objects' meshes): each loan
+// renders under versions of its own.
+class LentBackend final : public RenderBackend {
+ public:
+  explicit LentBackend(RenderBackend* backend) : backend_(backend) {
+    static std::atomic<std::uint64_t> loans{0};
+    version_base_ = ++loans << 32;
+  }
+  std::string Name() const override { return backend_->Name(); }
+  std::string Device() const override { return backend_->Device(); }
+
+ protected:
+  void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
+                unsigned outputs) override {
+    world_ = world;
+    world_.geometry_version = version_base_ + world.geometry_version;
+    backend_->Render(world_, camera, out, outputs);
+  }
+
+ private:
+  RenderBackend* backend_;
+  std::uint64_t version_base_ = 0;
+  RenderWorld world_;  // `world` under this loan's versions
+};
+
+// Vertex bounds of each mesh, kept across the views of an object (its meshes do not change).
+using MeshBounds = std::unordered_map<const MeshData*, std::pair<Eigen::Vector3f, Eigen::Vector3f>>;
+
 // Bounds of everything the scene renders, in the world, from the meshes' vertex bounds.
-void RenderBounds(const RenderWorld& world, Eigen::Vector3d* lo, Eigen::Vector3d* hi) {
+void RenderBounds(const RenderWorld& world, MeshBounds* cache, Eigen::Vector3d* lo,
+                  Eigen::Vector3d* hi) {
   *lo = Eigen::Vector3d::Constant(kInf);
   *hi = Eigen::Vector3d::Constant(-kInf);
   for (const RenderInstance& inst : world.instances) {
     if (!inst.mesh || inst.mesh->vertices.empty()) continue;
-    Eigen::Vector3f mlo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
-    Eigen::Vector3f mhi = -mlo;
-    for (const Eigen::Vector3f& v : inst.mesh->vertices) {
-      mlo = mlo.cwiseMin(v);
-      mhi = mhi.cwiseMax(v);
+    auto [it, added] = cache->try_emplace(inst.mesh.get());
+    if (added) {
+      Eigen::Vector3f mlo = Eigen::Vector3f::Constant(std::numeric_limits<float>::infinity());
+      Eigen::Vector3f mhi = -mlo;
+      for (const Eigen::Vector3f& v : inst.mesh->vertices) {
+        mlo = mlo.cwiseMin(v);
+        mhi = mhi.cwiseMax(v);
+      }
+      it->second = {mlo, mhi};
     }
+    const Eigen::Vector3f& mlo = it->second.first;
+    const Eigen::Vector3f& mhi = it->second.second;
     for (int k = 0; k < 8; ++k) {
       const Eigen::Vector4d corner((k & 1) ? mhi.x() : mlo.x(), (k & 2) ? mhi.y() : mlo.y(),
                                    (k & 4) ? mhi.z() : mlo.z(), 1.0);
@@ -182,7 +272,8 @@ void RenderBounds(const RenderWorld& world, Eigen::Vector3d* lo, Eigen::Vector3d
   if (!(lo->array() <= hi->array()).all()) *lo = *hi = Eigen::Vector3d::Zero();
 }
 
-// What one rendered view holds, in pixels and in the OpenCV camera frame.
+// What one rendered view holds, in pixels and in the OpenCV camera frame (its buffers are
+// reused from view to view).
 struct View {
   int width = 0, height = 0;
   std::vector<std::uint8_t> rgb;       // h x w x 3
@@ -197,9 +288,14 @@ struct View {
 
 class ObjectRenderer {
  public:
-  ObjectRenderer(const DatasetOptions& options, const std::string& folder)
+  // `backend`: a kept backend to render with (it must outlive this), or null for a new one of
+  // options.backend
+  ObjectRenderer(const DatasetOptions& options, const std::string& folder, RenderBackend* backend)
       : options_(options), scene_(std::make_unique<Scene>()) {
-    scene_->SetRenderBackend(options.backend);
+    if (backend != nullptr)
+      scene_->SetRenderBackend(std::make_unique<LentBackend>(backend));
+    else
+      scene_->SetRenderBackend(options.backend);
     PartNetMobilityLoader loader(scene_.get());
     object_ = loader.Parse(folder);
     articulation_ = scene_->AddArticulation(object_.articulation);
@@ -210,9 +306,12 @@ class ObjectRenderer {
     const Eigen::Vector3d front = Front();
     scene_->AddDirectionalLight((-front - Eigen::Vector3d(0, 0, 1.5)).normalized(),
                                 Eigen::Vector3f::Constant(2.2f), false);
-    for (const RenderEntityInfo& e : scene_->GetRenderEntities())
-      if (e.is_link && e.articulation_id == articulation_.GetId())
-        entity_link_[e.id] = e.link_index;
+    for (const RenderEntityInfo& e : scene_->GetRenderEntities()) {
+      if (!e.is_link || e.articulation_id != articulation_.GetId()) continue;
+      const std::size_t id = e.id;
+      if (id >= entity_link_.size()) entity_link_.resize(id + 1, -1);
+      entity_link_[id] = e.link_index;
+    }
     limits_ = articulation_.GetQlimits();
   }
 
@@ -241,11 +340,11 @@ class ObjectRenderer {
   // within 90 degrees either side of the object's front (Front), elevation 10 to 60
   // degrees, looking at the centre of its bounds from a distance that keeps the bounding sphere
   // in frame (1.0 to 1.3 times the nearest such distance).
-  View Render(const Eigen::VectorXd& q, Random* rng) {
+  void Render(const Eigen::VectorXd& q, Random* rng, View* view) {
     articulation_.SetQpos(q);
     scene_->UpdateRender();
     Eigen::Vector3d lo, hi;
-    RenderBounds(scene_->GetRenderWorld(), &lo, &hi);
+    RenderBounds(scene_->GetRenderWorld(), &mesh_bounds_, &lo, &hi);
     const Eigen::Vector3d centre = 0.5 * (lo + hi);
     const double radius = std::max(0.5 * (hi - lo).norm(), 1e-3);
     const Eigen::Vector3d front = Front();
@@ -262,7 +361,7 @@ class ObjectRenderer {
     camera_.TakePicture(kColor | kPosition | kSegmentation);
     const Picture& pic = camera_.GetPictureData();
 
-    View v;
+    View& v = *view;
     v.width = pic.width;
     v.height = pic.height;
     v.K = camera_.GetIntrinsicMatrix();
@@ -272,19 +371,22 @@ class ObjectRenderer {
     const std::size_t n = static_cast<std::size_t>(pic.width) * pic.height;
     const std::vector<std::uint8_t> rgba = ToRgba8(pic.color);
     v.rgb.resize(3 * n);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c) v.rgb[3 * i + c] = rgba[4 * i + c];
-    v.depth = DepthImage(pic);
-    v.link.assign(n, -1);
-    v.point.assign(n, Eigen::Vector3f::Zero());
+    v.depth.resize(n);
+    v.link.resize(n);
+    v.point.resize(n);
+    const float* position = pic.position.data();
+    const std::uint32_t* segmentation = pic.segmentation.data();
     for (std::size_t i = 0; i < n; ++i) {
-      auto it = entity_link_.find(pic.segmentation[2 * i + 1]);
-      if (it != entity_link_.end()) v.link[i] = it->second;
-      if (v.depth[i] > 0)  // OpenGL camera frame (x right, y up, z back) -> OpenCV
-        v.point[i] = Eigen::Vector3f(pic.position[4 * i], -pic.position[4 * i + 1],
-                                     -pic.position[4 * i + 2]);
+      for (int c = 0; c < 3; ++c) v.rgb[3 * i + c] = rgba[4 * i + c];
+      const float depth = position[4 * i + 3];
+      v.depth[i] = depth;  // DepthImage's values
+      const std::uint32_t entity = segmentation[2 * i + 1];
+      v.link[i] = entity < entity_link_.size() ? entity_link_[entity] : -1;
+      // OpenGL camera frame (x right, y up, z back) -> OpenCV
+      v.point[i] =
+          depth > 0 ? Eigen::Vector3f(position[4 * i], -position[4 * i + 1], -position[4 * i + 2])
+                    : Eigen::Vector3f::Zero();
     }
-    return v;
   }
 
  private:
@@ -293,7 +395,8 @@ class ObjectRenderer {
   PartNetMobilityObject object_;
   Articulation articulation_;
   Camera camera_;
-  std::map<std::uint32_t, int> entity_link_;  // render entity id -> link index
+  std::vector<int> entity_link_;  // render entity id -> link index of the object, -1 none
+  MeshBounds mesh_bounds_;
   Eigen::MatrixX2d limits_;
 };
 
@@ -311,9 +414,15 @@ std::map<int, const PartNetLink*> LabelledLinks(const PartNetMobilityObject& o) 
   return out;
 }
 
+// The datasets' PNGs: zlib level 1, rows not filtered. The same pixels as libpng's default
+// compression (level 6, a filter chosen per row by trying all five), written about five times
+// faster in files 1.5 to 2 times larger: tens of kB per view, beside the 1 MB depth NPY.
+constexpr PngCompression kPngCompression{1, 0};
+
 void WriteViewPictures(const std::string& dir, const std::string& stem, const View& v) {
-  WritePng(dir + "/rgb/" + stem + ".png", v.width, v.height, 3, v.rgb.data());
-  WriteDepthPng(dir + "/depth/" + stem + ".png", v.width, v.height, v.depth.data());
+  WritePng(dir + "/rgb/" + stem + ".png", v.width, v.height, 3, v.rgb.data(), kPngCompression);
+  WriteDepthPng(dir + "/depth/" + stem + ".png", v.width, v.height, v.depth.data(),
+                kPngCompression);
   WriteNpy(dir + "/depth/" + stem + ".npy", v.depth.data(),
            {static_cast<std::size_t>(v.height), static_cast<std::size_t>(v.width)});
 }
@@ -330,46 +439,97 @@ json RleJson(const Rle& rle) {
   return {{"size", {rle.height, rle.width}}, {"counts", CompressRleCounts(rle.counts)}};
 }
 
-Mask MaskOf(const View& v, int link) {
-  Mask m(v.width, v.height, 0);
-  for (std::size_t i = 0; i < v.link.size(); ++i) m.data[i] = v.link[i] == link ? 1 : 0;
-  return m;
+// The RLE of every instance 1..count of a width x height instance map (row-major, 0 = none) in
+// one column-major walk: the runs EncodeMask makes of each instance's mask (background first,
+// a run ends where the pixel's membership changes), without a mask per instance.
+std::vector<Rle> EncodeInstances(const std::vector<std::uint16_t>& map, int width, int height,
+                                 int count) {
+  std::vector<Rle> rle(static_cast<std::size_t>(count) + 1);
+  std::vector<std::uint32_t> run_start(rle.size(), 0);  // where each instance's current run began
+  std::uint32_t at = 0;
+  std::uint16_t previous = 0;
+  for (int x = 0; x < width; ++x) {
+    for (int y = 0; y < height; ++y, ++at) {
+      const std::uint16_t value = map[static_cast<std::size_t>(y) * width + x];
+      if (value == previous) continue;
+      if (previous != 0) {  // previous's run of pixels ends
+        rle[previous].counts.push_back(at - run_start[previous]);
+        run_start[previous] = at;
+      }
+      if (value != 0) {  // value's run of background ends
+        rle[value].counts.push_back(at - run_start[value]);
+        run_start[value] = at;
+      }
+      previous = value;
+    }
+  }
+  for (std::size_t k = 1; k < rle.size(); ++k) {
+    rle[k].counts.push_back(at - run_start[k]);
+    rle[k].height = height;
+    rle[k].width = width;
+  }
+  return rle;
 }
 
 // The detection views of one object into `dir`; returns views.json.
 json RenderDetectionObject(const DatasetOptions& options, const std::string& folder,
                            const std::string& name, const std::map<std::string, int>& category_ids,
-                           const std::string& dir, long* views_rendered) {
-  ObjectRenderer r(options, folder);
+                           const std::string& dir, RenderBackend* backend, long* views_rendered) {
+  ObjectRenderer r(options, folder, backend);
   const PartNetMobilityObject& o = r.Object();
   const std::string category = CategoryOf(o);
-  const std::map<int, const PartNetLink*> labelled = LabelledLinks(o);
+  // per link index: its PartNet entry when labelled (else null) and its category id
+  const std::size_t num_links = r.GetArticulation().GetLinks().size();
+  std::vector<const PartNetLink*> labelled(num_links, nullptr);
+  std::vector<int> category_of(num_links, 0);
+  for (const auto& [link, pl] : LabelledLinks(o)) {
+    if (link < 0 || static_cast<std::size_t>(link) >= num_links) continue;
+    labelled[static_cast<std::size_t>(link)] = pl;
+    category_of[static_cast<std::size_t>(link)] = category_ids.at(PartCategory(category, *pl));
+  }
   for (const char* sub : {"rgb", "depth", "instances", "cloud"})
     fs::create_directories(dir + "/" + sub);
   Random rng(Hash(options.seed, name));
   const double min_pixels = options.min_area_fraction * options.size * options.size;
   json views = json::array();
+  View v;
+  std::vector<long> pixels(num_links);
+  std::vector<int> instance_of(num_links);  // link -> instance number (1-based), 0 none
+  std::vector<std::uint16_t> instance_map;
   for (int k = 0; k < options.views; ++k) {
     const Eigen::VectorXd q = r.DrawJointPositions(&rng);
-    const View v = r.Render(q, &rng);
+    r.Render(q, &rng, &v);
     ++*views_rendered;
     const std::string stem = Two(k);
     WriteViewPictures(dir, stem, v);
     // pixel counts of the labelled links seen; instances numbered in link order
-    std::map<int, long> pixels;
+    std::fill(pixels.begin(), pixels.end(), 0);
     for (int l : v.link)
-      if (l >= 0 && labelled.count(l)) ++pixels[l];
-    std::map<int, int> instance_of;  // link -> instance number (1-based)
+      if (l >= 0) ++pixels[static_cast<std::size_t>(l)];
+    std::fill(instance_of.begin(), instance_of.end(), 0);
+    std::vector<std::size_t> instance_links;  // instance number - 1 -> link
+    for (std::size_t link = 0; link < num_links; ++link) {
+      if (!labelled[link] || pixels[link] == 0) continue;
+      if (static_cast<double>(pixels[link]) < min_pixels) continue;
+      instance_links.push_back(link);
+      instance_of[link] = static_cast<int>(instance_links.size());
+    }
+    const std::size_t n = v.link.size();
+    instance_map.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i)
+      if (v.link[i] >= 0)
+        instance_map[i] =
+            static_cast<std::uint16_t>(instance_of[static_cast<std::size_t>(v.link[i])]);
+    const std::vector<Rle> rles =
+        EncodeInstances(instance_map, v.width, v.height, static_cast<int>(instance_links.size()));
     json instances = json::array();
-    for (const auto& [link, count] : pixels) {
-      if (static_cast<double>(count) < min_pixels) continue;
-      const PartNetLink& pl = *labelled.at(link);
-      const int number = static_cast<int>(instance_of.size()) + 1;
-      instance_of[link] = number;
-      const Rle rle = EncodeMask(MaskOf(v, link));
+    for (std::size_t m = 0; m < instance_links.size(); ++m) {
+      const std::size_t link = instance_links[m];
+      const PartNetLink& pl = *labelled[link];
+      const Rle& rle = rles[m + 1];
       const std::array<double, 4> box = RleBoundingBox(rle);
-      instances.push_back({{"instance", number},
-                           {"link", r.GetArticulation().GetLink(link).GetName()},
+      instances.push_back({{"instance", m + 1},
+                           {"link", r.GetArticulation().GetLink(static_cast<int>(link)).GetName()},
                            {"label", pl.semantic_label},
                            {"category", PartCategory(category, pl)},
                            {"joint", pl.joint},
@@ -377,31 +537,25 @@ json RenderDetectionObject(const DatasetOptions& options, const std::string& fol
                            {"bbox", {box[0], box[1], box[2], box[3]}},
                            {"segmentation", RleJson(rle)}});
     }
-    const std::size_t n = v.link.size();
-    std::vector<std::uint16_t> instance_map(n, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-      auto it = instance_of.find(v.link[i]);
-      if (it != instance_of.end()) instance_map[i] = static_cast<std::uint16_t>(it->second);
-    }
-    WritePng16(dir + "/instances/" + stem + ".png", v.width, v.height, instance_map.data());
+    WritePng16(dir + "/instances/" + stem + ".png", v.width, v.height, instance_map.data(),
+               kPngCompression);
     if (options.point_clouds) {
-      std::vector<float> xyz;
-      std::vector<std::uint8_t> rgb;
-      std::vector<std::int32_t> instance, label;
-      for (std::size_t i = 0; i < n; ++i) {
+      // every pixel that sees a surface, in pixel order
+      std::size_t m = 0;
+      for (float d : v.depth) m += d > 0 ? 1 : 0;
+      std::vector<float> xyz(3 * m);
+      std::vector<std::uint8_t> rgb(3 * m);
+      std::vector<std::int32_t> instance(m), label(m);
+      for (std::size_t i = 0, j = 0; i < n; ++i) {
         if (!(v.depth[i] > 0)) continue;
         for (int c = 0; c < 3; ++c) {
-          xyz.push_back(v.point[i][c]);
-          rgb.push_back(v.rgb[3 * i + c]);
+          xyz[3 * j + c] = v.point[i][c];
+          rgb[3 * j + c] = v.rgb[3 * i + c];
         }
-        auto it = instance_of.find(v.link[i]);
-        instance.push_back(it == instance_of.end() ? 0 : it->second);
-        int id = 0;
-        if (it != instance_of.end())
-          id = category_ids.at(PartCategory(category, *labelled.at(v.link[i])));
-        label.push_back(id);
+        instance[j] = instance_map[i];
+        label[j] = instance_map[i] ? category_of[static_cast<std::size_t>(v.link[i])] : 0;
+        ++j;
       }
-      const std::size_t m = instance.size();
       internal::WriteNpz(
           dir + "/cloud/" + stem + ".npz",
           {internal::MakeNpyArray("xyz", xyz, {m, 3}), internal::MakeNpyArray("rgb", rgb, {m, 3}),
@@ -425,14 +579,16 @@ json RenderDetectionObject(const DatasetOptions& options, const std::string& fol
 // samples; a sample whose camera does not see the part (fewer pixels than the threshold) is
 // drawn again, at most 10 times, then left out.
 json RenderMotionObject(const DatasetOptions& options, const std::string& folder,
-                        const std::string& name, const std::string& dir, long* views_rendered) {
-  ObjectRenderer r(options, folder);
+                        const std::string& name, const std::string& dir, RenderBackend* backend,
+                        long* views_rendered) {
+  ObjectRenderer r(options, folder, backend);
   const PartNetMobilityObject& o = r.Object();
   Articulation& art = r.GetArticulation();
   for (const char* sub : {"rgb", "depth", "mask"}) fs::create_directories(dir + "/" + sub);
   Random rng(Hash(options.seed, name));
   const double min_pixels = options.min_area_fraction * options.size * options.size;
   json samples = json::array();
+  View v;
   for (const auto& [link, pl] : LabelledLinks(o)) {
     const Target target = TargetOf(*pl);
     if (target == Target::kNone) continue;
@@ -441,9 +597,8 @@ json RenderMotionObject(const DatasetOptions& options, const std::string& folder
     if (dof < 0) continue;
     for (int k = 0; k < options.views; ++k) {
       bool seen = false;
-      View v;
       for (int attempt = 0; attempt < 10 && !seen; ++attempt) {
-        v = r.Render(r.DrawJointPositions(&rng), &rng);
+        r.Render(r.DrawJointPositions(&rng), &rng, &v);
         ++*views_rendered;
         long count = std::count(v.link.begin(), v.link.end(), link);
         seen = static_cast<double>(count) >= min_pixels;
@@ -462,7 +617,7 @@ json RenderMotionObject(const DatasetOptions& options, const std::string& folder
         }
       }
       if (count > 0) centroid /= static_cast<double>(count);
-      WritePng(dir + "/mask/" + stem + ".png", v.width, v.height, 1, mask.data());
+      WritePng(dir + "/mask/" + stem + ".png", v.width, v.height, 1, mask.data(), kPngCompression);
       // the joint's axis in the OpenCV camera frame; the pivot is the point of the axis nearest
       // the centroid of the part's visible points
       art.SetQpos(v.qpos);
@@ -648,14 +803,18 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
 
   // the dataset as a whole: every object's category, labels and targets (for the split, the
   // category ids and the slider range), whichever shard renders it
-  std::vector<ObjectInfo> objects;
-  PartNetMobilityLoader loader;
-  for (const std::string& folder : folders) {
-    ObjectInfo info;
+  // (parsed on `jobs` threads: reading every object's meshes is most of a run's start)
+  std::vector<ObjectInfo> parsed(folders.size());
+  std::vector<std::string> parse_error(folders.size());
+  std::vector<std::exception_ptr> parse_exception(folders.size());
+  RunParts(options.jobs, static_cast<int>(folders.size()), [&](int part) {
+    const auto f = static_cast<std::size_t>(part);
+    const std::string& folder = folders[f];
+    ObjectInfo& info = parsed[f];
     info.folder = folder;
-    info.name = ObjectName(options.dataset_root, folder);
     try {
-      const PartNetMobilityObject o = loader.Parse(folder);
+      info.name = ObjectName(options.dataset_root, folder);
+      const PartNetMobilityObject o = PartNetMobilityLoader().Parse(folder);
       info.category = CategoryOf(o);
       for (const auto& [link, pl] : LabelledLinks(o)) {
         info.labels.push_back(PartCategory(info.category, *pl));
@@ -669,10 +828,20 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
         }
       }
     } catch (const Error& e) {
-      summary.errors.push_back(folder + ": " + e.what());
+      parse_error[f] = folder + ": " + e.what();
+    } catch (...) {
+      parse_exception[f] = std::current_exception();  // thrown from here below, as before
+    }
+  });
+  std::vector<ObjectInfo> objects;
+  for (std::size_t f = 0; f < folders.size(); ++f) {
+    if (parse_exception[f]) std::rethrow_exception(parse_exception[f]);
+    if (!parse_error[f].empty()) {
+      summary.errors.push_back(parse_error[f]);
       ++summary.failed;
       continue;
     }
+    ObjectInfo& info = parsed[f];
     if (options.kind == DatasetKind::kMotion && info.doors + info.drawers == 0) continue;
     objects.push_back(std::move(info));
   }
@@ -743,8 +912,8 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
     std::mutex mutex;
     long done = 0;
     partsim::internal::ProgressLine progress(stderr);
-    partsim::internal::WorkerPool pool(std::min<int>(options.jobs, static_cast<int>(todo.size())));
-    pool.Start(static_cast<int>(todo.size()), [&](int part) {
+    BackendShelf backends(options.backend);
+    RunParts(options.jobs, static_cast<int>(todo.size()), [&](int part) {
       const ObjectInfo& info = objects[todo[static_cast<std::size_t>(part)]];
       const std::string final_dir = options.out + "/objects/" + info.name;
       const std::string dir = final_dir + ".partial";
@@ -754,10 +923,13 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
         fs::remove_all(dir);  // a torn earlier attempt
         fs::remove_all(final_dir);
         fs::create_directories(dir);
+        std::unique_ptr<RenderBackend> backend = backends.Take();  // null: a new one per object
         const json doc =
             options.kind == DatasetKind::kDetection
-                ? RenderDetectionObject(options, info.folder, info.name, category_ids, dir, &views)
-                : RenderMotionObject(options, info.folder, info.name, dir, &views);
+                ? RenderDetectionObject(options, info.folder, info.name, category_ids, dir,
+                                        backend.get(), &views)
+                : RenderMotionObject(options, info.folder, info.name, dir, backend.get(), &views);
+        backends.Put(std::move(backend));
         WriteText(dir + "/views.json", doc.dump(1));
         WriteText(dir + "/" + kDone, "");
         fs::rename(dir, final_dir);
@@ -786,7 +958,6 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
         progress.Update(done, static_cast<long>(todo.size()), text.str());
       }
     });
-    pool.Wait();
     progress.Break();
   }
   std::sort(summary.errors.begin(), summary.errors.end());

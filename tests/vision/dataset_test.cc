@@ -12,6 +12,8 @@
 
 #include "partsim/assets/generator.h"
 #include "partsim/core/error.h"
+#include "partsim/render/image_io.h"
+#include "partsim/render/image_read.h"
 #include "partsim/vision/coco_dataset.h"
 #include "partsim/vision/evaluate.h"
 
@@ -198,6 +200,30 @@ TEST(DatasetTest, MotionDatasetHasDoorsAndDrawersWithUnitAxes) {
   EXPECT_EQ(e.hinge_accuracy, 1.0);
   EXPECT_NEAR(e.hinge_axis_error, 0.0, 1e-6);
   EXPECT_NEAR(e.hinge_origin_error, 0.0, 1e-9);
+}
+
+// The datasets write their PNGs at zlib level 1, rows not filtered (PngCompression{1, 0}), to
+// be faster: other bytes than libpng's default, the same pixels.
+TEST(DatasetTest, FasterPngCompressionKeepsThePixels) {
+  const int w = 37, h = 23;
+  std::vector<std::uint8_t> rgb(3 * w * h);
+  for (std::size_t i = 0; i < rgb.size(); ++i)
+    rgb[i] = static_cast<std::uint8_t>((i * 7919u) % 251u + (i % 97u < 40u ? 0u : 4u));
+  const std::string dir = Temp("png");
+  fs::create_directories(dir);
+  WritePng(dir + "/default.png", w, h, 3, rgb.data());
+  WritePng(dir + "/fast.png", w, h, 3, rgb.data(), PngCompression{1, 0});
+  int w1 = 0, h1 = 0, w2 = 0, h2 = 0;
+  const std::vector<std::uint8_t> a = ReadPng(dir + "/default.png", 3, &w1, &h1);
+  const std::vector<std::uint8_t> b = ReadPng(dir + "/fast.png", 3, &w2, &h2);
+  EXPECT_EQ(w1, w);
+  EXPECT_EQ(h2, h);
+  EXPECT_EQ(a, rgb);
+  EXPECT_EQ(b, rgb);
+  EXPECT_NE(Files(dir)["default.png"], Files(dir)["fast.png"]);
+  EXPECT_THROW(WritePng(dir + "/x.png", w, h, 3, rgb.data(), PngCompression{10, 2}), Error);
+  EXPECT_THROW(WritePng(dir + "/x.png", w, h, 3, rgb.data(), PngCompression{1, 5}), Error);
+  EXPECT_FALSE(fs::exists(dir + "/x.png"));
 }
 
 TEST(DatasetTest, BadOptionsAreRefusedByName) {

@@ -1,0 +1,561 @@
+// Detection dataset benchmark (issue 16, "Speed"): views per second of `partsim vision
+// detection-dataset` (vision::GenerateDataset: render, then write RGB, depth PNG and NPY, the
+// part-instance PNG, the point cloud NPZ, the RLE masks and views.json) against the bare
+// rasterizer rate measured on the same objects, on the same machine, in the same run.
+//
+// The objects: a tree generated with partsim's generator (GenerateObject / WriteObject), a
+// systematic sample of the paper's category mix (object i is the category holding model
+// (i + 1/2) * 2346 / N in the order of the paper's table, counted by its #M), in a temporary
+// folder.
+//
+// Runs per repetition, rotating which goes first:
+//   raster C+P+S  partsim's rasterizer (RenderBackend::Render, read-back included) asked for
+//                 Color + Position + Segmentation, the outputs a dataset view takes, at one
+//                 camera per object like a dataset view's (one object's scene, its lights);
+//                 objects in turn, one warm-up picture each (mesh upload) not counted
+//   bare GL       a bare OpenGL program on the same triangles (one Lambert term, colour RGBA
+//                 float + depth read back), partsim_render_bench's "bare" column
+//   dataset j1    GenerateDataset --views V --size S --jobs 1 into a fresh folder
+//   dataset j2    the same with --jobs 2
+// A dataset run's views/s is summary.views / summary.seconds ("all": the folder scan, every
+// object's parse for the split, the split files at the end included); "render" leaves out the
+// time of a merge-only run into the finished folder (the scan, the parse and the split files
+// without rendering), i.e. it counts the workers' time only. The projection for the paper's
+// 2,346 objects x 20 views is 46,920 / render rate + the merge-only time scaled by objects.
+//
+// Usage: partsim_vision_dataset_bench [--objects N] [--views V] [--size S] [--reps R]
+//                                     [--seconds T] [--jobs J1,J2,...] [--tree DIR] [--keep]
+// (--tree: the objects of an existing tree, e.g. ../shared/realdata, instead of generated ones)
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "partsim/assets/generator.h"
+#include "partsim/assets/partnet_mobility.h"
+#include "partsim/core/constants.h"
+#include "partsim/physics/scene.h"
+#include "partsim/render/backend.h"
+#include "partsim/render/camera.h"
+#include "partsim/render/camera_math.h"
+#include "partsim/vision/dataset.h"
+#include "render/gl_util.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using partsim::CameraParams;
+using partsim::kPi;
+using partsim::MeshData;
+using partsim::RenderInstance;
+using partsim::RenderWorld;
+
+constexpr int kPaperObjects = 2346;
+constexpr int kPaperViews = 20;
+
+double Now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// CPU seconds of the whole process (every thread: the workers and llvmpipe's), which other jobs
+// on a shared machine disturb less than the wall clock
+double CpuNow() {
+  timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The tree: object i of N is the category that holds model (i + 1/2) * 2346 / N when the
+// paper's models are counted in the order of its table.
+std::vector<std::string> MakeTree(const std::string& dir, int objects, std::uint64_t seed) {
+  const std::vector<std::string> categories = partsim::GeneratorCategories();
+  std::vector<int> cumulative;
+  int total = 0;
+  for (const std::string& c : categories)
+    cumulative.push_back(total += partsim::PaperModelCount(c));
+  std::map<std::string, int> next_index;
+  std::vector<std::string> picked;
+  for (int i = 0; i < objects; ++i) {
+    const double model = (i + 0.5) * total / objects;
+    size_t c = 0;
+    while (c + 1 < categories.size() && cumulative[c] <= model) ++c;
+    const partsim::GeneratedObject o =
+        partsim::GenerateObject(categories[c], next_index[categories[c]]++, seed);
+    partsim::WriteObject(o, dir + "/" + o.anno_id);
+    picked.push_back(categories[c]);
+  }
+  return picked;
+}
+
+// One object's render world and a camera like a dataset view's: the scene GenerateDataset
+// builds (its lights), joints at rest, the camera in front of the object at 35 degrees of
+// elevation, 1.15 times the distance that keeps the bounding sphere in a 35 degree frame.
+struct ObjectView {
+  RenderWorld world;
+  CameraParams camera;
+};
+
+ObjectView MakeObjectView(const std::string& folder, int size) {
+  partsim::Scene scene;
+  partsim::PartNetMobilityLoader loader(&scene);
+  const partsim::PartNetMobilityObject object = loader.Parse(folder);
+  partsim::Articulation art = scene.AddArticulation(object.articulation);
+  const Eigen::Vector3d front = art.GetRootPose().q * -Eigen::Vector3d::UnitX();
+  scene.SetAmbientLight(Eigen::Vector3f::Constant(0.35f));
+  scene.AddDirectionalLight((-front - Eigen::Vector3d(0, 0, 1.5)).normalized(),
+                            Eigen::Vector3f::Constant(2.2f), false);
+  scene.UpdateRender();
+  ObjectView out;
+  out.world = scene.GetRenderWorld();
+  Eigen::AlignedBox3d box;
+  for (const RenderInstance& inst : out.world.instances)
+    for (const Eigen::Vector3f& v : inst.mesh->vertices)
+      box.extend((inst.X_WV * v.cast<double>().homogeneous()).head<3>());
+  const double fovy = 35.0 * kPi / 180.0;
+  const double radius = std::max(0.5 * box.diagonal().norm(), 1e-3);
+  const double azimuth = std::atan2(front.y(), front.x()), elevation = 35.0 * kPi / 180.0;
+  const Eigen::Vector3d dir(std::cos(elevation) * std::cos(azimuth),
+                            std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+  const Eigen::Vector3d centre = box.center();
+  const double distance = 1.15 * radius / std::sin(0.5 * fovy);
+  out.camera =
+      partsim::MakeCameraParams(size, size, partsim::IntrinsicsFromFovy(size, size, fovy), 0.01,
+                                100.0, partsim::CameraLookAt(centre + distance * dir, centre));
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// the bare OpenGL program of partsim_render_bench ("bare"): one Lambert term, colour (RGBA
+// float) and depth (float) read back, one VAO per mesh, one draw per instance
+
+const char* kBareVertex = R"(#version 450 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+uniform mat4 u_mvp;
+uniform mat3 u_normal_matrix;
+out vec3 v_normal;
+void main() {
+  v_normal = u_normal_matrix * a_normal;
+  gl_Position = u_mvp * vec4(a_position, 1.0);
+}
+)";
+
+const char* kBareFragment = R"(#version 450 core
+in vec3 v_normal;
+uniform vec4 u_color;
+layout(location = 0) out vec4 o_color;
+void main() {
+  float l = max(dot(normalize(v_normal), normalize(vec3(0.3, 0.5, 0.8))), 0.0);
+  o_color = vec4(u_color.rgb * (0.2 + 0.8 * l), u_color.a);
+}
+)";
+
+class BareRenderer {
+ public:
+  BareRenderer() {
+    program_ =
+        partsim::internal::BuildProgram("bare", kBareVertex, "bench", kBareFragment, "bench");
+    mvp_ = glGetUniformLocation(program_, "u_mvp");
+    normal_matrix_ = glGetUniformLocation(program_, "u_normal_matrix");
+    color_ = glGetUniformLocation(program_, "u_color");
+  }
+  ~BareRenderer() {
+    context_.MakeCurrent();
+    Clear();
+    glDeleteFramebuffers(1, &fbo_);
+    glDeleteTextures(1, &color_tex_);
+    glDeleteTextures(1, &depth_tex_);
+    glDeleteProgram(program_);
+  }
+  BareRenderer(const BareRenderer&) = delete;
+  BareRenderer& operator=(const BareRenderer&) = delete;
+
+  // uploads the meshes of `world` (replacing the last world's)
+  void Load(const RenderWorld& world) {
+    context_.MakeCurrent();
+    Clear();
+    for (const RenderInstance& inst : world.instances) {
+      const MeshData* key = inst.mesh.get();
+      if (std::find_if(meshes_.begin(), meshes_.end(),
+                       [&](const Mesh& m) { return m.key == key; }) == meshes_.end())
+        meshes_.push_back(Upload(*inst.mesh));
+    }
+  }
+
+  void Render(const RenderWorld& world, const CameraParams& cam) {
+    context_.MakeCurrent();
+    Resize(cam.width, cam.height);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, cam.width, cam.height);
+    const float zeros[4] = {0, 0, 0, 0}, one = 1;
+    glClearNamedFramebufferfv(fbo_, GL_COLOR, 0, zeros);
+    glClearNamedFramebufferfv(fbo_, GL_DEPTH, 0, &one);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glUseProgram(program_);
+    const Eigen::Matrix4d view_proj = cam.projection * cam.view;
+    for (const RenderInstance& inst : world.instances) {
+      const Mesh* mesh = nullptr;
+      for (const Mesh& m : meshes_)
+        if (m.key == inst.mesh.get()) mesh = &m;
+      const Eigen::Matrix4f mvp = (view_proj * inst.X_WV).cast<float>();
+      const Eigen::Matrix3f nm =
+          (cam.view * inst.X_WV).topLeftCorner<3, 3>().inverse().transpose().cast<float>();
+      glUniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
+      glUniformMatrix3fv(normal_matrix_, 1, GL_FALSE, nm.data());
+      glUniform4fv(color_, 1, inst.material.base_color.data());
+      glBindVertexArray(mesh->vao);
+      glDrawElements(GL_TRIANGLES, mesh->count, GL_UNSIGNED_INT, nullptr);
+    }
+    const size_t n = static_cast<size_t>(cam.width) * cam.height;
+    color_buf_.resize(4 * n);
+    depth_buf_.resize(n);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glReadPixels(0, 0, cam.width, cam.height, GL_RGBA, GL_FLOAT, color_buf_.data());
+    glReadPixels(0, 0, cam.width, cam.height, GL_DEPTH_COMPONENT, GL_FLOAT, depth_buf_.data());
+  }
+
+ private:
+  struct Mesh {
+    const MeshData* key = nullptr;
+    GLuint vao = 0, vbo = 0, ebo = 0;
+    GLsizei count = 0;
+  };
+
+  void Clear() {
+    for (Mesh& m : meshes_) {
+      glDeleteVertexArrays(1, &m.vao);
+      glDeleteBuffers(1, &m.vbo);
+      glDeleteBuffers(1, &m.ebo);
+    }
+    meshes_.clear();
+  }
+
+  // flat normals when the mesh has none, as partsim does
+  static Mesh Upload(const MeshData& data) {
+    std::vector<float> v;
+    std::vector<uint32_t> idx;
+    const bool smooth = data.normals.size() == data.vertices.size();
+    if (smooth) {
+      for (size_t i = 0; i < data.vertices.size(); ++i) {
+        v.insert(v.end(), data.vertices[i].data(), data.vertices[i].data() + 3);
+        v.insert(v.end(), data.normals[i].data(), data.normals[i].data() + 3);
+      }
+      for (const auto& f : data.faces)
+        idx.insert(idx.end(), {uint32_t(f[0]), uint32_t(f[1]), uint32_t(f[2])});
+    } else {
+      for (const auto& f : data.faces) {
+        const Eigen::Vector3f n = (data.vertices[f[1]] - data.vertices[f[0]])
+                                      .cross(data.vertices[f[2]] - data.vertices[f[0]])
+                                      .normalized();
+        for (int k = 0; k < 3; ++k) {
+          idx.push_back(static_cast<uint32_t>(v.size() / 6));
+          v.insert(v.end(), data.vertices[f[k]].data(), data.vertices[f[k]].data() + 3);
+          v.insert(v.end(), n.data(), n.data() + 3);
+        }
+      }
+    }
+    Mesh m;
+    m.key = &data;
+    m.count = static_cast<GLsizei>(idx.size());
+    glCreateBuffers(1, &m.vbo);
+    glNamedBufferStorage(m.vbo, v.size() * sizeof(float), v.data(), 0);
+    glCreateBuffers(1, &m.ebo);
+    glNamedBufferStorage(m.ebo, idx.size() * sizeof(uint32_t), idx.data(), 0);
+    glCreateVertexArrays(1, &m.vao);
+    glVertexArrayVertexBuffer(m.vao, 0, m.vbo, 0, 6 * sizeof(float));
+    glVertexArrayElementBuffer(m.vao, m.ebo);
+    for (GLuint a = 0; a < 2; ++a) {
+      glEnableVertexArrayAttrib(m.vao, a);
+      glVertexArrayAttribFormat(m.vao, a, 3, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
+      glVertexArrayAttribBinding(m.vao, a, 0);
+    }
+    return m;
+  }
+
+  void Resize(int w, int h) {
+    if (w == width_ && h == height_) return;
+    glDeleteFramebuffers(1, &fbo_);
+    glDeleteTextures(1, &color_tex_);
+    glDeleteTextures(1, &depth_tex_);
+    glCreateTextures(GL_TEXTURE_2D, 1, &color_tex_);
+    glTextureStorage2D(color_tex_, 1, GL_RGBA32F, w, h);
+    glCreateTextures(GL_TEXTURE_2D, 1, &depth_tex_);
+    glTextureStorage2D(depth_tex_, 1, GL_DEPTH_COMPONENT32F, w, h);
+    glCreateFramebuffers(1, &fbo_);
+    glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, color_tex_, 0);
+    glNamedFramebufferTexture(fbo_, GL_DEPTH_ATTACHMENT, depth_tex_, 0);
+    width_ = w;
+    height_ = h;
+  }
+
+  partsim::internal::EglContext context_;  // constructed (and current) before the GL calls
+  GLuint program_ = 0;
+  GLint mvp_ = -1, normal_matrix_ = -1, color_ = -1;
+  std::vector<Mesh> meshes_;
+  GLuint fbo_ = 0, color_tex_ = 0, depth_tex_ = 0;
+  int width_ = 0, height_ = 0;
+  std::vector<float> color_buf_, depth_buf_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+struct Rates {
+  double per_second = 0;  // pictures per wall-clock second
+  double cpu_ms = 0;      // process CPU milliseconds per picture
+};
+
+// Pictures per second over the objects in turn: per object one warm-up picture (mesh upload),
+// then pictures for `seconds` / objects.
+template <typename Prepare, typename Draw>
+Rates Rate(size_t objects, double seconds, Prepare&& prepare, Draw&& draw) {
+  long frames = 0;
+  double elapsed = 0, cpu = 0;
+  for (size_t i = 0; i < objects; ++i) {
+    prepare(i);
+    draw(i);
+    const double start = Now(), cpu_start = CpuNow();
+    double t = 0;
+    do {
+      draw(i);
+      ++frames;
+      t = Now() - start;
+    } while (t < seconds / static_cast<double>(objects));
+    elapsed += t;
+    cpu += CpuNow() - cpu_start;
+  }
+  return {static_cast<double>(frames) / elapsed, 1000 * cpu / static_cast<double>(frames)};
+}
+
+struct DatasetRun {
+  double all = 0;     // views / summary.seconds
+  double render = 0;  // views / (summary.seconds - merge-only seconds)
+  double merge = 0;   // merge-only seconds
+  double cpu_ms = 0;  // process CPU milliseconds per view, the merge-only run's left out
+  long views = 0;
+};
+
+DatasetRun RunDataset(const std::string& tree, const std::string& out, int views, int size,
+                      int jobs) {
+  fs::remove_all(out);
+  partsim::vision::DatasetOptions o;
+  o.dataset_root = tree;
+  o.out = out;
+  o.views = views;
+  o.size = size;
+  o.seed = 1;
+  o.jobs = jobs;
+  o.progress = false;
+  const double cpu0 = CpuNow();
+  const partsim::vision::DatasetSummary s = partsim::vision::GenerateDataset(o);
+  const double cpu1 = CpuNow();
+  if (s.failed > 0)
+    throw partsim::Error("dataset run failed: " + (s.errors.empty() ? "" : s.errors.front()));
+  o.merge_only = true;
+  const partsim::vision::DatasetSummary m = partsim::vision::GenerateDataset(o);
+  const double cpu2 = CpuNow();
+  fs::remove_all(out);
+  DatasetRun r;
+  r.views = s.views;
+  r.merge = m.seconds;
+  r.cpu_ms = 1000 * ((cpu1 - cpu0) - (cpu2 - cpu1)) / static_cast<double>(s.views);
+  r.all = static_cast<double>(s.views) / s.seconds;
+  r.render = static_cast<double>(s.views) / std::max(s.seconds - m.seconds, 1e-9);
+  return r;
+}
+
+std::string Minutes(double seconds) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.1f min", seconds / 60.0);
+  return buf;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int objects = 12, views = 20, size = 512, reps = 3;
+  std::vector<int> jobs = {1, 2};
+  double seconds = 4.0;
+  bool keep = false;
+  std::string tree;  // an existing tree instead of a generated one
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&]() -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", argv[i]);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (!std::strcmp(argv[i], "--objects")) {
+      objects = std::atoi(next());
+    } else if (!std::strcmp(argv[i], "--views")) {
+      views = std::atoi(next());
+    } else if (!std::strcmp(argv[i], "--size")) {
+      size = std::atoi(next());
+    } else if (!std::strcmp(argv[i], "--reps")) {
+      reps = std::atoi(next());
+    } else if (!std::strcmp(argv[i], "--seconds")) {
+      seconds = std::atof(next());
+    } else if (!std::strcmp(argv[i], "--jobs")) {
+      jobs.clear();
+      for (const char* p = next(); *p;) {
+        char* end = nullptr;
+        jobs.push_back(static_cast<int>(std::strtol(p, &end, 10)));
+        if (jobs.back() < 1 || end == p || (*end != ',' && *end != '\0')) {
+          std::fprintf(stderr, "--jobs takes a list like 1,2\n");
+          return 2;
+        }
+        p = *end == ',' ? end + 1 : end;
+      }
+    } else if (!std::strcmp(argv[i], "--tree")) {
+      tree = next();
+    } else if (!std::strcmp(argv[i], "--keep")) {
+      keep = true;
+    } else {
+      std::fprintf(stderr,
+                   "usage: %s [--objects N] [--views V] [--size S] [--reps R] [--seconds T] "
+                   "[--jobs J1,J2,...] [--tree DIR] [--keep]\n",
+                   argv[0]);
+      return 2;
+    }
+  }
+  if (objects < 1 || views < 1 || size < 16 || reps < 1) {
+    std::fprintf(stderr, "bad arguments\n");
+    return 2;
+  }
+
+  const std::string root =
+      (fs::temp_directory_path() / ("partsim_vision_dataset_bench_" + std::to_string(::getpid())))
+          .string();
+  fs::remove_all(root);
+  const std::string out = root + "/out";
+  std::vector<std::string> folders;
+  if (tree.empty()) {
+    tree = root + "/tree";
+    const std::vector<std::string> picked = MakeTree(tree, objects, 1);
+    std::map<std::string, int> mix;
+    for (const std::string& c : picked) ++mix[c];
+    std::printf("objects: %d generated (", objects);
+    bool first = true;
+    for (const auto& [c, n] : mix)
+      std::printf("%s%s %d", first ? "" : ", ", c.c_str(), n), first = false;
+    std::printf(")\n");
+  }
+  // the objects' scenes, one camera each (every folder holding a mobility.urdf, as the dataset
+  // finds them)
+  for (const auto& e : fs::recursive_directory_iterator(tree))
+    if (e.is_regular_file() && e.path().filename() == "mobility.urdf")
+      folders.push_back(e.path().parent_path().string());
+  std::sort(folders.begin(), folders.end());
+  objects = static_cast<int>(folders.size());
+  if (objects == 0) {
+    std::fprintf(stderr, "no object (a folder with mobility.urdf) under '%s'\n", tree.c_str());
+    return 2;
+  }
+  std::printf("tree: %s, %d objects\n", tree.c_str(), objects);
+  std::vector<ObjectView> scenes;
+  size_t triangles = 0;
+  for (const std::string& f : folders) {
+    scenes.push_back(MakeObjectView(f, size));
+    for (const RenderInstance& inst : scenes.back().world.instances)
+      triangles += inst.mesh->faces.size();
+  }
+  auto backend = partsim::MakeRasterBackend();
+  BareRenderer bare;
+  const unsigned kDatasetOutputs = partsim::kColor | partsim::kPosition | partsim::kSegmentation;
+  std::printf("device: %s; %zu triangles per object on average; %d x %d, %d views per object\n",
+              backend->Device().c_str(), triangles / scenes.size(), size, size, views);
+  std::printf("%d repetitions; rasterizer rates over >= %.1f s each; hardware threads %u\n", reps,
+              seconds, std::thread::hardware_concurrency());
+  std::fflush(stdout);
+
+  partsim::Picture pic;
+  const size_t runs = 2 + jobs.size();  // raster, bare GL, one dataset run per --jobs value
+  std::vector<double> raster, raster_cpu, bare_rate, bare_cpu;
+  std::vector<std::vector<double>> j_all(jobs.size()), j_render(jobs.size()), j_cpu(jobs.size()),
+      j_merge(jobs.size());
+  long views_per_run = 0;
+  for (int r = 0; r < reps; ++r) {
+    for (size_t k = 0; k < runs; ++k) {
+      const size_t run = (static_cast<size_t>(r) + k) % runs;
+      if (run == 0) {
+        const Rates rate = Rate(
+            scenes.size(), seconds, [](size_t) {},
+            [&](size_t i) {
+              backend->Render(scenes[i].world, scenes[i].camera, &pic, kDatasetOutputs);
+            });
+        raster.push_back(rate.per_second);
+        raster_cpu.push_back(rate.cpu_ms);
+      } else if (run == 1) {
+        const Rates rate = Rate(
+            scenes.size(), seconds, [&](size_t i) { bare.Load(scenes[i].world); },
+            [&](size_t i) { bare.Render(scenes[i].world, scenes[i].camera); });
+        bare_rate.push_back(rate.per_second);
+        bare_cpu.push_back(rate.cpu_ms);
+      } else {
+        const size_t j = run - 2;
+        const DatasetRun d = RunDataset(tree, out, views, size, jobs[j]);
+        j_all[j].push_back(d.all);
+        j_render[j].push_back(d.render);
+        j_cpu[j].push_back(d.cpu_ms);
+        j_merge[j].push_back(d.merge);
+        views_per_run = d.views;
+      }
+    }
+    std::printf("rep %d: raster C+P+S %.1f/s (%.1f cpu ms), bare GL %.1f/s (%.1f cpu ms)", r + 1,
+                raster.back(), raster_cpu.back(), bare_rate.back(), bare_cpu.back());
+    for (size_t j = 0; j < jobs.size(); ++j)
+      std::printf(", dataset j%d %.2f views/s (render %.2f, %.1f cpu ms)", jobs[j], j_all[j].back(),
+                  j_render[j].back(), j_cpu[j].back());
+    std::printf("\n");
+    std::fflush(stdout);
+  }
+
+  const double raster_m = Median(raster), bare_m = Median(bare_rate);
+  const double raster_cpu_m = Median(raster_cpu), bare_cpu_m = Median(bare_cpu);
+  std::printf("\nmedians over %d repetitions (%ld views per dataset run)\n", reps, views_per_run);
+  std::printf("  raster C+P+S (partsim, read-back)  %8.1f pictures/s  %6.1f cpu ms/picture\n",
+              raster_m, raster_cpu_m);
+  std::printf("  bare GL (Lambert, colour + depth)  %8.1f pictures/s  %6.1f cpu ms/picture\n",
+              bare_m, bare_cpu_m);
+  std::printf("%-9s %8s %8s %8s | %8s %8s %8s | %8s | %s\n", "dataset", "views/s", "render",
+              "cpu ms", "/raster", "/bare GL", "cpu/rast", "merge s", "2,346 x 20 views");
+  for (size_t j = 0; j < jobs.size(); ++j) {
+    const double all = Median(j_all[j]), render = Median(j_render[j]), cpu = Median(j_cpu[j]);
+    const double merge = Median(j_merge[j]);
+    // the rendering at the measured rate, the start (scan, parse) and the split files scaled
+    // by the number of objects
+    const double projected = kPaperObjects * kPaperViews / render + merge * kPaperObjects / objects;
+    const std::string name = "--jobs " + std::to_string(jobs[j]);
+    std::printf("%-9s %8.2f %8.2f %8.1f | %8.3f %8.3f %8.3f | %8.2f | %s\n", name.c_str(), all,
+                render, cpu, render / raster_m, render / bare_m, raster_cpu_m / cpu, merge,
+                Minutes(projected).c_str());
+  }
+  std::printf(
+      "(render: views/s without the merge-only run's time; /raster, /bare GL: render "
+      "rate over theirs; cpu/rast: raster CPU per picture over dataset CPU per view)\n");
+  if (!keep)
+    fs::remove_all(root);
+  else
+    std::printf("kept %s\n", root.c_str());
+  return 0;
+}
