@@ -27,6 +27,7 @@
 #include "partsim/core/check.h"
 #include "partsim/core/constants.h"
 #include "partsim/core/error.h"
+#include "partsim/core/log.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
 #include "partsim/vision/coco.h"
@@ -628,7 +629,10 @@ json RenderMotionObject(const DatasetOptions& options, const std::string& folder
       const Eigen::Vector3d axis = (R * (X_WJ.q * Eigen::Vector3d::UnitX())).normalized();
       const Eigen::Vector3d pivot = origin + axis * axis.dot(centroid - origin);
       const double lower = joint.GetLimits()[0];
-      const double state = v.qpos[dof] - (std::isfinite(lower) ? lower : 0.0);
+      // the opening from the lower limit; a hinge without limits (continuous) from 0, in
+      // [0, 2 pi)
+      double state = v.qpos[dof] - (std::isfinite(lower) ? lower : 0.0);
+      if (!std::isfinite(lower)) state = std::fmod(std::fmod(state, 2 * kPi) + 2 * kPi, 2 * kPi);
       samples.push_back(
           {{"sample_id", name + "/" + stem},
            {"link", art.GetLink(link).GetName()},
@@ -913,6 +917,14 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
     long done = 0;
     partsim::internal::ProgressLine progress(stderr);
     BackendShelf backends(options.backend);
+    // the scan above logged each object's load warnings once; reading the objects again to
+    // render them would log them again
+    const LogLevel log_level = GetLogLevel();
+    if (log_level == LogLevel::kWarning) SetLogLevel(LogLevel::kError);
+    struct RestoreLogLevel {
+      LogLevel level;
+      ~RestoreLogLevel() { SetLogLevel(level); }
+    } restore_log_level{log_level};
     RunParts(options.jobs, static_cast<int>(todo.size()), [&](int part) {
       const ObjectInfo& info = objects[todo[static_cast<std::size_t>(part)]];
       const std::string final_dir = options.out + "/objects/" + info.name;

@@ -1,6 +1,9 @@
 // .npy and .npz writing (the zip container: local headers, stored entries, central directory).
 #include "vision/npz.h"
 
+#include <zlib.h>
+
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <fstream>
@@ -73,18 +76,15 @@ std::vector<std::uint8_t> NpyBytes(const NpyArray& array) {
 }
 
 std::uint32_t Crc32(const std::uint8_t* data, std::size_t size) {
-  static const std::array<std::uint32_t, 256> table = [] {
-    std::array<std::uint32_t, 256> t{};
-    for (std::uint32_t i = 0; i < 256; ++i) {
-      std::uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[i] = c;
-    }
-    return t;
-  }();
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xff] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFu;
+  // zlib's table-driven CRC-32, in pieces that fit its uInt length
+  uLong crc = crc32(0L, Z_NULL, 0);
+  while (size > 0) {
+    const auto n = static_cast<uInt>(std::min<std::size_t>(size, 1u << 30));
+    crc = crc32(crc, data, n);
+    data += n;
+    size -= n;
+  }
+  return static_cast<std::uint32_t>(crc);
 }
 
 void WriteNpz(const std::string& path, const std::vector<NpyArray>& arrays) {

@@ -16,6 +16,7 @@
 #include "partsim/render/image_read.h"
 #include "partsim/vision/coco_dataset.h"
 #include "partsim/vision/evaluate.h"
+#include "vision/npz.h"
 
 namespace partsim::vision {
 namespace {
@@ -253,6 +254,23 @@ TEST(DatasetTest, BadOptionsAreRefusedByName) {
   b.dataset_root = Temp("empty");
   fs::create_directories(b.dataset_root);
   refused(b, "no PartNet-Mobility object");
+}
+
+}  // namespace
+}  // namespace partsim::vision
+
+namespace partsim::vision {
+namespace {
+
+TEST(NpzTest, Crc32IsZipsAndArchivesHoldTheirArrays) {
+  const std::string check = "123456789";  // the CRC-32 check value of the standard
+  EXPECT_EQ(internal::Crc32(reinterpret_cast<const std::uint8_t*>(check.data()), check.size()),
+            0xCBF43926u);
+  const std::vector<std::uint8_t> npy =
+      internal::NpyBytes(internal::MakeNpyArray("a", std::vector<float>{1, 2, 3}, {3}));
+  ASSERT_EQ(npy.size() % 16, 12u);  // 64-byte aligned header, then 3 float32
+  EXPECT_EQ(std::string(npy.begin() + 1, npy.begin() + 6), "NUMPY");
+  EXPECT_THROW(internal::MakeNpyArray("b", std::vector<float>{1, 2}, {3}), Error);
 }
 
 }  // namespace
