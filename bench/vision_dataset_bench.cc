@@ -42,6 +42,7 @@
 #include <thread>
 #include <vector>
 
+#include "bare_renderer.h"
 #include "partsim/assets/generator.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/core/constants.h"
@@ -50,7 +51,6 @@
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/vision/dataset.h"
-#include "render/gl_util.h"
 
 namespace {
 
@@ -141,181 +141,6 @@ ObjectView MakeObjectView(const std::string& folder, int size) {
                                 100.0, partsim::CameraLookAt(centre + distance * dir, centre));
   return out;
 }
-
-// ---------------------------------------------------------------------------------------------
-// the bare OpenGL program of partsim_render_bench ("bare"): one Lambert term, colour (RGBA
-// float) and depth (float) read back, one VAO per mesh, one draw per instance
-
-const char* kBareVertex = R"(#version 450 core
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_normal;
-uniform mat4 u_mvp;
-uniform mat3 u_normal_matrix;
-out vec3 v_normal;
-void main() {
-  v_normal = u_normal_matrix * a_normal;
-  gl_Position = u_mvp * vec4(a_position, 1.0);
-}
-)";
-
-const char* kBareFragment = R"(#version 450 core
-in vec3 v_normal;
-uniform vec4 u_color;
-layout(location = 0) out vec4 o_color;
-void main() {
-  float l = max(dot(normalize(v_normal), normalize(vec3(0.3, 0.5, 0.8))), 0.0);
-  o_color = vec4(u_color.rgb * (0.2 + 0.8 * l), u_color.a);
-}
-)";
-
-class BareRenderer {
- public:
-  BareRenderer() {
-    program_ =
-        partsim::internal::BuildProgram("bare", kBareVertex, "bench", kBareFragment, "bench");
-    mvp_ = glGetUniformLocation(program_, "u_mvp");
-    normal_matrix_ = glGetUniformLocation(program_, "u_normal_matrix");
-    color_ = glGetUniformLocation(program_, "u_color");
-  }
-  ~BareRenderer() {
-    context_.MakeCurrent();
-    Clear();
-    glDeleteFramebuffers(1, &fbo_);
-    glDeleteTextures(1, &color_tex_);
-    glDeleteTextures(1, &depth_tex_);
-    glDeleteProgram(program_);
-  }
-  BareRenderer(const BareRenderer&) = delete;
-  BareRenderer& operator=(const BareRenderer&) = delete;
-
-  // uploads the meshes of `world` (replacing the last world's)
-  void Load(const RenderWorld& world) {
-    context_.MakeCurrent();
-    Clear();
-    for (const RenderInstance& inst : world.instances) {
-      const MeshData* key = inst.mesh.get();
-      if (std::find_if(meshes_.begin(), meshes_.end(),
-                       [&](const Mesh& m) { return m.key == key; }) == meshes_.end())
-        meshes_.push_back(Upload(*inst.mesh));
-    }
-  }
-
-  void Render(const RenderWorld& world, const CameraParams& cam) {
-    context_.MakeCurrent();
-    Resize(cam.width, cam.height);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    glViewport(0, 0, cam.width, cam.height);
-    const float zeros[4] = {0, 0, 0, 0}, one = 1;
-    glClearNamedFramebufferfv(fbo_, GL_COLOR, 0, zeros);
-    glClearNamedFramebufferfv(fbo_, GL_DEPTH, 0, &one);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glUseProgram(program_);
-    const Eigen::Matrix4d view_proj = cam.projection * cam.view;
-    for (const RenderInstance& inst : world.instances) {
-      const Mesh* mesh = nullptr;
-      for (const Mesh& m : meshes_)
-        if (m.key == inst.mesh.get()) mesh = &m;
-      const Eigen::Matrix4f mvp = (view_proj * inst.X_WV).cast<float>();
-      const Eigen::Matrix3f nm =
-          (cam.view * inst.X_WV).topLeftCorner<3, 3>().inverse().transpose().cast<float>();
-      glUniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
-      glUniformMatrix3fv(normal_matrix_, 1, GL_FALSE, nm.data());
-      glUniform4fv(color_, 1, inst.material.base_color.data());
-      glBindVertexArray(mesh->vao);
-      glDrawElements(GL_TRIANGLES, mesh->count, GL_UNSIGNED_INT, nullptr);
-    }
-    const size_t n = static_cast<size_t>(cam.width) * cam.height;
-    color_buf_.resize(4 * n);
-    depth_buf_.resize(n);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, cam.width, cam.height, GL_RGBA, GL_FLOAT, color_buf_.data());
-    glReadPixels(0, 0, cam.width, cam.height, GL_DEPTH_COMPONENT, GL_FLOAT, depth_buf_.data());
-  }
-
- private:
-  struct Mesh {
-    const MeshData* key = nullptr;
-    GLuint vao = 0, vbo = 0, ebo = 0;
-    GLsizei count = 0;
-  };
-
-  void Clear() {
-    for (Mesh& m : meshes_) {
-      glDeleteVertexArrays(1, &m.vao);
-      glDeleteBuffers(1, &m.vbo);
-      glDeleteBuffers(1, &m.ebo);
-    }
-    meshes_.clear();
-  }
-
-  // flat normals when the mesh has none, as partsim does
-  static Mesh Upload(const MeshData& data) {
-    std::vector<float> v;
-    std::vector<uint32_t> idx;
-    const bool smooth = data.normals.size() == data.vertices.size();
-    if (smooth) {
-      for (size_t i = 0; i < data.vertices.size(); ++i) {
-        v.insert(v.end(), data.vertices[i].data(), data.vertices[i].data() + 3);
-        v.insert(v.end(), data.normals[i].data(), data.normals[i].data() + 3);
-      }
-      for (const auto& f : data.faces)
-        idx.insert(idx.end(), {uint32_t(f[0]), uint32_t(f[1]), uint32_t(f[2])});
-    } else {
-      for (const auto& f : data.faces) {
-        const Eigen::Vector3f n = (data.vertices[f[1]] - data.vertices[f[0]])
-                                      .cross(data.vertices[f[2]] - data.vertices[f[0]])
-                                      .normalized();
-        for (int k = 0; k < 3; ++k) {
-          idx.push_back(static_cast<uint32_t>(v.size() / 6));
-          v.insert(v.end(), data.vertices[f[k]].data(), data.vertices[f[k]].data() + 3);
-          v.insert(v.end(), n.data(), n.data() + 3);
-        }
-      }
-    }
-    Mesh m;
-    m.key = &data;
-    m.count = static_cast<GLsizei>(idx.size());
-    glCreateBuffers(1, &m.vbo);
-    glNamedBufferStorage(m.vbo, v.size() * sizeof(float), v.data(), 0);
-    glCreateBuffers(1, &m.ebo);
-    glNamedBufferStorage(m.ebo, idx.size() * sizeof(uint32_t), idx.data(), 0);
-    glCreateVertexArrays(1, &m.vao);
-    glVertexArrayVertexBuffer(m.vao, 0, m.vbo, 0, 6 * sizeof(float));
-    glVertexArrayElementBuffer(m.vao, m.ebo);
-    for (GLuint a = 0; a < 2; ++a) {
-      glEnableVertexArrayAttrib(m.vao, a);
-      glVertexArrayAttribFormat(m.vao, a, 3, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
-      glVertexArrayAttribBinding(m.vao, a, 0);
-    }
-    return m;
-  }
-
-  void Resize(int w, int h) {
-    if (w == width_ && h == height_) return;
-    glDeleteFramebuffers(1, &fbo_);
-    glDeleteTextures(1, &color_tex_);
-    glDeleteTextures(1, &depth_tex_);
-    glCreateTextures(GL_TEXTURE_2D, 1, &color_tex_);
-    glTextureStorage2D(color_tex_, 1, GL_RGBA32F, w, h);
-    glCreateTextures(GL_TEXTURE_2D, 1, &depth_tex_);
-    glTextureStorage2D(depth_tex_, 1, GL_DEPTH_COMPONENT32F, w, h);
-    glCreateFramebuffers(1, &fbo_);
-    glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, color_tex_, 0);
-    glNamedFramebufferTexture(fbo_, GL_DEPTH_ATTACHMENT, depth_tex_, 0);
-    width_ = w;
-    height_ = h;
-  }
-
-  partsim::internal::EglContext context_;  // constructed (and current) before the GL calls
-  GLuint program_ = 0;
-  GLint mvp_ = -1, normal_matrix_ = -1, color_ = -1;
-  std::vector<Mesh> meshes_;
-  GLuint fbo_ = 0, color_tex_ = 0, depth_tex_ = 0;
-  int width_ = 0, height_ = 0;
-  std::vector<float> color_buf_, depth_buf_;
-};
 
 // ---------------------------------------------------------------------------------------------
 
@@ -480,7 +305,8 @@ int main(int argc, char** argv) {
       triangles += inst.mesh->faces.size();
   }
   auto backend = partsim::MakeRasterBackend();
-  BareRenderer bare;
+  partsim_bench::BareRenderer bare;
+  std::vector<float> bare_color, bare_depth;  // what it reads back
   const unsigned kDatasetOutputs = partsim::kColor | partsim::kPosition | partsim::kSegmentation;
   std::printf("device: %s; %zu triangles per object on average; %d x %d, %d views per object\n",
               backend->Device().c_str(), triangles / scenes.size(), size, size, views);
@@ -508,7 +334,9 @@ int main(int argc, char** argv) {
       } else if (run == 1) {
         const Rates rate = Rate(
             scenes.size(), seconds, [&](size_t i) { bare.Load(scenes[i].world); },
-            [&](size_t i) { bare.Render(scenes[i].world, scenes[i].camera); });
+            [&](size_t i) {
+              bare.Render(scenes[i].world, scenes[i].camera, &bare_color, &bare_depth);
+            });
         bare_rate.push_back(rate.per_second);
         bare_cpu.push_back(rate.cpu_ms);
       } else {
