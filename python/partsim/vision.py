@@ -253,7 +253,7 @@ class DetectionDataset:
         `transform(image, target)`, when given, returns the pair to yield. Raises ImportError
         when torch cannot be imported."""
         torch = _torch()
-        return _make_torch_detection(torch, self, transform)
+        return _make_torch_dataset(torch, self, transform, _detection_tensors)
 
     def __repr__(self):
         return "DetectionDataset(%r, %r): %d images, %d categories" % (
@@ -327,64 +327,48 @@ class MotionDataset:
         target's mask (0 or 1); m a float32 tensor (13,). `transform(x, m)`, when given,
         returns the pair to yield. Raises ImportError when torch cannot be imported."""
         torch = _torch()
-        return _make_torch_motion(torch, self, transform)
+        return _make_torch_dataset(torch, self, transform, _motion_tensors)
 
     def __repr__(self):
         return "MotionDataset(%r, %r): %d samples, slider_range %g m" % (
             self.root, self.split, len(self.samples), self.slider_range)
 
 
-def _make_torch_detection(torch, dataset, transform):
-    class _DetectionTorchDataset(torch.utils.data.Dataset):
-        """A DetectionDataset as (image, target) pairs of tensors (DetectionDataset.torch)."""
+def _make_torch_dataset(torch, dataset, transform, convert):
+    """`dataset` as a torch Dataset of the pairs `convert(torch, item)` makes, passed through
+    `transform(a, b)` when one is given."""
 
-        def __init__(self):
-            self.dataset = dataset
-            self.transform = transform
-
+    class _TorchDataset(torch.utils.data.Dataset):
         def __len__(self):
-            return len(self.dataset)
+            return len(dataset)
 
         def __getitem__(self, index):
-            item = self.dataset[index]
-            image = torch.from_numpy(item["rgb"]).permute(2, 0, 1).float().div_(255.0)
-            xywh = item["boxes"]
-            xyxy = _np.concatenate([xywh[:, :2], xywh[:, :2] + xywh[:, 2:]], axis=1)
-            target = {
-                "boxes": torch.as_tensor(xyxy, dtype=torch.float32).reshape(-1, 4),
-                "labels": torch.as_tensor(item["labels"], dtype=torch.int64),
-                "masks": torch.from_numpy(item["masks"].astype(_np.uint8)),
-                "image_id": torch.tensor([item["image_id"]], dtype=torch.int64),
-                "area": torch.as_tensor(item["areas"], dtype=torch.float32),
-                "iscrowd": torch.as_tensor(item["iscrowd"], dtype=torch.int64),
-            }
-            if self.transform is not None:
-                return self.transform(image, target)
-            return image, target
+            a, b = convert(torch, dataset[index])
+            return transform(a, b) if transform is not None else (a, b)
 
-    return _DetectionTorchDataset()
+    return _TorchDataset()
 
 
-def _make_torch_motion(torch, dataset, transform):
-    class _MotionTorchDataset(torch.utils.data.Dataset):
-        """A MotionDataset as (5-channel input, m) pairs of tensors (MotionDataset.torch)."""
+def _detection_tensors(torch, item):
+    """A DetectionDataset item as (image, target): torchvision's detection convention."""
+    image = torch.from_numpy(item["rgb"]).permute(2, 0, 1).float().div_(255.0)
+    xywh = item["boxes"]
+    xyxy = _np.concatenate([xywh[:, :2], xywh[:, :2] + xywh[:, 2:]], axis=1)
+    target = {
+        "boxes": torch.as_tensor(xyxy, dtype=torch.float32).reshape(-1, 4),
+        "labels": torch.as_tensor(item["labels"], dtype=torch.int64),
+        "masks": torch.from_numpy(item["masks"].astype(_np.uint8)),
+        "image_id": torch.tensor([item["image_id"]], dtype=torch.int64),
+        "area": torch.as_tensor(item["areas"], dtype=torch.float32),
+        "iscrowd": torch.as_tensor(item["iscrowd"], dtype=torch.int64),
+    }
+    return image, target
 
-        def __init__(self):
-            self.dataset = dataset
-            self.transform = transform
 
-        def __len__(self):
-            return len(self.dataset)
-
-        def __getitem__(self, index):
-            item = self.dataset[index]
-            rgb = item["rgb"].astype(_np.float32) / 255.0
-            x = _np.concatenate([rgb, item["depth"][..., None].astype(_np.float32),
-                                 item["mask"][..., None].astype(_np.float32)], axis=2)
-            x = torch.from_numpy(_np.ascontiguousarray(x.transpose(2, 0, 1)))
-            m = torch.as_tensor(item["m"], dtype=torch.float32)
-            if self.transform is not None:
-                return self.transform(x, m)
-            return x, m
-
-    return _MotionTorchDataset()
+def _motion_tensors(torch, item):
+    """A MotionDataset item as (5-channel input, m): RGB in [0, 1], depth in metres, mask."""
+    rgb = item["rgb"].astype(_np.float32) / 255.0
+    x = _np.concatenate([rgb, item["depth"][..., None].astype(_np.float32),
+                         item["mask"][..., None].astype(_np.float32)], axis=2)
+    x = torch.from_numpy(_np.ascontiguousarray(x.transpose(2, 0, 1)))
+    return x, torch.as_tensor(item["m"], dtype=torch.float32)
