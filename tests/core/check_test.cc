@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "error_of.h"
 #include "partsim/core/constants.h"
 
 namespace partsim {
@@ -14,16 +15,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// the message of the Error that `f` throws, or "" when it throws none
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using partsim::testing::ErrorOf;
 
 TEST(FormatNumberTest, SmallNumbersKeepTheirValue) {
   // std::to_string prints this as "0.000000"

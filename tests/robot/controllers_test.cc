@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "error_of.h"
 #include "robot/test_robots.h"
 
 namespace partsim {
@@ -334,16 +335,7 @@ TEST(EndEffectorController, UnreachablePoseFailsAndArmStays) {
   EXPECT_THROW(EndEffectorController(w.arm, {}, "nope", Pose(), JointControllerOptions()), Error);
 }
 
-// The message of what `f` throws as partsim::Error; "" when it throws nothing.
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using partsim::testing::ErrorOf;
 
 // A setting out of range, the text its value prints as, and how to apply it.
 template <typename T>

@@ -10,6 +10,7 @@
 #include <functional>
 #include <string>
 
+#include "error_of.h"
 #include "partsim/core/error.h"
 
 namespace partsim::vision {
@@ -18,14 +19,7 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using partsim::testing::ErrorOf;
 
 // two 4x3 images (width 4, height 3), two categories, three annotations: a 2-pixel mask as
 // counts, the same as compressed text ("52" is 5, 2, then 5 -> "525"), and a crowd region

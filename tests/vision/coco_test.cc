@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "error_of.h"
 #include "partsim/core/error.h"
 
 namespace partsim::vision {
@@ -19,14 +20,7 @@ namespace {
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using partsim::testing::ErrorOf;
 
 // a mask of `width` x `height` with each pixel foreground with probability `density`
 Mask RandomMask(int width, int height, double density, std::mt19937* rng) {

@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 
+#include "error_of.h"
 #include "partsim/core/constants.h"
 #include "partsim/core/error.h"
 #include "partsim/vision/evaluate.h"
@@ -15,14 +16,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using partsim::testing::ErrorOf;
 
 // m of a hinge: pivot p, axis d, state x_door
 MotionSample Hinge(const std::string& id, std::array<double, 3> p, std::array<double, 3> d,

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "error_of.h"
 #include "partsim/assets/generator.h"
 #include "partsim/core/error.h"
 #include "partsim/render/image_io.h"
@@ -365,16 +366,7 @@ TEST(ShowTest, WriteShowPngWritesThePicture) {
   EXPECT_EQ(h, s.height);
 }
 
-// the message of the Error that `f` throws, "" when it throws none
-template <typename F>
-std::string ErrorOf(const F& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using partsim::testing::ErrorOf;
 
 bool Contains(const std::string& text, const std::string& what) {
   return text.find(what) != std::string::npos;
