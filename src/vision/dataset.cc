@@ -357,8 +357,7 @@ class ObjectRenderer {
     const Eigen::Vector3d dir(std::cos(elevation) * std::cos(azimuth),
                               std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
     const Eigen::Vector3d eye = centre + distance * dir;
-    camera_.LookAt(eye, centre);
-    scene_->UpdateRender();
+    camera_.LookAt(eye, centre);  // a free camera: the picture reads its pose, not the snapshot
     camera_.TakePicture(kColor | kPosition | kSegmentation);
     const Picture& pic = camera_.GetPictureData();
 
@@ -903,16 +902,16 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
                                 .dump(1));
 
   // this shard's objects that are not done yet
-  std::vector<std::size_t> todo;
+  std::vector<std::size_t> pending;
   for (std::size_t i = 0; i < objects.size(); ++i) {
     if (static_cast<int>(i % options.shard_count) != options.shard_index) continue;
     if (fs::exists(options.out + "/objects/" + objects[i].name + "/" + kDone)) {
       ++summary.skipped;
       continue;
     }
-    todo.push_back(i);
+    pending.push_back(i);
   }
-  if (!options.merge_only && !todo.empty()) {
+  if (!options.merge_only && !pending.empty()) {
     std::mutex mutex;
     long done = 0;
     partsim::internal::ProgressLine progress(stderr);
@@ -925,8 +924,8 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
       LogLevel level;
       ~RestoreLogLevel() { SetLogLevel(level); }
     } restore_log_level{log_level};
-    RunParts(options.jobs, static_cast<int>(todo.size()), [&](int part) {
-      const ObjectInfo& info = objects[todo[static_cast<std::size_t>(part)]];
+    RunParts(options.jobs, static_cast<int>(pending.size()), [&](int part) {
+      const ObjectInfo& info = objects[pending[static_cast<std::size_t>(part)]];
       const std::string final_dir = options.out + "/objects/" + info.name;
       const std::string dir = final_dir + ".partial";
       long views = 0;
@@ -962,12 +961,12 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const double rate = summary.views / std::max(elapsed, 1e-9);
         const double eta = elapsed / static_cast<double>(done) *
-                           static_cast<double>(static_cast<long>(todo.size()) - done);
+                           static_cast<double>(static_cast<long>(pending.size()) - done);
         std::ostringstream text;
-        text << "[" << done << "/" << todo.size() << "] " << info.name << "  "
+        text << "[" << done << "/" << pending.size() << "] " << info.name << "  "
              << FormatNumber(std::round(rate * 10) / 10) << " views/s  elapsed "
              << Duration(elapsed) << "  eta " << Duration(eta);
-        progress.Update(done, static_cast<long>(todo.size()), text.str());
+        progress.Update(done, static_cast<long>(pending.size()), text.str());
       }
     });
     progress.Break();
