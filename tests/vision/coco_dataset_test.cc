@@ -172,3 +172,30 @@ TEST(VisionCocoDatasetTest, LoadNamesTheFile) {
 
 }  // namespace
 }  // namespace partsim::vision
+
+namespace partsim::vision {
+namespace {
+
+TEST(VisionCocoDatasetTest, HostileFilesAreRefusedByName) {
+  auto error = [](const std::string& text) {
+    return ErrorOf([&] { ParseCocoDataset(text, "gt"); });
+  };
+  // nesting deep enough to overflow a recursive parser's stack
+  EXPECT_THAT(error(std::string(100000, '[') + std::string(100000, ']')),
+              HasSubstr("nested deeper than"));
+  // bytes that are not text at all, and garbage after a valid document
+  EXPECT_THAT(error(std::string("\xff\xfe\x00\x9c garbage", 12)), HasSubstr("gt: not valid JSON"));
+  EXPECT_THAT(error(std::string(kGroundTruth) + "\xc3\x28"), HasSubstr("gt: not valid JSON"));
+  // numbers far out of range
+  EXPECT_THAT(error(Edited("\"width\": 4,", "\"width\": 1e300,")),
+              HasSubstr("images[0] (id 7): 'width'"));
+  EXPECT_THAT(error(Edited("\"id\": 7,", "\"id\": 1e300,")),
+              HasSubstr("images[0]: 'id' must be an integer"));
+  EXPECT_THAT(error(Edited("\"counts\": [5, 2, 5]", "\"counts\": [5, 99999999999999999999, 5]")),
+              HasSubstr("annotations[0] (id 10): 'segmentation'"));
+  EXPECT_THAT(error(Edited("\"counts\": [5, 2, 5]", "\"counts\": [5, -2, 9]")),
+              HasSubstr("annotations[0] (id 10): 'segmentation'"));
+}
+
+}  // namespace
+}  // namespace partsim::vision
