@@ -353,7 +353,11 @@ std::vector<LoadedMesh> LoadMeshFile(const std::string& path, const Eigen::Vecto
 }
 
 std::shared_ptr<MeshData> LoadMergedMesh(const std::string& path, const Eigen::Vector3d& scale) {
-  std::vector<LoadedMesh> parts = LoadMeshFile(path, scale);
+  return MergeMeshes(LoadMeshFile(path, scale), path);
+}
+
+std::shared_ptr<MeshData> MergeMeshes(const std::vector<LoadedMesh>& parts,
+                                      const std::string& path) {
   auto merged = std::make_shared<MeshData>();
   merged->source = path;
   merged->name = fs::path(path).stem().string();
@@ -448,8 +452,12 @@ std::vector<std::shared_ptr<MeshData>> SplitConnectedComponents(const MeshData& 
 
 std::vector<std::shared_ptr<MeshData>> LoadConvexPieces(const std::string& path,
                                                         const Eigen::Vector3d& scale) {
+  return ConnectedPieces(LoadMeshFile(path, scale));
+}
+
+std::vector<std::shared_ptr<MeshData>> ConnectedPieces(const std::vector<LoadedMesh>& parts) {
   std::vector<std::shared_ptr<MeshData>> out;
-  for (const LoadedMesh& part : LoadMeshFile(path, scale)) {
+  for (const LoadedMesh& part : parts) {
     for (auto& piece : SplitConnectedComponents(*part.mesh)) out.push_back(std::move(piece));
   }
   return out;

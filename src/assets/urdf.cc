@@ -105,8 +105,8 @@ class Parser {
                                                                const Eigen::Vector3d& scale,
                                                                const std::string& where,
                                                                const std::string& uri);
-  const std::vector<LoadedMesh>& VisualMeshes(const std::string& path,
-                                              const Eigen::Vector3d& scale);
+  // the sub-meshes of a file as read (LoadMeshFile), once per parse
+  const std::vector<LoadedMesh>& FileMeshes(const std::string& path, const Eigen::Vector3d& scale);
 
   const UrdfLoader& loader_;
   fs::path base_dir_;
@@ -119,7 +119,7 @@ class Parser {
   // files that are missing or cannot be read: "where: 'uri' problem", in file order
   mutable std::vector<std::string> bad_files_;
   mutable std::set<std::string> bad_uris_;
-  std::map<std::pair<std::string, std::string>, std::vector<LoadedMesh>> visual_cache_;
+  std::map<std::pair<std::string, std::string>, std::vector<LoadedMesh>> file_cache_;
 };
 
 std::vector<double> Parser::Numbers(const char* text, size_t count,
@@ -279,11 +279,13 @@ std::vector<std::shared_ptr<const MeshData>> Parser::CollisionMeshes(const std::
   auto found = collision_cache_.find({path, key.str()});
   if (found != collision_cache_.end()) return found->second;
 
+  // the file is read once per parse, for its visuals and collisions alike
+  const std::vector<LoadedMesh>& parts = FileMeshes(path, scale);
   std::vector<std::shared_ptr<MeshData>> loaded;
   if (loader_.load_multiple_collisions_from_file) {
-    loaded = LoadConvexPieces(path, scale);
+    loaded = ConnectedPieces(parts);
   } else {
-    loaded = {LoadMergedMesh(path, scale)};
+    loaded = {MergeMeshes(parts, path)};
   }
 
   // MuJoCo collides each piece as its convex hull and refuses pieces without volume: flat,
@@ -338,12 +340,12 @@ std::vector<std::shared_ptr<const MeshData>> Parser::CollisionMeshes(const std::
   return pieces;
 }
 
-const std::vector<LoadedMesh>& Parser::VisualMeshes(const std::string& path,
-                                                    const Eigen::Vector3d& scale) {
+const std::vector<LoadedMesh>& Parser::FileMeshes(const std::string& path,
+                                                  const Eigen::Vector3d& scale) {
   std::ostringstream key;
   key.precision(17);
   key << scale.transpose();
-  auto& cached = visual_cache_[{path, key.str()}];
+  auto& cached = file_cache_[{path, key.str()}];
   if (cached.empty()) cached = LoadMeshFile(path, scale);
   return cached;
 }
@@ -477,7 +479,7 @@ void Parser::ReadVisual(const XMLElement* v, const std::string& link, LinkDesc* 
   if (!path) return;
   const std::vector<LoadedMesh>* parts = nullptr;
   try {
-    parts = &VisualMeshes(*path, mesh->second);
+    parts = &FileMeshes(*path, mesh->second);
   } catch (const Error& e) {
     NoteBadFile(where + " <mesh>", mesh->first, std::string("cannot be read: ") + e.what());
     return;
@@ -570,8 +572,8 @@ std::optional<Inertial> Parser::ReadInertial(const XMLElement* e, const std::str
 LinkDesc Parser::ReadLink(const XMLElement* link, const std::string& name) {
   LinkDesc out;
   out.name = name;
-  for (const XMLElement* c = link->FirstChildElement("collision"); c != nullptr;
-       c = c->NextSiblingElement("collision")) {
+  for (const XMLElement* c = link->FirstChildElement("collision");
+       c != nullptr && loader_.load_collisions; c = c->NextSiblingElement("collision")) {
     ReadCollision(c, name, &out);
   }
   for (const XMLElement* v = link->FirstChildElement("visual"); v != nullptr;

@@ -54,6 +54,9 @@ void BindAssets(py::module_& m) {
       .def_readwrite("load_multiple_collisions_from_file",
                      &UrdfLoader::load_multiple_collisions_from_file,
                      "Each mesh file (and each connected component) becomes its own convex piece.")
+      .def_readwrite("load_collisions", &UrdfLoader::load_collisions,
+                     "True (default); False skips every <collision> element: for scenes that are "
+                     "only rendered, which load faster and hold no contact shapes.")
       .def_readwrite("density", &UrdfLoader::density, "kg/m^3 for links without <inertial>.")
       .def_readwrite("material", &UrdfLoader::material,
                      "Default PhysicalMaterial of collision shapes, or None.")

@@ -298,6 +298,7 @@ class ObjectRenderer {
     else
       scene_->SetRenderBackend(options.backend);
     PartNetMobilityLoader loader(scene_.get());
+    loader.urdf.load_collisions = false;  // rendered, never stepped
     object_ = loader.Parse(folder);
     articulation_ = scene_->AddArticulation(object_.articulation);
     const double fovy = options.fovy_degrees * kPi / 180.0;
@@ -817,7 +818,9 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
     info.folder = folder;
     try {
       info.name = ObjectName(options.dataset_root, folder);
-      const PartNetMobilityObject o = PartNetMobilityLoader().Parse(folder);
+      PartNetMobilityLoader loader;
+      loader.urdf.load_collisions = false;
+      const PartNetMobilityObject o = loader.Parse(folder);
       info.category = CategoryOf(o);
       for (const auto& [link, pl] : LabelledLinks(o)) {
         info.labels.push_back(PartCategory(info.category, *pl));

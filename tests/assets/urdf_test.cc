@@ -265,6 +265,70 @@ TEST_F(ArmTest, PackageMeshesVisualsAndCollisions) {
   EXPECT_TRUE(link8.visuals.empty() && link8.collisions.empty() && !link8.inertial);
 }
 
+TEST_F(ArmTest, WithoutCollisionsKeepsVisualsJointsAndInertials) {
+  UrdfLoader loader;
+  loader.load_collisions = false;
+  const ArticulationDesc visual_only = loader.ParseFile(kArmUrdf);
+  ASSERT_EQ(visual_only.links.size(), arm_.links.size());
+  int collisions = 0;
+  for (size_t i = 0; i < arm_.links.size(); ++i) {
+    const LinkDesc& a = arm_.links[i];
+    const LinkDesc& b = visual_only.links[i];
+    collisions += static_cast<int>(a.collisions.size());
+    EXPECT_TRUE(b.collisions.empty()) << b.name;
+    EXPECT_EQ(b.visuals.size(), a.visuals.size()) << b.name;
+    EXPECT_EQ(b.joint.type, a.joint.type) << b.name;
+    EXPECT_EQ(b.joint.lower, a.joint.lower) << b.name;
+    EXPECT_EQ(b.joint.upper, a.joint.upper) << b.name;
+    EXPECT_EQ(b.inertial.has_value(), a.inertial.has_value()) << b.name;
+  }
+  EXPECT_GT(collisions, 0);
+  // a scene takes it and moves its joints
+  Scene scene;
+  Articulation arm = scene.AddArticulation(visual_only);
+  Eigen::VectorXd q = Eigen::VectorXd::Constant(arm.Dof(), 0.1);
+  arm.SetQpos(q);
+  EXPECT_TRUE(arm.GetQpos().isApprox(q));
+}
+
+TEST(UrdfTest, OneMeshFileServesVisualAndCollisionAlike) {
+  const std::string dir = ::testing::TempDir() + "/urdf_shared_mesh_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  WriteObj(dir + "/box.obj",
+           {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},
+           {{0, 2, 1},
+            {0, 3, 2},
+            {4, 5, 6},
+            {4, 6, 7},
+            {0, 1, 5},
+            {0, 5, 4},
+            {1, 2, 6},
+            {1, 6, 5},
+            {2, 3, 7},
+            {2, 7, 6},
+            {3, 0, 4},
+            {3, 4, 7}});
+  const std::string urdf = Robot(
+      "<link name=\"base\"><visual><geometry><mesh filename=\"box.obj\" scale=\"0.5 0.5 "
+      "0.5\"/></geometry></visual><collision><geometry><mesh filename=\"box.obj\" scale=\"0.5 "
+      "0.5 0.5\"/></geometry></collision></link>\n");
+  const ArticulationDesc d = UrdfLoader().Parse(urdf, dir, "shared.urdf");
+  ASSERT_EQ(d.links[0].visuals.size(), 1u);
+  ASSERT_EQ(d.links[0].collisions.size(), 1u);
+  const MeshData& visual = *d.links[0].visuals[0].mesh;
+  const MeshData& collision = *d.links[0].collisions[0].mesh;
+  // separate copies of the same geometry, scaled once
+  EXPECT_NE(&visual, &collision);
+  ASSERT_EQ(visual.vertices.size(), collision.vertices.size());
+  ASSERT_EQ(visual.faces.size(), collision.faces.size());
+  for (size_t k = 0; k < visual.vertices.size(); ++k)
+    EXPECT_TRUE(visual.vertices[k].isApprox(collision.vertices[k])) << k;
+  float top = 0;
+  for (const Eigen::Vector3f& v : collision.vertices) top = std::max(top, v.z());
+  EXPECT_FLOAT_EQ(top, 0.5f);
+  std::filesystem::remove_all(dir);
+}
+
 TEST_F(ArmTest, InertialIsDiagonalisedProperly) {
   // panda_link1's identified inertia tensor about its centre of mass
   const LinkDesc& l1 = FindLink(arm_, "panda_link1");

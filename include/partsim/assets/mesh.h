@@ -26,6 +26,11 @@ std::vector<LoadedMesh> LoadMeshFile(const std::string& path,
 std::shared_ptr<MeshData> LoadMergedMesh(const std::string& path,
                                          const Eigen::Vector3d& scale = Eigen::Vector3d::Ones());
 
+/// Sub-meshes already loaded (LoadMeshFile of `path`) merged into one mesh named after `path`;
+/// the parts are not changed.
+std::shared_ptr<MeshData> MergeMeshes(const std::vector<LoadedMesh>& parts,
+                                      const std::string& path);
+
 /// Splits a mesh into its connected components (triangles sharing vertices, with positions
 /// welded within 1e-7 m).
 std::vector<std::shared_ptr<MeshData>> SplitConnectedComponents(const MeshData& mesh);
@@ -34,6 +39,9 @@ std::vector<std::shared_ptr<MeshData>> SplitConnectedComponents(const MeshData& 
 /// connected components.
 std::vector<std::shared_ptr<MeshData>> LoadConvexPieces(
     const std::string& path, const Eigen::Vector3d& scale = Eigen::Vector3d::Ones());
+
+/// LoadConvexPieces of sub-meshes already loaded; the parts are not changed.
+std::vector<std::shared_ptr<MeshData>> ConnectedPieces(const std::vector<LoadedMesh>& parts);
 
 /// What CheckConvexPiece found about a mesh meant to collide as one convex piece (MuJoCo collides
 /// the convex hull of its vertices, and refuses vertices that span no volume).

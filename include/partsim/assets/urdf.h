@@ -35,6 +35,10 @@ class UrdfLoader {
   double scale = 1.0;  ///< uniform scale on geometry, origins and prismatic limits
   /// Each mesh file (and each connected component of it) becomes its own convex piece.
   bool load_multiple_collisions_from_file = false;
+  /// false skips every <collision> element and reads no collision mesh: for scenes that are only
+  /// rendered (datasets), which load faster and hold no contact shapes. Links without <inertial>
+  /// then get a small mass.
+  bool load_collisions = true;
   double density = 1000.0;                                 ///< kg/m^3 for links without <inertial>
   std::optional<PhysicalMaterial> material;                ///< default material of collision shapes
   std::map<std::string, UrdfLinkOverride> link_overrides;  ///< by link name
