@@ -56,7 +56,7 @@ NpyArray MakeNpyArray(const std::string& name, const std::vector<std::uint8_t>& 
   return Make(name, "|u1", values, shape);
 }
 
-std::vector<std::uint8_t> NpyBytes(const NpyArray& array) {
+std::vector<std::uint8_t> NpyHeader(const NpyArray& array) {
   std::string shape = "(";
   for (std::size_t i = 0; i < array.shape.size(); ++i)
     shape += std::to_string(array.shape[i]) + (array.shape.size() == 1      ? ","
@@ -71,41 +71,58 @@ std::vector<std::uint8_t> NpyBytes(const NpyArray& array) {
   std::vector<std::uint8_t> out = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0};
   Put16(&out, static_cast<std::uint32_t>(header.size()));
   out.insert(out.end(), header.begin(), header.end());
+  return out;
+}
+
+std::vector<std::uint8_t> NpyBytes(const NpyArray& array) {
+  std::vector<std::uint8_t> out = NpyHeader(array);
   out.insert(out.end(), array.bytes.begin(), array.bytes.end());
   return out;
 }
 
-std::uint32_t Crc32(const std::uint8_t* data, std::size_t size) {
+std::uint32_t Crc32(const std::uint8_t* data, std::size_t size, std::uint32_t crc) {
   // zlib's table-driven CRC-32, in pieces that fit its uInt length
-  uLong crc = crc32(0L, Z_NULL, 0);
+  uLong c = crc;
   while (size > 0) {
     const auto n = static_cast<uInt>(std::min<std::size_t>(size, 1u << 30));
-    crc = crc32(crc, data, n);
+    c = crc32(c, data, n);
     data += n;
     size -= n;
   }
-  return static_cast<std::uint32_t>(crc);
+  return static_cast<std::uint32_t>(c);
 }
 
 void WriteNpz(const std::string& path, const std::vector<NpyArray>& arrays) {
-  std::vector<std::uint8_t> out, central;
+  // the archive's headers are assembled here; each array's bytes go to the file from where they
+  // are, without a copy
+  std::ofstream f(path, std::ios::binary);
+  auto write = [&f](const std::uint8_t* data, std::size_t size) {
+    f.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  };
+  std::vector<std::uint8_t> local, central;
+  std::size_t offset = 0;
   for (const NpyArray& a : arrays) {
-    const std::vector<std::uint8_t> data = NpyBytes(a);
-    if (data.size() >= 0xFFFFFFFFu) throw Error("npz: array '" + a.name + "' is over 4 GB");
+    const std::vector<std::uint8_t> header = NpyHeader(a);
+    const std::size_t bytes = header.size() + a.bytes.size();
+    if (bytes >= 0xFFFFFFFFu) throw Error("npz: array '" + a.name + "' is over 4 GB");
+    if (offset >= 0xFFFFFFFFu) throw Error("npz: '" + path + "' is over 4 GB");
     const std::string file = a.name + ".npy";
-    const std::uint32_t crc = Crc32(data.data(), data.size());
-    const auto size = static_cast<std::uint32_t>(data.size());
-    const auto offset = static_cast<std::uint32_t>(out.size());
+    const std::uint32_t crc =
+        Crc32(a.bytes.data(), a.bytes.size(), Crc32(header.data(), header.size()));
+    const auto size = static_cast<std::uint32_t>(bytes);
     // local file header: stored, no data descriptor, a fixed date (1980-01-01) for equal bytes
-    Put32(&out, 0x04034b50);
-    for (std::uint32_t v : {20u, 0u, 0u, 0u, 0x21u}) Put16(&out, v);
-    Put32(&out, crc);
-    Put32(&out, size);
-    Put32(&out, size);
-    Put16(&out, static_cast<std::uint32_t>(file.size()));
-    Put16(&out, 0);
-    out.insert(out.end(), file.begin(), file.end());
-    out.insert(out.end(), data.begin(), data.end());
+    local.clear();
+    Put32(&local, 0x04034b50);
+    for (std::uint32_t v : {20u, 0u, 0u, 0u, 0x21u}) Put16(&local, v);
+    Put32(&local, crc);
+    Put32(&local, size);
+    Put32(&local, size);
+    Put16(&local, static_cast<std::uint32_t>(file.size()));
+    Put16(&local, 0);
+    local.insert(local.end(), file.begin(), file.end());
+    local.insert(local.end(), header.begin(), header.end());
+    write(local.data(), local.size());
+    write(a.bytes.data(), a.bytes.size());
     // its central directory entry
     Put32(&central, 0x02014b50);
     for (std::uint32_t v : {20u, 20u, 0u, 0u, 0u, 0x21u}) Put16(&central, v);
@@ -115,21 +132,21 @@ void WriteNpz(const std::string& path, const std::vector<NpyArray>& arrays) {
     Put16(&central, static_cast<std::uint32_t>(file.size()));
     for (std::uint32_t v : {0u, 0u, 0u, 0u}) Put16(&central, v);
     Put32(&central, 0);
-    Put32(&central, offset);
+    Put32(&central, static_cast<std::uint32_t>(offset));
     central.insert(central.end(), file.begin(), file.end());
+    offset += local.size() + a.bytes.size();
   }
-  const auto central_offset = static_cast<std::uint32_t>(out.size());
-  out.insert(out.end(), central.begin(), central.end());
-  Put32(&out, 0x06054b50);
-  Put16(&out, 0);
-  Put16(&out, 0);
-  Put16(&out, static_cast<std::uint32_t>(arrays.size()));
-  Put16(&out, static_cast<std::uint32_t>(arrays.size()));
-  Put32(&out, static_cast<std::uint32_t>(central.size()));
-  Put32(&out, central_offset);
-  Put16(&out, 0);
-  std::ofstream f(path, std::ios::binary);
-  f.write(reinterpret_cast<const char*>(out.data()), static_cast<std::streamsize>(out.size()));
+  if (offset >= 0xFFFFFFFFu) throw Error("npz: '" + path + "' is over 4 GB");
+  std::vector<std::uint8_t> end = central;
+  Put32(&end, 0x06054b50);
+  Put16(&end, 0);
+  Put16(&end, 0);
+  Put16(&end, static_cast<std::uint32_t>(arrays.size()));
+  Put16(&end, static_cast<std::uint32_t>(arrays.size()));
+  Put32(&end, static_cast<std::uint32_t>(central.size()));
+  Put32(&end, static_cast<std::uint32_t>(offset));
+  Put16(&end, 0);
+  write(end.data(), end.size());
   if (!f) throw Error("npz: cannot write '" + path + "'");
 }
 
