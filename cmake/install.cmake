@@ -82,7 +82,7 @@ set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 # dependency, and Mesa's EGL and CPU rasterizer behind libEGL (the renderer without a GPU)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
     "python3 (>= 3.11), python3-numpy, libeigen3-dev, libegl-mesa0, libgl1-mesa-dri")
-set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "python3-pil")
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "python3-pil, python3-torch, python3-matplotlib")
 set(CPACK_PACKAGE_DIRECTORY ${CMAKE_BINARY_DIR})
 set(CPACK_OUTPUT_FILE_PREFIX ${CMAKE_BINARY_DIR})
 set(CPACK_STRIP_FILES ON)

@@ -10,8 +10,12 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-pytest
   # the SAPIEN-style examples save pictures and build rotations as SAPIEN's tutorials do
   python3-pil python3-transforms3d
-  # PyTorch (CPU) for partsim.vision's torch datasets and learning on the tasks
-  python3-torch
+  # PyTorch (CPU) for partsim.vision's torch datasets and learning on the tasks; matplotlib for
+  # the learning curves
+  python3-torch python3-matplotlib
+  # an optimised BLAS for it (Debian's torch calls the system BLAS: the reference one is ~15x
+  # slower at the networks' matrix products)
+  libopenblas0-openmp
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev clang-format clang-tidy
   libegl-dev libegl-mesa0 libgl1-mesa-dri libopengl-dev libembree-dev libpng-dev

@@ -347,6 +347,8 @@ class OpenCabinetEnv(_ClosedByContext):
                 opts.target = -1
         self._task = self._tasks[key]
         self._task.reset(int(self._np_random.integers(0, 2**62)))
+        lo, hi = np.asarray(self._task.target_joint.get_limits(), dtype=float).reshape(-1)[:2]
+        self._target_range = float(hi - lo)
         self._steps = 0
         return self._observation(), self._info()
 
@@ -355,7 +357,8 @@ class OpenCabinetEnv(_ClosedByContext):
         ``(obs, reward, terminated, truncated, info)``: the observation of ``obs_mode``, the
         dense reward (float), ``terminated`` on success or failure, ``truncated`` after
         ``max_episode_steps`` steps, and ``info`` with ``success``, ``progress`` (fraction of the
-        range opened), ``object`` (index or folder name), ``target`` (link name), ``touching``
+        range opened), ``opened`` (how far the target is open: rad for a door, m for a drawer),
+        ``object`` (index or folder name), ``target`` (link name), ``touching``
         and ``elapsed`` (simulated s). Raises ``RuntimeError`` before ``reset`` or after
         ``close``, ``ValueError`` for a wrong shape or a non-finite entry."""
         self._check_open()
@@ -425,6 +428,7 @@ class OpenCabinetEnv(_ClosedByContext):
                 else int(t.options.object_index)
             ),
             "target": t.target_link.get_name(),
+            "opened": float(t.get_progress() * self._target_range),
             "touching": bool(t.gripper_touches_target()),
             "elapsed": float(t.get_elapsed()),
         }
