@@ -47,4 +47,9 @@ cmake --build "$work/hello" >/dev/null
 echo "-- partsim tasks demo from $work"
 partsim tasks demo --size 320x240 --every 5 --out "$work/demo"
 [ -s "$work/demo/demo.mp4" ] || { echo "no video at $work/demo/demo.mp4"; exit 1; }
+echo "-- partsim learn (the installed Python package's learning protocol) from $work"
+partsim learn --help | grep -q "partsim learn train" || { echo "partsim learn --help failed"; exit 1; }
+/usr/bin/python3 -c "import partsim.learn.protocol as p, os, sys; \
+assert os.path.realpath(p.__file__).startswith(os.path.realpath(sys.argv[1]) + '/'), p.__file__" \
+  "$prefix"
 echo "install smoke test: all passed ($prefix)"

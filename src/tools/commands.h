@@ -37,6 +37,11 @@ int RunServeCommand(int argc, char** argv);
 /// success, 1 failure, 2 bad command line).
 int RunVisionCommand(int argc, char** argv);
 
+/// `partsim learn ...`: SAC on the door and drawer tasks (train, evaluate, table, curves). Runs
+/// `python3 -m partsim.learn` with the arguments after "learn"; returns only when that cannot
+/// start (exit code 1).
+int RunLearnCommand(int argc, char** argv);
+
 /// Removes the files of `dir` that an earlier run of the same command wrote: names starting with
 /// one of `prefixes` and ending with the matching entry of `suffixes` ("color_" + ".png"), so
 /// that a run with fewer views or frames leaves no stale ones beside its own. Other files stay.

@@ -21,9 +21,35 @@ Example::
     Trainer(env, agent, buffer, "runs/drawer", TrainConfig(total_steps=100_000)).train()
 """
 
-from .replay import ReplayBuffer
-from .sac import SAC, SACConfig
-from .trainer import Evaluation, SyncVectorEnv, TrainConfig, Trainer, evaluate
+import importlib
+
+# the names below come from modules that need PyTorch; they are imported when first used, so
+# that `partsim learn --help` and the protocol's file handling work without it and a missing
+# torch is reported by name
+_EXPORTS = {
+    "ReplayBuffer": "replay", "SAC": "sac", "SACConfig": "sac", "Evaluation": "trainer",
+    "SyncVectorEnv": "trainer", "TrainConfig": "trainer", "Trainer": "trainer",
+    "evaluate": "trainer",
+}
 
 __all__ = ["SAC", "SACConfig", "ReplayBuffer", "Trainer", "TrainConfig", "SyncVectorEnv",
            "Evaluation", "evaluate"]
+
+
+def __getattr__(name):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'partsim.learn' has no attribute {name!r}")
+    try:
+        value = getattr(importlib.import_module("." + module, __name__), name)
+    except ModuleNotFoundError as e:
+        if e.name != "torch":
+            raise
+        raise ImportError("partsim.learn needs PyTorch: install Debian's python3-torch "
+                          "(apt-get install python3-torch)") from e
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

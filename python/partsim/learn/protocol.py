@@ -1,0 +1,674 @@
+"""The SAPIEN paper's learning experiment on partsim's tasks (its Table 3): Soft Actor-Critic
+trained on 2, 4, 8 or 16 doors or drawers and tested on unseen ones.
+
+A run is a folder. :func:`train` writes ``run.json`` (the whole configuration: task, state
+representation, the training and test objects, the agent's and the loop's options),
+``progress.csv`` and checkpoints (see :mod:`partsim.learn.trainer`) and ``curves.png``;
+:func:`evaluate` writes ``eval.json`` and ``eval.csv``; :func:`table` reads runs and lays out
+Table 3 beside the paper's numbers. The command line is ``partsim learn`` (or
+``python3 -m partsim.learn``): ``train``, ``evaluate``, ``table`` and ``curves``.
+
+Objects. The pool is every object with a target for the task (a ``drawer`` or a
+``rotation_door`` with a handle and a finite range): the generated StorageFurniture objects
+(the first ``16 + test_objects`` of the generator's dataset seed) or, with ``dataset``, the
+PartNet-Mobility folders under that root. The pool is shuffled once by ``split_seed`` (not by
+the training seed, so runs of every seed and size share one test set). Training on N objects
+takes the first N of that order, so the 2 objects are among the 4, the 4 among the 8 and so
+on; the test objects are the ones after the first 16 (``test_objects`` of them, or all the
+rest), never trained on at any size.
+
+Metrics, as the paper's: for doors, the door's final opening in degrees, averaged over
+episodes; for drawers, the fraction of episodes that end with the drawer open to at least 80%
+of its range. Evaluation episodes are deterministic (the tanh of the policy's mean) and seeded.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+__all__ = [
+    "PAPER_TABLE3",
+    "TRAIN_SIZES",
+    "RunConfig",
+    "task_objects",
+    "train",
+    "evaluate_run",
+    "table",
+    "plot_curves",
+    "main",
+]
+
+TRAIN_SIZES = (2, 4, 8, 16)
+# Table 3 of the SAPIEN paper: door (final angle, degrees) and drawer (success rate at 80% of
+# the range) after 1M steps, for 2 / 4 / 8 / 16 training objects
+PAPER_TABLE3 = {
+    ("raw", "door", "train"): (85.4, 70.5, 50.5, 38.4),
+    ("raw", "door", "test"): (14.7, 18.7, 21.2, 27.3),
+    ("raw", "drawer", "train"): (0.84, 0.82, 0.77, 0.75),
+    ("raw", "drawer", "test"): (0.61, 0.63, 0.66, 0.66),
+    ("mobility", "door", "train"): (88.7, 78.6, 59.2, 41.1),
+    ("mobility", "door", "test"): (22.9, 27.3, 27.5, 32.8),
+    ("mobility", "drawer", "train"): (0.83, 0.81, 0.79, 0.78),
+    ("mobility", "drawer", "test"): (0.65, 0.65, 0.69, 0.68),
+    ("visual", "door", "train"): (90.2, 65.2, 56.7, 32.1),
+    ("visual", "door", "test"): (21.7, 24.5, 28.1, 29.6),
+    ("visual", "drawer", "train"): (0.80, 0.72, 0.69, 0.63),
+    ("visual", "drawer", "test"): (0.59, 0.60, 0.61, 0.60),
+}
+DRAWER_SUCCESS = 0.8  # the paper's drawer metric: open to 80% of the range
+RUN_FILE = "run.json"
+EVAL_FILE = "eval.json"
+
+
+@dataclasses.dataclass
+class RunConfig:
+    """Everything that defines a run (written to ``run.json``).
+
+    ``task``: "door" or "drawer"; ``obs``: "raw", "mobility" or "visual"; ``train_objects``: N;
+    ``steps``: environment steps; ``seed``: of the agent, the buffer and the episodes;
+    ``dataset``: a PartNet-Mobility root, or None for generated objects (``dataset_seed``);
+    ``split_seed``, ``test_objects``: the object split (see the module's docstring; 0 test
+    objects: all after the first 16); ``num_envs``: environments stepped together, sharing one
+    replay buffer; ``max_episode_steps``; ``warmup_steps``, ``updates_per_step``,
+    ``buffer_size`` (0: a million transitions for states, 20,000 for pictures, whose
+    transitions are large), ``batch_size``, ``hidden_sizes``, ``lr``, ``init_alpha`` (the
+    entropy coefficient's start, tuned from there); ``checkpoint_interval``,
+    ``log_interval``: in environment steps.
+    """
+
+    task: str = "drawer"
+    obs: str = "mobility"
+    train_objects: int = 4
+    steps: int = 100_000
+    seed: int = 0
+    dataset: str | None = None
+    dataset_seed: int = 0
+    split_seed: int = 0
+    test_objects: int = 8
+    num_envs: int = 4
+    max_episode_steps: int = 250
+    warmup_steps: int = 2_000
+    updates_per_step: float = 0.25
+    buffer_size: int = 0  # 0: 1,000,000 transitions for states, 20,000 for pictures
+    batch_size: int = 256
+    hidden_sizes: tuple = (256, 256)
+    lr: float = 3e-4
+    init_alpha: float = 0.1
+    checkpoint_interval: int = 10_000
+    log_interval: int = 2_000
+
+    def check(self):
+        """Raises ValueError naming the first option out of range."""
+        if self.task not in ("door", "drawer"):
+            raise ValueError(f"task must be 'door' or 'drawer', got {self.task!r}")
+        if self.obs not in ("raw", "mobility", "visual"):
+            raise ValueError(f"obs must be 'raw', 'mobility' or 'visual', got {self.obs!r}")
+        for name in ("train_objects", "num_envs", "max_episode_steps", "batch_size",
+                     "log_interval"):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f"{name} must be at least 1, got {getattr(self, name)}")
+        for name in ("steps", "warmup_steps", "test_objects", "checkpoint_interval",
+                     "buffer_size"):
+            if int(getattr(self, name)) < 0:
+                raise ValueError(f"{name} must not be negative, got {getattr(self, name)}")
+        if not (self.updates_per_step >= 0 and math.isfinite(self.updates_per_step)):
+            raise ValueError(f"updates_per_step must be >= 0, got {self.updates_per_step}")
+        for name in ("lr", "init_alpha"):
+            v = float(getattr(self, name))
+            if not (v > 0 and math.isfinite(v)):
+                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
+
+    def to_json(self) -> dict:
+        """The configuration as JSON values."""
+        d = dataclasses.asdict(self)
+        d["hidden_sizes"] = list(self.hidden_sizes)
+        return d
+
+    @classmethod
+    def from_json(cls, d: dict) -> "RunConfig":
+        """A configuration from ``to_json``'s dict; unknown keys raise ValueError."""
+        known = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(d) - known)
+        if unknown:
+            raise ValueError(f"unknown run options {unknown}")
+        d = dict(d)
+        if "hidden_sizes" in d:
+            d["hidden_sizes"] = tuple(int(h) for h in d["hidden_sizes"])
+        return cls(**d)
+
+
+# --- objects -------------------------------------------------------------------------------
+
+
+def _ps():
+    from .. import _partsim
+
+    return _partsim
+
+
+def _dataset_pool(task: str, root: str) -> list:
+    """The PartNet-Mobility folders under ``root`` (sorted by path) with a target for the task;
+    folders that cannot be read are left out with a warning on stderr."""
+    ps = _ps()
+    if not os.path.isdir(root):
+        raise ValueError(f"dataset: {root!r} is not a folder")
+    loader = ps.PartNetMobilityLoader()
+    urdf = loader.urdf
+    urdf.load_collisions = False  # only the labels and joints are read here
+    loader.urdf = urdf
+    kind = ps.parse_task_type(task)
+    pool = []
+    for entry in ps.parse_partnet_mobility_batch(root, loader):
+        if not entry.ok:
+            print(f"partsim learn: skipping {entry.folder}: {entry.error}", file=sys.stderr)
+            continue
+        if ps.find_task_targets(entry.object, kind):
+            pool.append(entry.folder)
+    return pool
+
+
+def task_objects(config: RunConfig) -> tuple:
+    """(training objects, test objects) of a run: generated StorageFurniture indices (ints) or
+    PartNet-Mobility folders (str), split as the module's docstring says. Raises ValueError
+    when the pool is too small for the training objects and at least one test object."""
+    largest = max(TRAIN_SIZES[-1], config.train_objects)
+    if config.dataset is None:
+        count = largest + (config.test_objects or 8)
+        pool = list(_ps().find_task_objects(_ps().parse_task_type(config.task), count,
+                                            config.dataset_seed))
+    else:
+        pool = _dataset_pool(config.task, config.dataset)
+    order = np.random.default_rng(np.random.SeedSequence([config.split_seed, 7])).permutation(
+        len(pool))
+    pool = [pool[int(i)] for i in order]
+    # with a small pool the test objects are what the largest training set leaves
+    held = min(largest, len(pool) - 1)
+    if config.train_objects > held:
+        raise ValueError(
+            f"train_objects = {config.train_objects}: the pool has {len(pool)} objects with a "
+            f"{config.task}, and at least one must stay unseen for the test")
+    rest = pool[held:]
+    test = rest[: config.test_objects] if config.test_objects else rest
+    return pool[: config.train_objects], test
+
+
+def _make_env(config: RunConfig, objects, num_envs: int):
+    from .. import envs
+
+    return envs.VectorOpenCabinetEnv(
+        num_envs, task=config.task, obs_mode=config.obs, objects=list(objects),
+        dataset_seed=config.dataset_seed, max_episode_steps=config.max_episode_steps)
+
+
+# --- training ------------------------------------------------------------------------------
+
+
+def _read_run(run: str) -> dict:
+    path = os.path.join(run, RUN_FILE)
+    try:
+        with open(path, encoding="utf-8") as f:
+            doc = json.load(f)
+    except FileNotFoundError:
+        raise ValueError(f"{run!r} is not a run folder (no {RUN_FILE})") from None
+    except (OSError, ValueError) as e:
+        raise ValueError(f"{path}: cannot be read: {e}") from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("config"), dict):
+        raise ValueError(f"{path}: has no 'config' object")
+    return doc
+
+
+def _agent_and_buffer(config: RunConfig, env):
+    from .replay import ReplayBuffer
+    from .sac import SAC, SACConfig
+
+    sac = SACConfig(hidden_sizes=tuple(config.hidden_sizes), lr=config.lr,
+                    batch_size=config.batch_size, init_alpha=config.init_alpha)
+    agent = SAC(env.single_observation_space, env.single_action_space, sac, seed=config.seed)
+    capacity = config.buffer_size or (20_000 if config.obs == "visual" else 1_000_000)
+    buffer = ReplayBuffer(capacity, env.single_observation_space, agent.action_dim,
+                          seed=config.seed)
+    return agent, buffer
+
+
+def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
+    """Trains SAC on the run's training objects into the folder ``out`` and returns a summary
+    (steps, seconds, environment steps/s, updates/s).
+
+    A folder holding a run of the same configuration continues from its last checkpoint: a run
+    cut short by a crash loses nothing, a finished run returns at once, and one started again
+    with more ``steps`` goes on to them (equal to a run of that length from the start when the
+    steps done are a multiple of ``checkpoint_interval``). A folder holding a different run is
+    refused with the options that differ. Torch runs on one thread per
+    process unless ``torch.set_num_threads`` was called before.
+    """
+    import torch
+
+    from .trainer import TrainConfig, Trainer
+
+    config.check()
+    out = os.fspath(out)
+    train_objs, test_objs = task_objects(config)
+    doc = {"config": config.to_json(), "train": train_objs, "test": test_objs}
+    run_file = os.path.join(out, RUN_FILE)
+    resume = os.path.exists(run_file)
+    if resume:
+        old = _read_run(out)
+        # the same run, perhaps with more steps: it continues from its last checkpoint
+        differ = sorted(k for k in set(old["config"]) | set(doc["config"])
+                        if k != "steps" and old["config"].get(k) != doc["config"].get(k))
+        if differ:
+            raise ValueError(f"{out!r} holds a run with other options ({', '.join(differ)}); "
+                             "choose another folder")
+        if old["train"] != train_objs or old["test"] != test_objs:
+            raise ValueError(f"{out!r}: the objects of the run changed (the dataset under "
+                             f"{config.dataset!r} is not what it was)")
+        done = _checkpoint_steps(out)
+        if config.steps < done:
+            raise ValueError(f"{out!r} has trained {done} steps already, more than --steps "
+                             f"{config.steps}")
+    if not resume or doc != old:
+        os.makedirs(out, exist_ok=True)
+        tmp = run_file + ".tmp"
+        with open(tmp, "w", encoding="utf-8") as f:
+            json.dump(doc, f, indent=1)
+        os.replace(tmp, run_file)
+
+    if torch.get_num_threads() > 1 and "OMP_NUM_THREADS" not in os.environ:
+        torch.set_num_threads(1)
+    env = _make_env(config, train_objs, config.num_envs)
+    try:
+        agent, buffer = _agent_and_buffer(config, env)
+        loop = TrainConfig(total_steps=config.steps, warmup_steps=config.warmup_steps,
+                           updates_per_step=config.updates_per_step,
+                           checkpoint_interval=config.checkpoint_interval,
+                           log_interval=config.log_interval, seed=config.seed, quiet=quiet)
+        start = time.monotonic()
+        summary = Trainer(env, agent, buffer, out, loop, resume=resume).train()
+        seconds = time.monotonic() - start
+    finally:
+        env.close()
+    try:
+        plot_curves(out)
+    except ImportError:  # matplotlib is optional: the CSV has the curves
+        pass
+    summary = dict(summary or {})
+    summary.setdefault("seconds", seconds)
+    return summary
+
+
+def _checkpoint_steps(run: str) -> int:
+    """Environment steps of a run's last checkpoint (0 without one)."""
+    from .trainer import POINTER
+
+    try:
+        with open(os.path.join(run, POINTER), encoding="utf-8") as f:
+            return int(json.load(f)["env_steps"])
+    except FileNotFoundError:
+        return 0
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise ValueError(f"{os.path.join(run, POINTER)}: cannot be read: {e}") from None
+
+
+def _load_agent(run: str, config: RunConfig, env):
+    """The agent of a run's last checkpoint."""
+    import torch
+
+    from .trainer import POINTER
+
+    agent, _ = _agent_and_buffer(config, env)
+    pointer = os.path.join(run, POINTER)
+    try:
+        with open(pointer, encoding="utf-8") as f:
+            folder = json.load(f)["dir"]
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise ValueError(f"{run!r} has no checkpoint to evaluate ({pointer}: {e})") from None
+    state = torch.load(os.path.join(run, folder, "agent.pt"), map_location="cpu")
+    agent.load_state_dict(state)
+    return agent
+
+
+# --- evaluation ----------------------------------------------------------------------------
+
+
+def _score(task: str, opened: np.ndarray, progress: np.ndarray) -> float:
+    """The paper's metric over episodes: mean final door angle (degrees), or the drawer success
+    rate at 80% of the range."""
+    if task == "door":
+        return float(np.degrees(np.mean(opened)))
+    return float(np.mean(progress >= DRAWER_SUCCESS))
+
+
+def evaluate_run(run: str, episodes: int = 20, seed: int = 1000, which=("train", "test"),
+                 policy: str = "agent", quiet: bool = False) -> dict:
+    """Evaluates a run's last checkpoint: ``episodes`` deterministic episodes on each training
+    and each test object (``which``), seeds ``seed``, ``seed + 1``, ... per object. Writes
+    ``eval.json`` (with ``policy="agent"``) and ``eval.csv`` (one row per episode) into the
+    run and returns the summary: per set, the paper's metric, the mean return and success rate
+    (the task's own, 90% of the range) and the per-object metric.
+
+    ``policy="random"`` plays uniform random actions instead (a baseline; written to
+    ``eval_random.json`` / ``.csv``).
+    """
+    from .trainer import evaluate as run_episodes
+
+    if episodes < 1:
+        raise ValueError(f"episodes must be at least 1, got {episodes}")
+    if policy not in ("agent", "random"):
+        raise ValueError(f"policy must be 'agent' or 'random', got {policy!r}")
+    doc = _read_run(run)
+    config = RunConfig.from_json(doc["config"])
+    agent = None
+    rng = np.random.default_rng(seed)
+    result = {"episodes": int(episodes), "seed": int(seed), "policy": policy,
+              "task": config.task, "obs": config.obs, "train_objects": config.train_objects,
+              "steps": config.steps, "metric": "final angle (degrees)" if config.task == "door"
+              else f"success rate at {int(DRAWER_SUCCESS * 100)}% of the range"}
+    rows = []
+    for name in which:
+        objects = doc[name]
+        per_object = []
+        opened_all, progress_all, returns_all, success_all = [], [], [], []
+        for k, obj in enumerate(objects):
+            env = _make_env(config, [obj], min(episodes, config.num_envs))
+            try:
+                if agent is None and policy == "agent":
+                    agent = _load_agent(run, config, env)
+                random_policy = (lambda o: rng.uniform(-1, 1, (len(_first(o)), 7))) \
+                    if policy == "random" else None
+                ev = run_episodes(env, agent, episodes, seed=seed + 1000 * k,
+                                  policy=random_policy)
+            finally:
+                env.close()
+            opened = np.array([i["opened"] for i in ev.infos], dtype=float)
+            progress = np.array([i["progress"] for i in ev.infos], dtype=float)
+            success = np.array([bool(i["success"]) for i in ev.infos])
+            per_object.append({"object": obj, "metric": _score(config.task, opened, progress),
+                               "mean_return": float(np.mean(ev.returns))})
+            for j in range(len(ev.returns)):
+                rows.append([name, obj, j, float(ev.returns[j]), int(ev.lengths[j]),
+                             float(opened[j]), float(progress[j]), bool(success[j])])
+            opened_all += list(opened)
+            progress_all += list(progress)
+            returns_all += list(ev.returns)
+            success_all += list(success)
+            if not quiet:
+                print(f"{name} object {obj}: {per_object[-1]['metric']:.3f}", file=sys.stderr)
+        result[name] = {
+            "metric": _score(config.task, np.array(opened_all), np.array(progress_all)),
+            "mean_return": float(np.mean(returns_all)),
+            "success_rate": float(np.mean(success_all)),
+            "objects": per_object,
+        }
+    stem = "eval" if policy == "agent" else "eval_random"
+    with open(os.path.join(run, stem + ".json.tmp"), "w", encoding="utf-8") as f:
+        json.dump(result, f, indent=1)
+    os.replace(os.path.join(run, stem + ".json.tmp"), os.path.join(run, stem + ".json"))
+    with open(os.path.join(run, stem + ".csv"), "w", newline="", encoding="utf-8") as f:
+        w = csv.writer(f)
+        w.writerow(["set", "object", "episode", "return", "length", "opened", "progress",
+                    "success"])
+        w.writerows(rows)
+    return result
+
+
+def _first(obs):
+    return next(iter(obs.values())) if isinstance(obs, dict) else obs
+
+
+# --- the table -----------------------------------------------------------------------------
+
+
+def table(runs, fmt: str = "markdown") -> str:
+    """Table 3's layout from evaluated runs: rows (state, train|test), columns door and drawer
+    at 2 / 4 / 8 / 16 training objects; each cell "ours (paper)", ours the mean over the runs
+    (seeds) of that cell and "-" where no run is. ``fmt``: "markdown" or "csv" (one row per
+    cell with both values and the number of runs)."""
+    cells = {}
+    for run in runs:
+        path = os.path.join(run, EVAL_FILE)
+        try:
+            with open(path, encoding="utf-8") as f:
+                ev = json.load(f)
+        except FileNotFoundError:
+            raise ValueError(f"{run!r} has not been evaluated (no {EVAL_FILE}; run "
+                             "'partsim learn evaluate' first)") from None
+        except (OSError, ValueError) as e:
+            raise ValueError(f"{path}: cannot be read: {e}") from None
+        for part in ("train", "test"):
+            if part in ev:
+                key = (ev["obs"], ev["task"], part, int(ev["train_objects"]))
+                cells.setdefault(key, []).append(float(ev[part]["metric"]))
+    if fmt == "csv":
+        lines = ["obs,task,set,train_objects,ours,runs,paper"]
+        for (obs, task, part, n), vals in sorted(cells.items()):
+            paper = PAPER_TABLE3.get((obs, task, part))
+            ref = paper[TRAIN_SIZES.index(n)] if paper and n in TRAIN_SIZES else ""
+            lines.append(f"{obs},{task},{part},{n},{np.mean(vals):.4g},{len(vals)},{ref}")
+        return "\n".join(lines) + "\n"
+    if fmt != "markdown":
+        raise ValueError(f"fmt must be 'markdown' or 'csv', got {fmt!r}")
+    head = ["state", "set"] + [f"door {n}" for n in TRAIN_SIZES] + \
+        [f"drawer {n}" for n in TRAIN_SIZES]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * 2 + "---:|" * 8]
+    for obs in ("raw", "mobility", "visual"):
+        for part in ("train", "test"):
+            row = [f"{obs}-exp", part]
+            for task in ("door", "drawer"):
+                paper = PAPER_TABLE3[(obs, task, part)]
+                for i, n in enumerate(TRAIN_SIZES):
+                    vals = cells.get((obs, task, part, n))
+                    ref = f"{paper[i]:.1f}" if task == "door" else f"{paper[i]:.2f}"
+                    ours = "-" if not vals else (f"{np.mean(vals):.1f}" if task == "door"
+                                                 else f"{np.mean(vals):.2f}")
+                    row.append(f"{ours} ({ref})")
+            lines.append("| " + " | ".join(row) + " |")
+    other = sorted(k for k in cells if k[3] not in TRAIN_SIZES)
+    for obs, task, part, n in other:
+        lines.append(f"\n{obs}-exp {task} {part} on {n} objects: "
+                     f"{np.mean(cells[(obs, task, part, n)]):.3g}")
+    lines.append("\ncells: ours, mean over runs (the paper's Table 3 in brackets); door: final "
+                 "angle in degrees, drawer: success rate at 80% of the range")
+    return "\n".join(lines) + "\n"
+
+
+# --- curves --------------------------------------------------------------------------------
+
+
+def plot_curves(run: str, out: str | None = None) -> str:
+    """Draws a run's learning curves from progress.csv (mean episode return, success rate,
+    critic and policy losses, entropy coefficient against environment steps) into a PNG
+    (``out``, default RUN/curves.png) and returns its path. Needs matplotlib."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    path = os.path.join(run, "progress.csv")
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        raise ValueError(f"{path} has no rows yet")
+
+    def col(name):
+        return np.array([float(r[name]) if r.get(name) not in (None, "") else np.nan
+                         for r in rows])
+
+    steps = col("env_steps")
+    doc = _read_run(run)
+    title = (f"{doc['config']['task']}, {doc['config']['obs']}-exp, "
+             f"{doc['config']['train_objects']} objects, seed {doc['config']['seed']}")
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7))
+    panels = [("mean_return", "mean episode return"), ("success_rate", "success rate (90%)"),
+              ("q1_loss", "critic loss"), ("alpha", "entropy coefficient")]
+    for ax, (name, label) in zip(axes.flat, panels):
+        y = col(name)
+        ax.plot(steps, y, marker=".", lw=1)
+        ax.set_xlabel("environment steps")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        if name == "q1_loss":
+            ax.plot(steps, col("policy_loss"), lw=1, label="policy loss")
+            ax.legend(["critic (Q1)", "policy"])
+    fig.suptitle(title)
+    fig.tight_layout()
+    out = out or os.path.join(run, "curves.png")
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+    return out
+
+
+# --- command line --------------------------------------------------------------------------
+
+USAGE = """usage:
+  partsim learn train --task door|drawer --obs raw|mobility|visual --train-objects N
+                      --steps S --seed K --out RUN [--dataset ROOT] [options]
+  partsim learn evaluate RUN [--episodes 20] [--seed E] [--random] [--quiet]
+  partsim learn table RUN... [--csv]
+  partsim learn curves RUN [--out FILE.png]
+
+train      trains SAC on N training objects (generated StorageFurniture, or the PartNet-Mobility
+           folders under ROOT) into the folder RUN: run.json, progress.csv (returns, success,
+           losses, steps/s), checkpoints, curves.png. Run it again with the same options to
+           continue after a crash (a finished run is left as it is), or with a larger --steps
+           to train it further.
+evaluate   plays the run's policy deterministically, --episodes per object, on its training
+           and its unseen test objects; writes RUN/eval.json and RUN/eval.csv and prints the
+           paper's metric (door: final angle, degrees; drawer: success at 80% of the range).
+           --random plays uniform random actions instead (eval_random.json), a baseline.
+table      prints the SAPIEN paper's Table 3 layout from evaluated runs (means over seeds),
+           each cell beside the paper's number.
+curves     draws RUN/progress.csv into a PNG (default RUN/curves.png).
+
+train options (defaults in brackets):
+  --num-envs E [4]            environments stepped together, one shared replay buffer
+  --test-objects T [8]        unseen objects for the test (0: every object after the first 16)
+  --split-seed Z [0]          the shuffle of the object pool (the same for every run)
+  --dataset-seed D [0]        the generator's seed when no --dataset is given
+  --max-episode-steps M [250] --warmup-steps W [2000] --updates-per-step U [0.25]
+  --buffer-size B [1000000; visual 20000]  --batch-size 256 --lr 3e-4 --hidden 256,256
+  --init-alpha A [0.1]        the entropy coefficient's start (it is then tuned)
+  --checkpoint-interval C [10000] --log-interval L [2000] --quiet
+"""
+
+
+def _parse_options(args, spec):
+    """--name value pairs (and flags) into a dict; ValueError naming an unknown or incomplete
+    option."""
+    out, positional, i = {}, [], 0
+    while i < len(args):
+        a = args[i]
+        if a.startswith("--"):
+            name = a[2:]
+            if name not in spec:
+                raise ValueError(f"unknown option {a}")
+            if spec[name] is bool:
+                out[name] = True
+                i += 1
+                continue
+            if i + 1 >= len(args):
+                raise ValueError(f"option {a} needs a value")
+            try:
+                out[name] = spec[name](args[i + 1])
+            except ValueError:
+                raise ValueError(f"option {a}: {args[i + 1]!r} is not a valid value") from None
+            i += 2
+        else:
+            positional.append(a)
+            i += 1
+    return out, positional
+
+
+def _hidden(text):
+    sizes = tuple(int(x) for x in text.split(","))
+    if not sizes or min(sizes) < 1:
+        raise ValueError(text)
+    return sizes
+
+
+TRAIN_SPEC = {
+    "task": str, "obs": str, "train-objects": int, "steps": int, "seed": int, "out": str,
+    "dataset": str, "dataset-seed": int, "split-seed": int, "test-objects": int,
+    "num-envs": int, "max-episode-steps": int, "warmup-steps": int, "updates-per-step": float,
+    "buffer-size": int, "batch-size": int, "lr": float, "hidden": _hidden, "init-alpha": float,
+    "checkpoint-interval": int, "log-interval": int, "quiet": bool,
+}
+
+
+def main(argv=None) -> int:
+    """``partsim learn`` / ``python3 -m partsim.learn``: returns the exit status (0 done,
+    1 a failure, 2 a usage error)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if not argv or argv[0] in ("-h", "--help", "help"):
+        print(USAGE, end="")
+        return 0 if argv else 2
+    command, args = argv[0], argv[1:]
+    try:
+        if "--help" in args or "-h" in args:
+            print(USAGE, end="")
+            return 0
+        if command == "train":
+            opts, positional = _parse_options(args, TRAIN_SPEC)
+            if positional:
+                raise ValueError(f"train takes no positional arguments ({positional[0]!r})")
+            if "out" not in opts:
+                raise ValueError("train needs --out RUN")
+            fields = {k.replace("-", "_"): v for k, v in opts.items() if k not in ("out",
+                                                                                   "quiet")}
+            if "hidden" in fields:
+                fields["hidden_sizes"] = fields.pop("hidden")
+            if "dataset" in fields:
+                fields["dataset"] = os.path.abspath(fields["dataset"])
+            config = RunConfig(**fields)
+            summary = train(config, opts["out"], quiet=opts.get("quiet", False))
+            print(json.dumps(summary))
+            return 0
+        if command == "evaluate":
+            opts, positional = _parse_options(
+                args, {"episodes": int, "seed": int, "random": bool, "quiet": bool})
+            if len(positional) != 1:
+                raise ValueError("evaluate takes one RUN folder")
+            result = evaluate_run(positional[0], episodes=opts.get("episodes", 20),
+                                  seed=opts.get("seed", 1000),
+                                  policy="random" if opts.get("random") else "agent",
+                                  quiet=opts.get("quiet", False))
+            for part in ("train", "test"):
+                r = result[part]
+                print(f"{part}: {result['metric']} {r['metric']:.3f}, mean return "
+                      f"{r['mean_return']:.2f}, success (90%) {r['success_rate']:.2f} over "
+                      f"{len(r['objects'])} objects x {result['episodes']} episodes")
+            return 0
+        if command == "table":
+            opts, positional = _parse_options(args, {"csv": bool})
+            if not positional:
+                raise ValueError("table needs at least one RUN folder")
+            print(table(positional, "csv" if opts.get("csv") else "markdown"), end="")
+            return 0
+        if command == "curves":
+            opts, positional = _parse_options(args, {"out": str})
+            if len(positional) != 1:
+                raise ValueError("curves takes one RUN folder")
+            print(plot_curves(positional[0], opts.get("out")))
+            return 0
+        print(f"partsim learn: unknown command {command!r} (expected train, evaluate, table or "
+              "curves)", file=sys.stderr)
+        return 2
+    except ValueError as e:
+        print(f"partsim learn {command}: {e}", file=sys.stderr)
+        return 2
+    except ImportError as e:
+        if getattr(e, "name", None) in ("torch", "matplotlib"):
+            e = f"needs {e.name}: install Debian's python3-{e.name}"
+        print(f"partsim learn {command}: {e}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"partsim learn {command}: interrupted (a train run continues from its last "
+              "checkpoint when started again)", file=sys.stderr)
+        return 130

@@ -1,0 +1,243 @@
+"""The learning protocol (partsim.learn.protocol and `partsim learn`) on tiny configurations:
+the object split, train -> evaluate -> table through the real command line, resuming a run,
+refusing a folder of another run, the bad arguments, and the environments' `opened` info that
+the door metric reads."""
+
+import csv
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import PYTHON_DIR
+
+torch = pytest.importorskip("torch")
+
+import partsim.envs as envs  # noqa: E402
+from partsim.learn import protocol  # noqa: E402
+
+CLI = os.environ.get("PARTSIM_CLI", os.path.join(os.path.dirname(os.path.abspath(PYTHON_DIR)),
+                                                 "partsim"))
+
+# a run small enough for the suite: 2 environments, 400 steps in two segments, 2 test objects
+TINY = ["--train-objects", "2", "--steps", "400", "--warmup-steps", "100", "--num-envs", "2",
+        "--test-objects", "2", "--checkpoint-interval", "200", "--log-interval", "100",
+        "--batch-size", "32", "--hidden", "32,32", "--max-episode-steps", "60",
+        "--buffer-size", "5000", "--quiet"]
+
+
+def learn(*args, check=True):
+    """Runs `partsim learn ARGS`; returns the CompletedProcess."""
+    result = subprocess.run([CLI, "learn"] + [str(a) for a in args], capture_output=True,
+                            text=True, timeout=600)
+    if check:
+        assert result.returncode == 0, result.stderr
+    return result
+
+
+def test_split_nests_training_sets_and_keeps_one_test_set():
+    splits = {}
+    for n in protocol.TRAIN_SIZES:
+        config = protocol.RunConfig(task="drawer", train_objects=n, test_objects=4)
+        splits[n] = protocol.task_objects(config)
+    tests = {tuple(test) for _, test in splits.values()}
+    assert len(tests) == 1, "every training size must be tested on the same objects"
+    test = set(next(iter(tests)))
+    assert len(test) == 4
+    for n, (train, _) in splits.items():
+        assert len(train) == n and len(set(train)) == n
+        assert not set(train) & test, f"{n} training objects overlap the test set"
+    for small, large in zip(protocol.TRAIN_SIZES, protocol.TRAIN_SIZES[1:]):
+        assert splits[small][0] == splits[large][0][:small]
+    # the training seed does not move the split; the split seed does
+    seeded = protocol.task_objects(protocol.RunConfig(task="drawer", train_objects=4,
+                                                      test_objects=4, seed=9))
+    assert seeded == splits[4]
+    other = protocol.task_objects(protocol.RunConfig(task="drawer", train_objects=4,
+                                                     test_objects=4, split_seed=1))
+    assert other != splits[4]
+    # the objects have the task's target
+    ps = sys.modules["partsim"]._partsim
+    assert set(splits[16][0]) <= set(ps.find_task_objects(ps.parse_task_type("drawer"), 20, 0))
+
+
+def test_split_of_a_dataset_tree_leaves_unseen_objects(tmp_path):
+    root = tmp_path / "tree"
+    subprocess.run([CLI, "assets", "generate", "--out", root, "--categories",
+                    "StorageFurniture", "--per-category", "5", "--seed", "2"], check=True,
+                   capture_output=True, timeout=300)
+    pool = protocol._dataset_pool("drawer", str(root))
+    assert pool and all(os.path.isfile(os.path.join(p, "mobility.urdf")) for p in pool)
+    train, test = protocol.task_objects(protocol.RunConfig(
+        task="drawer", train_objects=len(pool) - 1, dataset=str(root), test_objects=0))
+    assert len(test) == 1 and not set(train) & set(test)
+    assert sorted(train + test) == sorted(pool)
+    with pytest.raises(ValueError, match="at least one must stay unseen"):
+        protocol.task_objects(protocol.RunConfig(task="drawer", train_objects=len(pool),
+                                                 dataset=str(root)))
+    with pytest.raises(ValueError, match="not a folder"):
+        protocol.task_objects(protocol.RunConfig(dataset=str(tmp_path / "missing")))
+
+
+def test_opened_is_the_targets_displacement():
+    env = envs.OpenCabinetEnv(task="door", obs_mode="mobility", max_episode_steps=5)
+    try:
+        env.reset(seed=3)
+        _, _, _, _, info = env.step(np.zeros(7))
+        joint = env.task.target_joint
+        lo, hi = np.asarray(joint.get_limits()).reshape(-1)[:2]
+        assert info["opened"] == pytest.approx(info["progress"] * (hi - lo), abs=1e-12)
+        assert info["opened"] == pytest.approx(
+            min(abs(joint.get_qpos() - lo), abs(hi - joint.get_qpos())), abs=1e-9)
+    finally:
+        env.close()
+
+
+def test_train_evaluate_table_through_the_command_line(tmp_path):
+    run = tmp_path / "run"
+    learn("train", "--task", "drawer", "--obs", "mobility", "--seed", "0", "--out", run, *TINY)
+    doc = json.loads((run / "run.json").read_text())
+    assert doc["config"]["train_objects"] == 2 and len(doc["train"]) == 2
+    assert len(doc["test"]) == 2 and not set(doc["train"]) & set(doc["test"])
+    with open(run / "progress.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert [int(r["env_steps"]) for r in rows] == [100, 200, 300, 400]
+    assert int(rows[-1]["updates"]) > 0 and float(rows[-1]["updates_per_s"]) > 0
+    assert (run / "curves.png").stat().st_size > 1000
+    with open(run / "curves.png", "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+
+    # a second start of the finished run changes nothing
+    before = (run / "progress.csv").read_bytes()
+    learn("train", "--task", "drawer", "--obs", "mobility", "--seed", "0", "--out", run, *TINY)
+    assert (run / "progress.csv").read_bytes() == before
+    # a folder of another run is refused, naming what differs
+    bad = learn("train", "--task", "drawer", "--obs", "mobility", "--seed", "1", "--out", run,
+                *TINY, check=False)
+    assert bad.returncode == 2 and "seed" in bad.stderr
+
+    out = learn("evaluate", run, "--episodes", "2", "--quiet").stdout
+    assert "train: success rate at 80% of the range" in out and "test:" in out
+    ev = json.loads((run / "eval.json").read_text())
+    assert ev["policy"] == "agent" and ev["episodes"] == 2
+    for part in ("train", "test"):
+        assert [o["object"] for o in ev[part]["objects"]] == doc[part]
+        assert 0.0 <= ev[part]["metric"] <= 1.0
+    with open(run / "eval.csv", newline="") as f:
+        episodes = list(csv.DictReader(f))
+    assert len(episodes) == 2 * 2 * 2
+    # the drawer metric is the share of episodes ending at >= 80% of the range
+    test_rows = [r for r in episodes if r["set"] == "test"]
+    assert ev["test"]["metric"] == pytest.approx(
+        np.mean([float(r["progress"]) >= 0.8 for r in test_rows]))
+    # evaluation is deterministic
+    learn("evaluate", run, "--episodes", "2", "--quiet")
+    assert json.loads((run / "eval.json").read_text()) == ev
+    # a random baseline goes to its own file
+    learn("evaluate", run, "--episodes", "1", "--random", "--quiet")
+    assert json.loads((run / "eval_random.json").read_text())["policy"] == "random"
+    assert json.loads((run / "eval.json").read_text()) == ev
+
+    table = learn("table", run).stdout
+    cell = f"{ev['train']['metric']:.2f} (0.83)"
+    assert "| mobility-exp | train |" in table and cell in table
+    assert "- (85.4)" in table  # raw door: no run, the paper's number
+    rows = learn("table", run, "--csv").stdout.splitlines()
+    assert rows[0] == "obs,task,set,train_objects,ours,runs,paper"
+    assert "mobility,drawer,test,2," in "\n".join(rows)
+
+
+def test_resume_after_an_interruption_continues_the_same_run(tmp_path):
+    straight, cut = tmp_path / "straight", tmp_path / "cut"
+    args = ["--task", "door", "--obs", "raw", "--seed", "3"]
+    learn("train", *args, "--out", straight, *TINY)
+    # the same run stopped at its first checkpoint (the first of two segments), then started
+    # again for all its steps: what a crash's continuation does
+    short = [a if a != "400" else "200" for a in TINY]
+    learn("train", *args, "--out", cut, *short)
+    learn("train", *args, "--out", cut, *TINY)
+    assert json.loads((cut / "run.json").read_text())["config"]["steps"] == 400
+    fewer = learn("train", *args, "--out", cut, *short, check=False)
+    assert fewer.returncode == 2 and "has trained 400 steps already" in fewer.stderr
+    a = (straight / "progress.csv").read_text().splitlines()
+    b = (cut / "progress.csv").read_text().splitlines()
+    timing = {"wall_s", "env_steps_per_s", "updates_per_s"}
+    header = a[0].split(",")
+    keep = [i for i, h in enumerate(header) if h not in timing]
+    assert len(a) == len(b) == 5
+    for ra, rb in zip(a[1:], b[1:]):
+        assert [ra.split(",")[i] for i in keep] == [rb.split(",")[i] for i in keep]
+    sa = torch.load(next(straight.glob("ckpt_*")) / "agent.pt")
+    sb = torch.load(next(cut.glob("ckpt_*")) / "agent.pt")
+    for name in ("actor", "critic"):
+        for k, v in sa[name].items():
+            assert torch.equal(v, sb[name][k]), f"{name}.{k} differs after the resume"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["train", "--task", "window", "--out", "X"], "task must be 'door' or 'drawer'"),
+    (["train", "--obs", "depth", "--out", "X"], "obs must be"),
+    (["train", "--train-objects", "0", "--out", "X"], "train_objects must be at least 1"),
+    (["train", "--steps", "many", "--out", "X"], "--steps: 'many' is not a valid value"),
+    (["train", "--task", "drawer"], "needs --out"),
+    (["train", "--frobnicate", "1"], "unknown option --frobnicate"),
+    (["train", "--steps"], "needs a value"),
+    (["train", "--hidden", "0,4", "--out", "X"], "--hidden"),
+    (["train", "--init-alpha", "0", "--out", "X"], "init_alpha must be > 0"),
+    (["train", "--updates-per-step", "nan", "--out", "X"], "updates_per_step must be >= 0"),
+    (["evaluate", "NOWHERE"], "not a run folder"),
+    (["evaluate", "NOWHERE", "--episodes", "0"], "episodes must be at least 1"),
+    (["table"], "at least one RUN"),
+    (["frob"], "unknown command 'frob'"),
+])
+def test_bad_command_lines_are_refused_by_name(tmp_path, args, message):
+    args = [str(tmp_path / a) if a in ("X", "NOWHERE") else a for a in args]
+    result = learn(*args, check=False)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert message in result.stderr
+    assert not (tmp_path / "X").exists()
+
+
+def test_table_refuses_an_unevaluated_or_broken_run(tmp_path):
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "run.json").write_text(json.dumps({"config": {}}))
+    result = learn("table", run, check=False)
+    assert result.returncode == 2 and "has not been evaluated" in result.stderr
+    (run / "eval.json").write_text("{not json")
+    result = learn("table", run, check=False)
+    assert result.returncode == 2 and "eval.json: cannot be read" in result.stderr
+    (run / "run.json").write_text("[1, 2]")
+    result = learn("evaluate", run, check=False)
+    assert result.returncode == 2 and "has no 'config' object" in result.stderr
+
+
+def test_the_module_entry_point_is_the_same_command(tmp_path):
+    env = dict(os.environ, PYTHONPATH=os.path.abspath(PYTHON_DIR))
+    result = subprocess.run([sys.executable, "-m", "partsim.learn", "--help"],
+                            capture_output=True, text=True, env=env, timeout=120)
+    assert result.returncode == 0 and "partsim learn train" in result.stdout
+    assert learn("--help").stdout == result.stdout
+
+
+def test_without_torch_the_commands_say_what_to_install(tmp_path):
+    code = (
+        "import sys; sys.modules['torch'] = None\n"  # an interpreter without PyTorch
+        "from partsim.learn.protocol import main\n"
+        "import partsim.learn as learn\n"
+        "try:\n"
+        "    learn.SAC\n"
+        "except ImportError as e:\n"
+        "    print('import:', e)\n"
+        f"sys.exit(main(['train', '--out', {str(tmp_path / 'run')!r}]))\n"
+    )
+    env = dict(os.environ, PYTHONPATH=os.path.abspath(PYTHON_DIR))
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            env=env, timeout=120)
+    assert result.returncode == 1, result.stderr
+    assert "import: partsim.learn needs PyTorch" in result.stdout
+    assert "needs torch: install Debian's python3-torch" in result.stderr
+    assert not (tmp_path / "run").exists()
