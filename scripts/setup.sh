@@ -60,6 +60,17 @@ if [ ! -f build/CMakeCache.txt ] || [ ! -f build/Makefile ]; then
 fi
 cmake --build build -j"${PARTSIM_JOBS:-2}"
 
+# the viewer's web page (docs/viewer.md): Node.js and npm from Debian when there is no node yet,
+# then three.js, roslib and esbuild from npm (web/package-lock.json) bundled into build/web
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  # Debian's nodejs does not ship npm; NodeSource's nodejs does (and conflicts with Debian's npm)
+  $SUDO apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends nodejs npm
+fi
+bash scripts/build_web.sh
+
 # the Debian package (build/partsim_<version>_<arch>.deb), again only when something in it changed
 deb=$(ls build/partsim_*.deb 2>/dev/null | head -n 1 || true)
 if [ -z "$deb" ] || [ -n "$(find build/partsim build/libpartsim.so* build/python/partsim include \

@@ -1,0 +1,104 @@
+// Shared by the browser scripts: headless Chromium (Debian's) through puppeteer-core from
+// web/node_modules, with software GL, and a record of the page's console errors.
+import path from 'node:path';
+import fs from 'node:fs';
+import { createRequire } from 'node:module';
+import { fileURLToPath } from 'node:url';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+export const repo = path.resolve(here, '..', '..');
+const require = createRequire(path.join(repo, 'web', 'package.json'));
+
+export const CHROMIUM_CANDIDATES = ['/usr/bin/chromium', '/usr/bin/chromium-browser', '/usr/bin/google-chrome'];
+
+export function chromiumPath() {
+  if (process.env.PARTSIM_CHROMIUM) return process.env.PARTSIM_CHROMIUM;
+  return CHROMIUM_CANDIDATES.find((p) => fs.existsSync(p)) || null;
+}
+
+/** Prints one JSON line and exits: the Python side reads the last line of standard output. */
+export function finish(result, code = 0) {
+  process.stdout.write(JSON.stringify(result) + '\n', () => process.exit(code));
+}
+
+/**
+ * Starts headless Chromium; throws an Error whose `cannotStart` is true when the browser is
+ * missing or does not start (the tests then skip).
+ */
+export async function launch({ width = 1024, height = 768 } = {}) {
+  let puppeteer;
+  try {
+    puppeteer = require('puppeteer-core');
+  } catch (e) {
+    const err = new Error(`puppeteer-core is not installed (bash scripts/build_web.sh): ${e.message}`);
+    err.cannotStart = true;
+    throw err;
+  }
+  const executablePath = chromiumPath();
+  if (!executablePath) {
+    const err = new Error('no Chromium found (apt-get install chromium)');
+    err.cannotStart = true;
+    throw err;
+  }
+  try {
+    return await puppeteer.launch({
+      executablePath,
+      headless: true,
+      timeout: 60000,
+      protocolTimeout: 120000,
+      defaultViewport: { width, height, deviceScaleFactor: 1 },
+      args: [
+        '--no-sandbox', // root in CI
+        '--disable-dev-shm-usage',
+        '--use-angle=swiftshader', // software GL, the same on every machine
+        '--enable-unsafe-swiftshader',
+        '--ignore-gpu-blocklist',
+        '--disable-background-timer-throttling',
+        '--disable-renderer-backgrounding',
+        '--disable-backgrounding-occluded-windows',
+        '--no-first-run',
+        '--no-default-browser-check',
+        '--disable-extensions',
+        '--disable-component-update',
+        '--disable-sync',
+        '--metrics-recording-only',
+        '--password-store=basic',
+      ],
+    });
+  } catch (e) {
+    const err = new Error(`Chromium (${executablePath}) did not start: ${e.message}`);
+    err.cannotStart = true;
+    throw err;
+  }
+}
+
+/** Opens the viewer page; collects console errors and page errors into `errors`. */
+export async function openViewer(browser, url, { timeoutMs = 60000 } = {}) {
+  const page = await browser.newPage();
+  const errors = [];
+  const warnings = [];
+  page.on('console', (m) => {
+    if (m.type() === 'error') errors.push(m.text());
+    else if (m.type() === 'warn' || m.type() === 'warning') warnings.push(m.text());
+  });
+  page.on('pageerror', (e) => errors.push(`page error: ${e.message}`));
+  page.on('requestfailed', (r) => errors.push(`request failed: ${r.url()} ${r.failure()?.errorText}`));
+  page.on('response', (r) => {
+    if (r.status() >= 400) errors.push(`HTTP ${r.status()}: ${r.url()}`);
+  });
+  page.setDefaultTimeout(timeoutMs);
+  try {
+    await page.goto(url, { waitUntil: 'load', timeout: timeoutMs });
+    await page.waitForFunction(() => window.partsimViewer !== undefined, { timeout: timeoutMs });
+    await page.evaluate((ms) => Promise.race([
+    window.partsimViewer.ready.then(() => true),
+    new Promise((_, reject) => setTimeout(() => reject(new Error(`viewer not ready in ${ms} ms`)), ms)),
+  ]), timeoutMs);
+  } catch (e) {
+    e.message += errors.length ? ` (page errors: ${errors.join(' | ')})` : '';
+    throw e;
+  }
+  return { page, errors, warnings };
+}
+
+export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));

@@ -1,0 +1,257 @@
+// Builds the three.js scene from /api/scene.json and the meshes: one group per body at its world
+// pose, the body's visuals inside it, and the overlays (collision shapes, link frames, joint axes)
+// as children of the same group so that they follow the body.
+import * as THREE from 'three';
+import { parseMesh } from './mesh.js';
+
+const SEG_FALLBACK = [0.5, 0.5, 0.5];
+
+/** Sets a three Object3D's position and rotation from [x, y, z, qw, qx, qy, qz]. */
+export function applyPose(object, p, offset = 0) {
+  object.position.set(p[offset], p[offset + 1], p[offset + 2]);
+  object.quaternion.set(p[offset + 4], p[offset + 5], p[offset + 6], p[offset + 3]);
+}
+
+function poseMatrix(p) {
+  const m = new THREE.Matrix4();
+  const q = new THREE.Quaternion(p[4], p[5], p[6], p[3]);
+  m.compose(new THREE.Vector3(p[0], p[1], p[2]), q, new THREE.Vector3(1, 1, 1));
+  return m;
+}
+
+function identityPose(p) {
+  return Array.isArray(p) && p.length === 7 ? p : [0, 0, 0, 1, 0, 0, 0];
+}
+
+// three's capsules and cylinders are along y; partsim's along the shape's x
+const Y_TO_X = new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(0, 0, 1), -Math.PI / 2);
+
+export class SceneModel {
+  constructor(connection) {
+    this.connection = connection;
+    this.root = new THREE.Group();
+    this.root.name = 'partsim-bodies';
+    this.bodies = [];          // per body: {desc, group, visuals[], collision, frame, joint, articulation}
+    this.articulations = [];
+    this.cameras = [];
+    this.desc = null;
+    this.meshCache = new Map(); // mesh index -> Promise<BufferGeometry>
+    this.textureCache = new Map();
+    this.pickable = [];
+    this.segmentation = false;
+  }
+
+  geometry(index) {
+    if (!this.meshCache.has(index)) {
+      this.meshCache.set(index, this.connection.fetchBuffer(`/api/mesh/${index}.bin`).then(parseMesh));
+    }
+    return this.meshCache.get(index);
+  }
+
+  texture(index) {
+    if (!this.textureCache.has(index)) {
+      const p = this.connection.fetchBlob(`/api/texture/${index}.png`)
+        .then((blob) => createImageBitmap(blob, { imageOrientation: 'flipY' }))
+        .then((bitmap) => {
+          const t = new THREE.Texture(bitmap);
+          t.colorSpace = THREE.SRGBColorSpace;
+          t.wrapS = t.wrapT = THREE.RepeatWrapping;
+          t.flipY = false;
+          t.needsUpdate = true;
+          return t;
+        });
+      this.textureCache.set(index, p);
+    }
+    return this.textureCache.get(index);
+  }
+
+  /** Loads scene.json and every mesh and texture it names; replaces what was built before. */
+  async load() {
+    const desc = await this.connection.fetchJson('/api/scene.json');
+    this.clear();
+    this.desc = desc;
+    this.articulations = desc.articulations || [];
+    this.cameras = desc.cameras || [];
+    const bodies = desc.bodies || [];
+    const jobs = [];
+    for (const b of bodies) {
+      const group = new THREE.Group();
+      group.name = b.name || `body ${b.id}`;
+      group.userData.bodyId = b.id;
+      const body = { desc: b, group, visuals: [], collision: null, frame: null, axes: null, joint: null, articulation: null };
+      this.bodies[b.id] = body;
+      this.root.add(group);
+      for (const v of b.visuals || []) jobs.push(this.addVisual(body, v));
+    }
+    for (const a of this.articulations) {
+      for (const j of a.joints || []) {
+        const child = this.bodies[j.child];
+        if (child) {
+          child.joint = j;
+          child.articulation = a;
+        }
+      }
+      // links of the articulation without a joint (its root)
+      for (const body of this.bodies) {
+        if (body && body.desc.articulation === a.id && !body.articulation) body.articulation = a;
+      }
+    }
+    await Promise.all(jobs);
+    if (Array.isArray(desc.poses)) this.applyPoses(null, desc.poses);
+    return desc;
+  }
+
+  async addVisual(body, v) {
+    const color = v.color || [0.8, 0.8, 0.8, 1];
+    const material = new THREE.MeshStandardMaterial({
+      color: new THREE.Color(color[0], color[1], color[2]),
+      roughness: 0.7,
+      metalness: 0.0,
+      transparent: color[3] < 1,
+      opacity: color[3] ?? 1,
+    });
+    const [geometry, texture] = await Promise.all([
+      this.geometry(v.mesh),
+      v.texture !== undefined && v.texture >= 0 ? this.texture(v.texture) : Promise.resolve(null),
+    ]);
+    if (texture) {
+      material.map = texture;
+      material.needsUpdate = true;
+    }
+    const mesh = new THREE.Mesh(geometry, material);
+    applyPose(mesh, identityPose(v.pose));
+    if (v.scale) mesh.scale.set(v.scale[0], v.scale[1], v.scale[2]);
+    mesh.userData.bodyId = body.desc.id;
+    mesh.userData.material = material;
+    const seg = body.desc.seg_color || SEG_FALLBACK;
+    mesh.userData.segMaterial = new THREE.MeshBasicMaterial({ color: new THREE.Color(seg[0], seg[1], seg[2]) });
+    if (this.segmentation) mesh.material = mesh.userData.segMaterial;
+    body.group.add(mesh);
+    body.visuals.push(mesh);
+    this.pickable.push(mesh);
+  }
+
+  clear() {
+    for (const body of this.bodies) {
+      if (!body) continue;
+      body.group.traverse((o) => {
+        if (o.isMesh) {
+          o.userData.segMaterial?.dispose();
+          o.userData.material?.dispose();
+        }
+      });
+    }
+    this.root.clear();
+    this.bodies = [];
+    this.pickable = [];
+    this.meshCache.clear();
+    this.textureCache.clear();
+  }
+
+  /** Applies poses: `ids` null means every body in order. */
+  applyPoses(ids, poses) {
+    const count = ids ? ids.length : poses.length / 7;
+    for (let i = 0; i < count; ++i) {
+      const id = ids ? ids[i] : i;
+      const body = this.bodies[id];
+      if (body) applyPose(body.group, poses, 7 * i);
+    }
+  }
+
+  bounds() {
+    const box = new THREE.Box3();
+    this.root.updateMatrixWorld(true);
+    for (const m of this.pickable) box.expandByObject(m);
+    if (box.isEmpty()) box.set(new THREE.Vector3(-0.5, -0.5, 0), new THREE.Vector3(0.5, 0.5, 1));
+    return box;
+  }
+
+  setSegmentation(on) {
+    this.segmentation = on;
+    for (const m of this.pickable) m.material = on ? m.userData.segMaterial : m.userData.material;
+  }
+
+  /** Collision shapes as wireframes, built the first time they are shown. */
+  async setCollisions(on) {
+    for (const body of this.bodies) {
+      if (!body) continue;
+      if (on && !body.collision) body.collision = await this.buildCollision(body);
+      if (body.collision) body.collision.visible = on;
+    }
+  }
+
+  async buildCollision(body) {
+    const group = new THREE.Group();
+    group.name = 'collision';
+    const material = new THREE.MeshBasicMaterial({ color: 0x00d000, wireframe: true });
+    for (const c of body.desc.collisions || []) {
+      let geometry = null;
+      let alongX = false;
+      if (c.type === 'box') {
+        const h = c.half_size || [0.05, 0.05, 0.05];
+        geometry = new THREE.BoxGeometry(2 * h[0], 2 * h[1], 2 * h[2]);
+      } else if (c.type === 'sphere') {
+        geometry = new THREE.SphereGeometry(c.radius, 16, 12);
+      } else if (c.type === 'capsule') {
+        geometry = new THREE.CapsuleGeometry(c.radius, 2 * c.half_length, 6, 12);
+        alongX = true;
+      } else if (c.type === 'cylinder') {
+        geometry = new THREE.CylinderGeometry(c.radius, c.radius, 2 * c.half_length, 16);
+        alongX = true;
+      } else if (c.type === 'mesh' && c.mesh !== undefined) {
+        try {
+          geometry = await this.geometry(c.mesh);
+        } catch (e) {
+          console.warn(`collision mesh ${c.mesh}: ${e.message}`);
+        }
+      }
+      if (!geometry) continue;
+      const mesh = new THREE.Mesh(geometry, material);
+      applyPose(mesh, identityPose(c.pose));
+      if (alongX) mesh.quaternion.multiply(Y_TO_X);
+      if (c.scale) mesh.scale.set(c.scale[0], c.scale[1], c.scale[2]);
+      mesh.raycast = () => {};
+      group.add(mesh);
+    }
+    body.group.add(group);
+    return group;
+  }
+
+  setFrames(on, size) {
+    for (const body of this.bodies) {
+      if (!body) continue;
+      if (on && !body.frame) {
+        body.frame = new THREE.AxesHelper(size);
+        body.frame.raycast = () => {};
+        body.group.add(body.frame);
+      }
+      if (body.frame) body.frame.visible = on;
+    }
+  }
+
+  /** An arrow per joint along its axis, at the joint frame in the child link. */
+  setJointAxes(on, size) {
+    for (const body of this.bodies) {
+      if (!body || !body.joint || body.joint.type === 'fixed') continue;
+      if (on && !body.axes) {
+        const j = body.joint;
+        const frame = new THREE.Group();
+        applyPose(frame, identityPose(j.pose_in_child));
+        const axis = new THREE.Vector3(...(j.axis || [1, 0, 0])).normalize();
+        const color = j.type === 'prismatic' ? 0x2080ff : 0xff8020;
+        const arrow = new THREE.ArrowHelper(axis, new THREE.Vector3(0, 0, 0), size, color, 0.25 * size, 0.12 * size);
+        arrow.traverse((o) => { o.raycast = () => {}; });
+        frame.add(arrow);
+        body.axes = frame;
+        body.group.add(frame);
+      }
+      if (body.axes) body.axes.visible = on;
+    }
+  }
+
+  /** World pose matrix of a joint frame (for tests and the info panel). */
+  jointWorldMatrix(body) {
+    if (!body.joint) return null;
+    return body.group.matrixWorld.clone().multiply(poseMatrix(identityPose(body.joint.pose_in_child)));
+  }
+}
