@@ -22,6 +22,13 @@ if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
 fi
 npm install --prefix build/node --no-audit --no-fund roslib@^2.1.0 ws@^8
 
+echo "== Chromium for the viewer's browser tests (headless, driven by puppeteer-core from web/)"
+if ! command -v chromium >/dev/null; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends chromium
+fi
+
 echo "== physics alone: core and physics built and tested without the layers above (build-physics/)"
 if [ ! -f build-physics/CMakeCache.txt ]; then
   cmake -S . -B build-physics -DCMAKE_BUILD_TYPE=Release -DPARTSIM_PHYSICS_ONLY=ON >/dev/null
