@@ -114,10 +114,21 @@ class Viewer {
   }
 
   initialCamera(desc) {
+    // {"position": eye, "rpy": [roll, pitch, yaw]} (SAPIEN's set_camera_xyz / set_camera_rpy:
+    // the view direction is (cos p cos y, cos p sin y, sin p)), or a "target" to look at
     const c = desc.initial_camera;
-    if (c && (c.position || c.eye) && (c.target || c.look_at)) {
-      const fovy = c.fovy !== undefined ? THREE.MathUtils.radToDeg(c.fovy) : 45;
-      this.setCamera(c.position || c.eye, c.target || c.look_at, fovy);
+    if (c && Array.isArray(c.position)) {
+      const fovy = typeof c.fovy === 'number' ? THREE.MathUtils.radToDeg(c.fovy) : 45;
+      let target = c.target;
+      if (!Array.isArray(target)) {
+        const [, p, y] = Array.isArray(c.rpy) ? c.rpy : [0, 0, 0];
+        const eye = new THREE.Vector3(...c.position);
+        // look at the point of that ray nearest the scene's centre (at least 0.5 m ahead)
+        const dir = new THREE.Vector3(Math.cos(p) * Math.cos(y), Math.cos(p) * Math.sin(y), Math.sin(p));
+        const ahead = this.model.bounds().getCenter(new THREE.Vector3()).sub(eye).dot(dir);
+        target = eye.addScaledVector(dir, Math.max(ahead, 0.5)).toArray();
+      }
+      this.setCamera(c.position, target, fovy);
       return;
     }
     // frame the scene's bounds from the front-right, above (objects face +x)
