@@ -130,6 +130,8 @@ def main():
     ap.add_argument("--count", type=int, default=1000)
     ap.add_argument("--width", type=int, default=640)
     ap.add_argument("--height", type=int, default=480)
+    ap.add_argument("--step-log", default="",
+                    help="JSON file written at exit: [[sim time, wall time before render()], ...]")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
 
@@ -188,6 +190,7 @@ def main():
     steps = 0
     last_print = 0.0
     timed_out = False
+    step_log = []
     while not viewer.closed:
         scene.step()
         steps += 1
@@ -196,6 +199,9 @@ def main():
             for i, a in enumerate(actors):
                 a.set_pose(partsim.Pose([base[i][0], base[i][1], 0.5 + 0.05 * math.sin(4 * t + i)]))
         scene.update_render()
+        if args.step_log:
+            step_log.append((scene.get_time(),
+                             time.time()))
         viewer.render()
         now = time.time()
         if now - last_print >= 0.1:
@@ -212,6 +218,9 @@ def main():
     print(json.dumps({"closed": viewer.closed, "timeout": timed_out, "step": steps, "qpos": qpos()}),
           flush=True)
     viewer.stop()
+    if args.step_log:
+        with open(args.step_log, "w") as f:
+            json.dump(step_log, f)
 
 
 if __name__ == "__main__":

@@ -12,12 +12,33 @@ const now = () => performance.timeOrigin + performance.now(); // ms since the ep
 const $ = (id) => document.getElementById(id);
 const DRAW_LOG_SIZE = 4096;
 
+/** Whether WebGL runs on a CPU rasterizer (its renderer string names one). */
+function softwareRenderer() {
+  try {
+    const gl = document.createElement('canvas').getContext('webgl2');
+    if (!gl) return false;
+    const ext = gl.getExtension('WEBGL_debug_renderer_info');
+    const name = String(gl.getParameter(ext ? ext.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+    gl.getExtension('WEBGL_lose_context')?.loseContext();
+    return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+  } catch {
+    return false;
+  }
+}
+
 class Viewer {
   constructor() {
     const params = new URLSearchParams(location.search);
     this.connection = new Connection(params.get('token') || '');
     this.canvas = $('view');
-    this.renderer = new THREE.WebGLRenderer({ canvas: this.canvas, antialias: true });
+    // multisampling costs a software renderer (SwiftShader, llvmpipe) a third of its frame
+    // rate: it is on for GPUs only, unless the URL says ?antialias=0|1
+    const aa = params.get('antialias');
+    this.softwareGl = softwareRenderer();
+    this.renderer = new THREE.WebGLRenderer({
+      canvas: this.canvas,
+      antialias: aa === null ? !this.softwareGl : aa === '1',
+    });
     this.renderer.setPixelRatio(window.devicePixelRatio || 1);
     this.scene = new THREE.Scene();
     this.background = new THREE.Color(0xdfe3e8);
@@ -273,6 +294,8 @@ class Viewer {
       selected: this.panels.selected,
       connected: this.connection.connected,
       closed: this.closed,
+      software_gl: this.softwareGl,
+      antialias: this.renderer.getContextAttributes()?.antialias ?? null,
       scene_version: this.model.desc ? this.model.desc.scene_version : null,
     };
   }
