@@ -431,7 +431,7 @@ def table(runs, fmt: str = "markdown") -> str:
     at 2 / 4 / 8 / 16 training objects; each cell "ours (paper)", ours the mean over the runs
     (seeds) of that cell and "-" where no run is. ``fmt``: "markdown" or "csv" (one row per
     cell with both values and the number of runs)."""
-    cells = {}
+    cells, steps = {}, set()
     for run in runs:
         path = os.path.join(run, EVAL_FILE)
         try:
@@ -442,6 +442,7 @@ def table(runs, fmt: str = "markdown") -> str:
                              "'partsim learn evaluate' first)") from None
         except (OSError, ValueError) as e:
             raise ValueError(f"{path}: cannot be read: {e}") from None
+        steps.add(int(ev.get("steps", 0)))
         for part in ("train", "test"):
             if part in ev:
                 key = (ev["obs"], ev["task"], part, int(ev["train_objects"]))
@@ -475,7 +476,9 @@ def table(runs, fmt: str = "markdown") -> str:
         lines.append(f"\n{obs}-exp {task} {part} on {n} objects: "
                      f"{np.mean(cells[(obs, task, part, n)]):.3g}")
     lines.append("\ncells: ours, mean over runs (the paper's Table 3 in brackets); door: final "
-                 "angle in degrees, drawer: success rate at 80% of the range")
+                 "angle in degrees, drawer: success rate at 80% of the range; training steps "
+                 "per run: " + ", ".join(f"{n:,}" for n in sorted(steps)) + " (the paper: "
+                 "1,000,000)")
     return "\n".join(lines) + "\n"
 
 
@@ -507,7 +510,7 @@ def plot_curves(run: str, out: str | None = None) -> str:
              f"{doc['config']['train_objects']} objects, seed {doc['config']['seed']}")
     fig, axes = plt.subplots(2, 2, figsize=(10, 7))
     panels = [("mean_return", "mean episode return"), ("success_rate", "success rate (90%)"),
-              ("q1_loss", "critic loss"), ("alpha", "entropy coefficient")]
+              ("q1_loss", "loss"), ("alpha", "entropy coefficient")]
     for ax, (name, label) in zip(axes.flat, panels):
         y = col(name)
         ax.plot(steps, y, marker=".", lw=1)
