@@ -6,6 +6,7 @@
 #   PREFIX/include/partsim/                       its headers (they need Eigen only)
 #   PREFIX/lib/<multiarch>/cmake/partsim/         find_package(partsim) -> partsim::partsim
 #   PREFIX/lib/python3/dist-packages/partsim/     the Python package (Debian's path for /usr)
+#   PREFIX/share/partsim/web/                     the viewer's web bundle, when built
 # `cpack -G DEB` in build/ makes partsim_<version>_<arch>.deb of the same files under /usr; its
 # dependencies are computed from the libraries the binaries link (dpkg-shlibdeps).
 include(GNUInstallDirs)
@@ -20,7 +21,8 @@ add_library(partsim::partsim ALIAS partsim)
 # CMake's own WHOLE_ARCHIVE feature would list it twice), then the layers and their external
 # libraries as usual
 set(PARTSIM_LAYER_LIBS partsim_core partsim_physics partsim_assets partsim_render partsim_robot
-                       partsim_vision partsim_planning partsim_tasks partsim_server)
+                       partsim_vision partsim_planning partsim_tasks partsim_server
+                       partsim_viewer)
 set(whole "LINKER:--whole-archive")
 foreach(lib ${PARTSIM_LAYER_LIBS})
   list(APPEND whole "$<TARGET_FILE:${lib}>")
@@ -62,6 +64,9 @@ if(TARGET partsim_py)
           DESTINATION ${PARTSIM_PYTHON_INSTALL_DIR}/partsim COMPONENT partsim
           PATTERN "__pycache__" EXCLUDE)
 endif()
+# the browser viewer's web bundle (scripts/build_web.sh builds it into build/web), when built
+install(DIRECTORY ${CMAKE_BINARY_DIR}/web/ DESTINATION ${CMAKE_INSTALL_DATADIR}/partsim/web
+        COMPONENT partsim OPTIONAL)
 
 # the Debian package
 set(CPACK_GENERATOR DEB)

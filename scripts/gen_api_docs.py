@@ -46,6 +46,9 @@ PAGES = [
     ("planning", "Planning", "Collision-free motion planning (OMPL).", ["planning_py.cc"]),
     ("tasks", "Tasks",
      "The drawer-pulling and door-opening tasks and their heuristic solvers.", ["tasks_py.cc"]),
+    ("viewer", "Viewer",
+     "The viewer in a web browser (docs/viewer.md): partsim.Viewer and Scene.create_viewer.",
+     ["viewer_py.cc"]),
 ]
 # the package's Python modules, one page each: module, page slug, title, summary
 MODULE_PAGES = [

@@ -21,6 +21,8 @@ PACKAGES=(
   libegl-dev libegl-mesa0 libgl1-mesa-dri libopengl-dev libembree-dev libpng-dev
   libbullet-extras-dev libjpeg-dev libompl-dev
   libwebsocketpp-dev libboost-dev
+  # the viewer's Python tests talk to its WebSocket with websocket-client
+  python3-websocket
   # MP4 videos of the demo and of VideoWriter (H.264 through Debian's libx264)
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev
 )

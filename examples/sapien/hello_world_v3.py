@@ -1,8 +1,9 @@
 """SAPIEN 3's hello world on partsim: `import sapien` becomes `import partsim as sapien`.
 
 SAPIEN 3 has no Engine: scenes are made directly, actors are entities with a `pose`, visuals
-take `material=`. The viewer of the original is replaced by a camera picture saved as PNG
-(partsim's viewer is not built yet: scene.create_viewer() says so).
+take `material=`. The viewer runs in a web browser: scene.create_viewer() prints the URL to
+open, and SAPIEN's viewer loop runs unchanged (for 100 steps here); a camera picture is saved
+as PNG too.
 
     PYTHONPATH=build/python /usr/bin/python3 examples/sapien/hello_world_v3.py [out.png]
 """
@@ -30,18 +31,21 @@ def main(out_png):
     scene.set_ambient_light([0.5, 0.5, 0.5])
     scene.add_directional_light([0, 1, -1], [0.5, 0.5, 0.5], shadow=True)
 
-    try:
-        scene.create_viewer()
-    except sapien.PartsimError as e:
-        print("create_viewer:", str(e).split(":")[0])
+    viewer = scene.create_viewer()  # prints the URL of the page
+    viewer.set_camera_xyz(x=-4, y=0, z=2)
+    viewer.set_camera_rpy(r=0, p=-np.arctan2(2, 4), y=0)
+    print("viewer:", viewer.url.split("?")[0])
 
     camera = scene.add_camera(name="camera", width=320, height=240, fovy=np.deg2rad(50),
                               near=0.1, far=100)
     # x forward, y left, z up; pitched down towards the box
     camera.entity.set_pose(sapien.Pose(p=[-4, 0, 2], q=euler2quat(0, np.arctan2(2, 4), 0)))
     for _ in range(100):
+        if viewer.closed:
+            break
         scene.step()
-    scene.update_render()
+        scene.update_render()
+        viewer.render()
     camera.take_picture()
     rgba = camera.get_picture("Color")  # float32 (h, w, 4) in [0, 1]
     Image.fromarray((np.clip(rgba, 0, 1) * 255).astype(np.uint8)).save(out_png)

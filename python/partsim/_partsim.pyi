@@ -2737,6 +2737,9 @@ class Scene:
     def create_urdf_loader(self) -> UrdfLoader:
         """A UrdfLoader whose load() adds to this scene."""
         ...
+    def create_viewer(self, port: int = ..., address: str = ..., token: typing.Optional[str] = ...) -> Viewer:
+        """A Viewer of this scene (SAPIEN's name): starts the browser viewer's server on a free port and prints the URL to open on stderr."""
+        ...
     def find_actor_by_name(self, name: str) -> Actor:
         """The first actor named `name`; raises PartsimError when there is none."""
         ...
@@ -3284,6 +3287,55 @@ class VideoWriter:
     @property
     def path(self) -> str:
         """The video's final path."""
+        ...
+
+
+class Viewer:
+    """The scene in a web browser (docs/viewer.md): a server on one port for the page, the scene's meshes and a rosbridge WebSocket. SAPIEN's loop runs unchanged: while not viewer.closed: scene.step(); scene.update_render(); viewer.render()."""
+    def __init__(self, scene: Scene = ..., port: int = ..., address: str = ..., token: typing.Optional[str] = ..., allowed_origins: typing.List[str] = ..., web_root: str = ..., max_rate: float = ...) -> None:
+        """Starts serving `scene` (None: nothing until set_scene) on `address`:`port` (0: a free port) and prints the URL to open on stderr. `token`: what the page must carry (None: a random one, in the URL); `allowed_origins`: web pages of other origins that may connect (default: pages of this machine); `web_root`: the web bundle folder (default: $PARTSIM_WEB_DIR, the build tree's, the installed one); `max_rate`: most pose updates per second (Hz)."""
+        ...
+    def close(self) -> None:
+        """Marks the viewer closed (viewer.closed becomes True)."""
+        ...
+    @property
+    def closed(self) -> bool:
+        """True once the page's close button was pressed or close() called."""
+        ...
+    @property
+    def paused(self) -> bool:
+        """Whether the page paused the scene."""
+        ...
+    @property
+    def port(self) -> int:
+        """The port served."""
+        ...
+    def render(self) -> None:
+        """Applies the page's commands (joint targets, reset, camera pictures) and sends it what moved (at most max_rate times a second). While the page has paused the scene it blocks until resumed, stepped (step n: this and the next n - 1 calls return) or closed; Ctrl-C raises KeyboardInterrupt and closes the viewer."""
+        ...
+    def set_camera_rpy(self, r: float, p: float, y: float) -> None:
+        """How the page's camera starts: roll, pitch, yaw (rad); it looks along (cos p cos y, cos p sin y, sin p), as SAPIEN's viewer.set_camera_rpy."""
+        ...
+    def set_camera_xyz(self, x: float, y: float, z: float) -> None:
+        """Where the page's camera starts (m, world), as SAPIEN's viewer.set_camera_xyz; read by the page when it loads."""
+        ...
+    def set_scene(self, scene: Scene) -> None:
+        """Views another scene (SAPIEN's viewer.set_scene); the page reloads."""
+        ...
+    def stop(self) -> None:
+        """Stops the server (closes every connection); the viewer is closed for good."""
+        ...
+    @property
+    def token(self) -> str:
+        """The token the page carries."""
+        ...
+    @property
+    def url(self) -> str:
+        """http://ADDRESS:PORT/?token=T: the page."""
+        ...
+    @property
+    def web_root(self) -> str:
+        """The web bundle folder served, '' when none was found."""
         ...
 
 

@@ -31,11 +31,11 @@ import numpy as np
 
 from . import _partsim as _p
 
-_VIEWER_MESSAGE = (
-    "partsim has no on-screen viewer yet: the browser viewer (scene.create_viewer(), "
-    "`partsim view`) is not built. Render pictures instead: camera = scene.add_camera(name, "
-    "width, height, fovy, near, far); scene.update_render(); camera.take_picture(); "
-    "camera.get_picture('Color'), or run `partsim render`.")
+_WINDOW_MESSAGE = (
+    "partsim has no on-screen window: its viewer runs in a web browser (scene.create_viewer() "
+    "or partsim.Viewer(scene) print the URL to open). For pictures: camera = "
+    "scene.add_camera(name, width, height, fovy, near, far); scene.update_render(); "
+    "camera.take_picture(); camera.get_picture('Color'), or run `partsim render`.")
 
 
 def _add(cls, name=None):
@@ -324,7 +324,7 @@ class SapienRenderer:
         return RenderMaterial()
 
     def create_window(self, *args, **kwargs):
-        raise _p.PartsimError(_VIEWER_MESSAGE)
+        raise _p.PartsimError(_WINDOW_MESSAGE)
 
     @staticmethod
     def set_log_level(level):
@@ -399,12 +399,6 @@ def get_all_articulations(self):
 @_add(_p.Scene)
 def get_mounted_cameras(self):
     return self.get_cameras()
-
-
-@_add(_p.Scene)
-def create_viewer(self, *args, **kwargs):
-    """Not available yet: raises PartsimError saying what to use instead."""
-    raise _p.PartsimError(_VIEWER_MESSAGE)
 
 
 @_add(_p.Scene)
@@ -985,7 +979,7 @@ _alias_property(_p.Camera, "entity", lambda self: _CameraEntity(self))
 
 
 # names of the extension that the package exports as the SAPIEN-aware Python versions above
-EXPORT_OVERRIDES = ("set_log_level",)
+EXPORT_OVERRIDES = ("set_log_level", "Viewer")
 
 # ------------------------------------------------------------------------------ submodules
 
@@ -1078,12 +1072,34 @@ for _n in ("PhysxRigidBaseComponent", "PhysxRigidBodyComponent", "PhysxRigidDyna
 utils = _submodule("utils", "SAPIEN's sapien.utils names on partsim.")
 
 
-class Viewer:
-    """SAPIEN's window viewer: not available in partsim yet (raises PartsimError saying what to
-    use instead)."""
+@_add(_p.Viewer)
+def toggle_axes(self, show):
+    """SAPIEN's viewer.toggle_axes: accepted, no effect (the page has its own toggles)."""
 
-    def __init__(self, *args, **kwargs):
-        raise _p.PartsimError(_VIEWER_MESSAGE)
+
+@_add(_p.Viewer)
+def toggle_camera_lines(self, show):
+    """SAPIEN's viewer.toggle_camera_lines: accepted, no effect (the page has its own
+    toggles)."""
+
+
+@_add(_p.Scene)
+def create_viewer(self, port=0, address="127.0.0.1", token=None):
+    """A partsim.Viewer of this scene (SAPIEN's name): starts the browser viewer's server on a
+    free port (or `port`) and prints the URL to open on stderr."""
+    return Viewer(self, port=port, address=address, token=token)
+
+
+class Viewer(_p.Viewer):
+    """The browser viewer, taking SAPIEN's arguments too: Viewer(scene, port=0, ...) as
+    partsim's, or SAPIEN 2's Viewer(renderer, shader_dir="", resolutions=...) followed by
+    viewer.set_scene(scene) (the renderer, shader folder and window size are ignored: the page
+    draws in the browser)."""
+
+    def __init__(self, scene=None, *args, shader_dir=None, resolutions=None, **kwargs):
+        if scene is not None and not isinstance(scene, _p.Scene):
+            scene, args = None, ()  # SAPIEN: a renderer, then shader_dir and resolutions
+        super().__init__(scene, *args, **kwargs)
 
 
 utils.Viewer = Viewer

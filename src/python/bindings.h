@@ -33,6 +33,8 @@ void BindPlanning(py::module_& m);
 /// COCO masks and the perception evaluators, in the submodule `_vision` that
 /// python/partsim/vision.py re-exports as partsim.vision (vision_py.cc).
 void BindVision(py::module_& m);
+/// The browser viewer, partsim.Viewer and Scene.create_viewer (viewer_py.cc); after BindPhysics.
+void BindViewer(py::module_& m);
 
 /// Runs `f` without the GIL while this thread holds `scene` (Scene::Use), so that other Python
 /// threads can run meanwhile but not touch that scene: their calls on it raise PartsimError, and

@@ -16,5 +16,6 @@ PYBIND11_MODULE(_partsim, m) {
   partsim::python::BindTasks(m);
   partsim::python::BindPlanning(m);
   partsim::python::BindVision(m);
+  partsim::python::BindViewer(m);
   m.attr("__version__") = partsim::Version();
 }

@@ -2,10 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cctype>
 #include <chrono>
 #include <cstdio>
-#include <cstring>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -15,6 +13,7 @@
 
 #include "partsim/core/error.h"
 #include "server/rosbridge_protocol.h"
+#include "server/web_security.h"
 
 // The transport of RosbridgeServer: websocketpp over Boost.Asio on a thread of its own, the
 // accept loop, the handshake checks (origin, connection cap), each client's bounded outgoing
@@ -27,33 +26,10 @@ namespace {
 
 using internal::ClientPtr;
 using internal::Json;
+using internal::OriginAllowed;
 using internal::Outgoing;
 using WsServer = websocketpp::server<websocketpp::config::asio>;
 using Hdl = websocketpp::connection_hdl;
-
-std::string Lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char ch) { return std::tolower(ch); });
-  return s;
-}
-
-// Whether a page of `origin` ("scheme://host[:port]") may connect: one of `allowed`, or with
-// none given, a page of this machine.
-bool OriginAllowed(const std::string& origin, const std::vector<std::string>& allowed) {
-  if (origin.empty()) return true;  // not a browser: no page to protect against
-  const std::string o = Lower(origin);
-  for (const std::string& a : allowed)
-    if (a == "*" || Lower(a) == o) return true;
-  if (!allowed.empty()) return false;
-  for (const char* scheme : {"http://", "https://"}) {
-    if (o.rfind(scheme, 0) != 0) continue;
-    const std::string rest = o.substr(std::strlen(scheme));
-    for (const char* host : {"localhost", "127.0.0.1", "[::1]"}) {
-      const size_t n = std::strlen(host);
-      if (rest.compare(0, n, host) == 0 && (rest.size() == n || rest[n] == ':')) return true;
-    }
-  }
-  return false;
-}
 
 }  // namespace
 

@@ -5,6 +5,7 @@
 
 #include "core/json_parse.h"
 #include "partsim/core/error.h"
+#include "server/web_security.h"
 
 namespace partsim::internal {
 
@@ -23,13 +24,6 @@ constexpr std::chrono::seconds kCallTimeout{60};
 
 // Open subscribe requests (distinct ids) of one client on one topic.
 constexpr size_t kMaxRequestsPerTopic = 64;
-
-// Compares without stopping at the first difference (the time taken says nothing of where).
-bool SameToken(const std::string& a, const std::string& b) {
-  unsigned char diff = a.size() != b.size();
-  for (size_t i = 0; i < a.size(); ++i) diff |= a[i] ^ b[i % (b.empty() ? 1 : b.size())];
-  return diff == 0 && !b.empty();
-}
 
 std::string Str(const Json& j, const char* key, const std::string& op) {
   if (!j.contains(key) || !j[key].is_string())

@@ -50,12 +50,22 @@ def test_sapien2_and_sapien3_entry_points():
         sapien.SceneConfig(gravityy=[0, 0, 0])
 
 
-def test_viewer_calls_say_what_to_use_instead():
+def test_viewer_calls_give_the_browser_viewer():
     scene = sapien.Scene()
-    for call in (scene.create_viewer, sapien.utils.Viewer, sapien.utils.viewer.Viewer,
-                 sapien.SapienRenderer().create_window):
-        with pytest.raises(partsim.PartsimError, match="no on-screen viewer.*take_picture"):
-            call()
+    viewer = scene.create_viewer()
+    assert isinstance(viewer, partsim.Viewer) and viewer.url.startswith("http://127.0.0.1:")
+    viewer.stop()
+    # SAPIEN 2: Viewer(renderer), then set_scene
+    for cls in (sapien.utils.Viewer, sapien.utils.viewer.Viewer):
+        viewer = cls(sapien.SapienRenderer(), shader_dir="", resolutions=(800, 600))
+        viewer.set_scene(scene)
+        viewer.toggle_axes(False)
+        viewer.toggle_camera_lines(False)
+        viewer.render()
+        assert not viewer.closed
+        viewer.stop()
+    with pytest.raises(partsim.PartsimError, match="no on-screen window.*browser"):
+        sapien.SapienRenderer().create_window()
     with pytest.raises(partsim.PartsimError, match="set_render_backend\\('pathtracer'\\)"):
         sapien.KuafuRenderer()
 

@@ -42,7 +42,7 @@ def test_hello_world_box_rests_and_contact_force_is_its_weight(tmp_path):
 def test_hello_world_v3_renders_the_red_box(tmp_path):
     out = run_example("hello_world_v3.py", str(tmp_path / "box.png"), cwd=tmp_path)
     assert "hello world v3: ok" in out
-    assert "create_viewer: partsim has no on-screen viewer yet" in out
+    assert "viewer: http://127.0.0.1:" in out
     assert (tmp_path / "box.png").stat().st_size > 1000
 
 

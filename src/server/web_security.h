@@ -1,0 +1,23 @@
+// Checks shared by partsim's network services (the rosbridge server, the browser viewer): which
+// web pages may connect (the handshake's Origin), comparing tokens, and making one.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace partsim::internal {
+
+/// Whether a page of `origin` ("scheme://host[:port]", compared without case) may connect: one
+/// of `allowed` ("*" allows every origin), or with none given, a page of this machine (http or
+/// https, host localhost, 127.0.0.1 or [::1], any port). An empty origin (not a browser: no page
+/// to protect against) is allowed.
+bool OriginAllowed(const std::string& origin, const std::vector<std::string>& allowed);
+
+/// Whether `given` equals the non-empty `token`, compared without stopping at the first
+/// difference (the time taken says nothing of where they differ).
+bool SameToken(const std::string& given, const std::string& token);
+
+/// A random token of 32 hexadecimal digits (128 bits from std::random_device).
+std::string RandomToken();
+
+}  // namespace partsim::internal

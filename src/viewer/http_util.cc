@@ -1,0 +1,73 @@
+#include "viewer/http_util.h"
+
+#include <cctype>
+#include <map>
+
+namespace partsim::internal {
+
+void SplitResource(const std::string& resource, std::string* path, std::string* query) {
+  const size_t q = resource.find('?');
+  *path = resource.substr(0, q);
+  *query = q == std::string::npos ? "" : resource.substr(q + 1);
+}
+
+std::string QueryValue(const std::string& query, const std::string& key) {
+  size_t at = 0;
+  while (at <= query.size()) {
+    size_t end = query.find('&', at);
+    if (end == std::string::npos) end = query.size();
+    const std::string item = query.substr(at, end - at);
+    const size_t eq = item.find('=');
+    if (item.substr(0, eq) == key) return eq == std::string::npos ? "" : item.substr(eq + 1);
+    at = end + 1;
+  }
+  return "";
+}
+
+bool SafeBundlePath(const std::string& path) {
+  if (path.size() < 2 || path[0] != '/') return false;
+  size_t at = 1;
+  while (at <= path.size()) {
+    size_t end = path.find('/', at);
+    if (end == std::string::npos) end = path.size();
+    if (end == at || path[at] == '.') return false;  // empty segment, "..", hidden file
+    for (size_t i = at; i < end; ++i) {
+      const unsigned char c = static_cast<unsigned char>(path[i]);
+      if (!std::isalnum(c) && c != '.' && c != '_' && c != '-') return false;
+    }
+    at = end + 1;
+  }
+  return path.back() != '/';
+}
+
+std::string ContentTypeOf(const std::string& path) {
+  static const std::map<std::string, std::string> types = {
+      {"html", "text/html; charset=utf-8"},
+      {"js", "text/javascript; charset=utf-8"},
+      {"mjs", "text/javascript; charset=utf-8"},
+      {"css", "text/css; charset=utf-8"},
+      {"json", "application/json"},
+      {"map", "application/json"},
+      {"txt", "text/plain; charset=utf-8"},
+      {"png", "image/png"},
+      {"jpg", "image/jpeg"},
+      {"jpeg", "image/jpeg"},
+      {"svg", "image/svg+xml"},
+      {"ico", "image/x-icon"},
+      {"wasm", "application/wasm"},
+      {"woff2", "font/woff2"}};
+  const size_t dot = path.rfind('.');
+  if (dot == std::string::npos) return "application/octet-stream";
+  std::string ext = path.substr(dot + 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  auto it = types.find(ext);
+  return it == types.end() ? "application/octet-stream" : it->second;
+}
+
+std::string ImageContentType(const std::string& bytes) {
+  if (bytes.rfind("\x89PNG", 0) == 0) return "image/png";
+  if (bytes.rfind("\xff\xd8\xff", 0) == 0) return "image/jpeg";
+  return "application/octet-stream";
+}
+
+}  // namespace partsim::internal
