@@ -41,7 +41,11 @@ const quantile = (a, q) => {
 function startLoop(args) {
   const proc = spawn(python, [path.join(repo, 'tests/web/cabinet_viewer.py'), '--out', tmp, ...args], {
     cwd: repo,
-    env: { ...process.env, PARTSIM_PYTHON_DIR: process.env.PARTSIM_PYTHON_DIR || path.join(repo, 'build/python') },
+    env: {
+      ...process.env,
+      PARTSIM_PYTHON_DIR: process.env.PARTSIM_PYTHON_DIR || path.join(repo, 'build/python'),
+      PARTSIM_WEB_DIR: process.env.PARTSIM_WEB_DIR || path.join(repo, 'build/web'),
+    },
     stdio: ['ignore', 'pipe', 'pipe'],
   });
   let stderr = '';

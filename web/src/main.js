@@ -57,7 +57,11 @@ class Viewer {
     fill.position.set(-2, -1.5, 1);
     this.scene.add(fill);
 
-    this.model = new SceneModel(this.connection);
+    // per-vertex lighting on software GL (about 3x the frame rate there), unless the URL says
+    // ?shading=standard|fast
+    const shading = params.get('shading');
+    this.fastShading = shading === null ? this.softwareGl : shading === 'fast';
+    this.model = new SceneModel(this.connection, { fastShading: this.fastShading });
     this.scene.add(this.model.root);
     this.grid = null;
     this.contacts = null;
@@ -157,7 +161,7 @@ class Viewer {
     const centre = box.getCenter(new THREE.Vector3());
     const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 0.1);
     const fovy = 45;
-    const distance = (radius / Math.sin(THREE.MathUtils.degToRad(fovy) / 2)) * 1.05;
+    const distance = (radius / Math.sin(THREE.MathUtils.degToRad(fovy) / 2)) * 1.3;
     const dir = new THREE.Vector3(1.6, 1.0, 0.9).normalize();
     const eye = centre.clone().addScaledVector(dir, distance);
     this.setCamera(eye.toArray(), centre.toArray(), fovy);
@@ -295,6 +299,7 @@ class Viewer {
       connected: this.connection.connected,
       closed: this.closed,
       software_gl: this.softwareGl,
+      fast_shading: this.fastShading,
       antialias: this.renderer.getContextAttributes()?.antialias ?? null,
       scene_version: this.model.desc ? this.model.desc.scene_version : null,
     };
@@ -331,6 +336,8 @@ class Viewer {
         drawLog: () => this.drawLog.slice(),
         clearDrawLog: () => { this.drawLog.length = 0; },
         background: () => this.background.getHexString(),
+        // for experiments from the console: the three.js objects
+        internals: () => ({ scene: this.scene, renderer: this.renderer, camera: this.camera, model: this.model }),
       };
     }
     return this._api;

@@ -3,6 +3,7 @@
 // as children of the same group so that they follow the body.
 import * as THREE from 'three';
 import { parseMesh } from './mesh.js';
+import { makeFastMaterial } from './fast_material.js';
 
 const SEG_FALLBACK = [0.5, 0.5, 0.5];
 
@@ -27,8 +28,10 @@ function identityPose(p) {
 const Y_TO_X = new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(0, 0, 1), -Math.PI / 2);
 
 export class SceneModel {
-  constructor(connection) {
+  /** `fastShading`: per-vertex lighting (for software GL, see fast_material.js). */
+  constructor(connection, { fastShading = false } = {}) {
     this.connection = connection;
+    this.fastShading = fastShading;
     this.root = new THREE.Group();
     this.root.name = 'partsim-bodies';
     this.bodies = [];          // per body: {desc, group, visuals[], collision, frame, joint, articulation}
@@ -103,21 +106,17 @@ export class SceneModel {
 
   async addVisual(body, v) {
     const color = v.color || [0.8, 0.8, 0.8, 1];
-    const material = new THREE.MeshStandardMaterial({
-      color: new THREE.Color(color[0], color[1], color[2]),
-      roughness: 0.7,
-      metalness: 0.0,
-      transparent: color[3] < 1,
-      opacity: color[3] ?? 1,
-    });
+    const opacity = color[3] ?? 1;
     const [geometry, texture] = await Promise.all([
       this.geometry(v.mesh),
       v.texture !== undefined && v.texture >= 0 ? this.texture(v.texture) : Promise.resolve(null),
     ]);
-    if (texture) {
-      material.map = texture;
-      material.needsUpdate = true;
-    }
+    const rgb = new THREE.Color(color[0], color[1], color[2]);
+    const material = this.fastShading
+      ? makeFastMaterial(rgb, opacity, geometry.attributes.uv ? texture : null)
+      : new THREE.MeshStandardMaterial({
+        color: rgb, roughness: 0.7, metalness: 0.0, transparent: opacity < 1, opacity, map: texture,
+      });
     const mesh = new THREE.Mesh(geometry, material);
     applyPose(mesh, identityPose(v.pose));
     if (v.scale) mesh.scale.set(v.scale[0], v.scale[1], v.scale[2]);
