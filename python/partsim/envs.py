@@ -474,9 +474,33 @@ def _batch_space(space, n):
 
 
 def _stack(items):
+    """One batched observation from a list of them (arrays, or dicts of arrays)."""
     if isinstance(items[0], dict):
         return {k: np.stack([x[k] for x in items]) for k in items[0]}
     return np.stack(items)
+
+
+def _stack_infos(items):
+    """Gymnasium's vector info dict from a list of info dicts: an array per key, and a
+    ``_key`` mask saying which sub-environments have it (all of them here)."""
+    out = {}
+    for k in items[0]:
+        out[k] = np.array([x[k] for x in items])
+        out["_" + k] = np.ones(len(items), dtype=bool)
+    return out
+
+
+def _vector_seeds(seed, num_envs: int) -> list:
+    """The reset seeds of ``num_envs`` sub-environments from a vector reset's ``seed``: None
+    for all, ``seed + i`` for an int, or a sequence of ``num_envs`` seeds as given."""
+    if seed is None:
+        return [None] * num_envs
+    if isinstance(seed, numbers.Integral):
+        return [int(seed) + i for i in range(num_envs)]
+    seeds = list(seed)
+    if len(seeds) != num_envs:
+        raise ValueError(f"reset: {len(seeds)} seeds for {num_envs} environments")
+    return seeds
 
 
 def _task_action(a):
@@ -555,14 +579,7 @@ class VectorOpenCabinetEnv(_ClosedByContext):
         """Resets every sub-environment: ``seed`` None, an int (sub-environment i gets
         ``seed + i``) or a sequence of ``num_envs`` seeds (None entries allowed)."""
         self._check_open()
-        if seed is None:
-            seeds = [None] * self.num_envs
-        elif isinstance(seed, numbers.Integral):
-            seeds = [int(seed) + i for i in range(self.num_envs)]
-        else:
-            seeds = list(seed)
-            if len(seeds) != self.num_envs:
-                raise ValueError(f"reset: {len(seeds)} seeds for {self.num_envs} environments")
+        seeds = _vector_seeds(seed, self.num_envs)
         results = self._map(lambda i: self.envs[i].reset(seed=seeds[i], options=options))
         self._needs_reset[:] = False
         return _stack([r[0] for r in results]), self._infos([r[1] for r in results])
@@ -641,8 +658,4 @@ class VectorOpenCabinetEnv(_ClosedByContext):
 
     @staticmethod
     def _infos(items):
-        out = {}
-        for k in items[0]:
-            out[k] = np.array([x[k] for x in items])
-            out["_" + k] = np.ones(len(items), dtype=bool)
-        return out
+        return _stack_infos(items)

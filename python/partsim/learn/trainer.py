@@ -30,7 +30,6 @@ import dataclasses
 import io
 import json
 import math
-import numbers
 import os
 import shutil
 import sys
@@ -38,6 +37,8 @@ import time
 
 import numpy as np
 import torch
+
+from ..envs import _stack, _stack_infos, _vector_seeds
 
 __all__ = ["TrainConfig", "Trainer", "SyncVectorEnv", "Evaluation", "evaluate",
            "segment_seeds", "CSV_COLUMNS", "TIMING_COLUMNS"]
@@ -393,10 +394,6 @@ def _duration(s):
 # --- a generic vector environment --------------------------------------------------------------
 
 
-def _stack(items):
-    if isinstance(items[0], dict):
-        return {k: np.stack([x[k] for x in items]) for k in items[0]}
-    return np.stack(items)
 
 
 class SyncVectorEnv:
@@ -423,14 +420,7 @@ class SyncVectorEnv:
     def reset(self, *, seed=None, options=None):
         """Resets every sub-environment (see the class docstring for ``seed``); returns
         (stacked observations, infos)."""
-        if seed is None:
-            seeds = [None] * self.num_envs
-        elif isinstance(seed, numbers.Integral):
-            seeds = [int(seed) + i for i in range(self.num_envs)]
-        else:
-            seeds = list(seed)
-            if len(seeds) != self.num_envs:
-                raise ValueError(f"reset: {len(seeds)} seeds for {self.num_envs} environments")
+        seeds = _vector_seeds(seed, self.num_envs)
         results = [e.reset(seed=s, options=options) for e, s in zip(self.envs, seeds)]
         self._needs_reset[:] = False
         return _stack([r[0] for r in results]), self._infos([r[1] for r in results])
@@ -463,11 +453,7 @@ class SyncVectorEnv:
 
     @staticmethod
     def _infos(items):
-        out = {}
-        for k in items[0]:
-            out[k] = np.array([x[k] for x in items])
-            out["_" + k] = np.ones(len(items), dtype=bool)
-        return out
+        return _stack_infos(items)
 
 
 # --- evaluation --------------------------------------------------------------------------------
