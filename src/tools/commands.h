@@ -5,6 +5,12 @@
 #include <utility>
 #include <vector>
 
+#include "partsim/core/pose.h"
+
+namespace partsim {
+class Scene;
+}
+
 namespace partsim::tools {
 
 /// `partsim info ...`: the links, joints, mass and dof of an object (`args`: the arguments
@@ -31,6 +37,16 @@ int RunTasksCommand(int argc, char** argv);
 /// `partsim serve ...`: a scene stepped in real time behind a rosbridge v2 WebSocket server
 /// (arguments after "serve"). Returns the exit code (0 success, 1 failure, 2 bad command line).
 int RunServeCommand(int argc, char** argv);
+
+/// `partsim view ...`: the browser viewer of an asset, simulated in real time (arguments after
+/// "view"). Returns the exit code (0 success, 1 failure, 2 bad command line).
+int RunViewCommand(int argc, char** argv);
+
+/// What `partsim serve` and `partsim view` simulate: `scene_file` (a URDF file or a
+/// PartNet-Mobility folder placed at `where` with its root fixed, or a scene file's objects at
+/// their poses), or the built-in cabinet at `where` when it is "". Throws partsim::Error naming
+/// the file at fault.
+void AddServedObjects(Scene* scene, const std::string& scene_file, const Pose& where);
 
 /// `partsim vision ...`: the perception benchmark's tools (evaluate-detection,
 /// evaluate-motion); `argv` holds the arguments after "vision". Returns the exit code (0

@@ -26,6 +26,7 @@
 #include "partsim/server/rosbridge.h"
 #include "partsim/server/served_robot.h"
 #include "partsim/server/sim_server.h"
+#include "partsim/viewer/viewer.h"
 
 namespace partsim::tools {
 namespace {
@@ -34,7 +35,7 @@ constexpr char kServeUsage[] = R"(usage:
   partsim serve [SCENE] [--port P] [--rate R | --realtime-factor F | --fast]
                 [--robot gripper|panda] [--address A] [--duration S] [--camera WxH]
                 [--camera-rate HZ] [--token T] [--allow-origin O]... [--max-clients N]
-                [--ros1 [--ros1-wall-time]]
+                [--ros1 [--ros1-wall-time]] [--viewer [--viewer-port P]]
 
 Steps a scene on its own thread and serves it over the rosbridge v2 protocol (JSON over
 WebSocket): /clock, /joint_states and /tf out; /<robot>/joint_position_controller/command,
@@ -71,12 +72,29 @@ With no SCENE, a built-in cabinet stands in front of the robot.
   --camera-rate HZ       camera topics per simulated second (default 10; 0: every step)
   --ros1                 also serve over native ROS 1 (needs a ROS master)
   --ros1-wall-time       with --ros1: leave /use_sim_time alone
+  --viewer               also serve the browser viewer of the scene (docs/viewer.md) on its own
+                         port, attached to the same simulation; its URL is printed. It takes
+                         the --token if given (else a random one, in the URL), --address and
+                         --allow-origin
+  --viewer-port P        the viewer's port (default 8000; 0 picks a free one)
 )";
 
 std::atomic<bool> g_stop{false};
 void OnSignal(int) { g_stop = true; }
 
 }  // namespace
+
+void AddServedObjects(Scene* scene, const std::string& scene_file, const Pose& where) {
+  if (scene_file.empty()) {
+    UrdfLoader loader(scene);
+    loader.fix_root_link = true;
+    ArticulationDesc object = loader.Parse(MakeCabinetUrdf(), ".", "cabinet");
+    object.root_pose = where;
+    scene->AddArticulation(object);
+  } else {
+    AddSceneObjects(scene, scene_file, where, true);
+  }
+}
 
 int RunServeCommand(int argc, char** argv) {
   std::string scene_file, robot_kind = "panda", address = "127.0.0.1";
@@ -86,7 +104,8 @@ int RunServeCommand(int argc, char** argv) {
   size_t max_clients = 100;
   int port = 9090;
   double rate = 500, factor = 1, duration = 0;
-  bool fast = false, ros1 = false, ros1_sim_time = true;
+  bool fast = false, ros1 = false, ros1_sim_time = true, viewer = false;
+  int viewer_port = 8000;
   int cam_w = 640, cam_h = 480;
   double camera_rate = 10;
   const std::vector<std::string> args(argv, argv + argc);
@@ -117,6 +136,10 @@ int RunServeCommand(int argc, char** argv) {
              [&](const FlagValue& v) { max_clients = static_cast<size_t>(v.Integer(1, 100000)); });
     p.Switch("--ros1", [&] { ros1 = true; });
     p.Switch("--ros1-wall-time", [&] { ros1_sim_time = false; });
+    p.Switch("--viewer", [&] { viewer = true; });
+    p.Option("--viewer-port", [&](const FlagValue& v) {
+      viewer_port = static_cast<int>(v.Integer(0, 65535, "(0 picks a free port)"));
+    });
     p.Switch("--help", [] {});  // answered above; declared to be suggested
     p.Parse(args);
     return 0;
@@ -148,16 +171,7 @@ int RunServeCommand(int argc, char** argv) {
     cfg.timestep = 1.0 / rate;
     Scene scene(cfg);
     scene.AddGround(0.0);
-    const Pose ahead(Eigen::Vector3d(1.0, 0, 0));
-    if (scene_file.empty()) {
-      UrdfLoader loader(&scene);
-      loader.fix_root_link = true;
-      ArticulationDesc object = loader.Parse(MakeCabinetUrdf(), ".", "cabinet");
-      object.root_pose = ahead;
-      scene.AddArticulation(object);
-    } else {
-      AddSceneObjects(&scene, scene_file, ahead, true);
-    }
+    AddServedObjects(&scene, scene_file, Pose(Eigen::Vector3d(1.0, 0, 0)));
     RobotModel model = robot_kind == "panda" ? BuildPanda() : BuildFlyingGripper();
     if (robot_kind == "gripper") model.articulation.root_pose = Pose(Eigen::Vector3d(0, 0, 0.5));
     Articulation robot = scene.AddArticulation(model.articulation);
@@ -201,6 +215,23 @@ int RunServeCommand(int argc, char** argv) {
       throw std::runtime_error(std::string(e.what()) +
                                "; choose another port with --port P, or --port 0 for a free one");
     }
+    // the browser viewer, attached to the same simulation (before it starts)
+    std::unique_ptr<Viewer> page;
+    if (viewer) {
+      ViewerOptions vo;
+      vo.address = address;
+      vo.port = viewer_port;
+      vo.auth_token = token;
+      vo.allowed_origins = origins;
+      page = std::make_unique<Viewer>(&scene, vo);
+      page->Attach(&sim);
+      try {
+        page->Start();
+      } catch (const std::exception& e) {
+        throw std::runtime_error(std::string(e.what()) +
+                                 "; choose another port with --viewer-port P (0: a free one)");
+      }
+    }
 #ifdef PARTSIM_WITH_ROS1
     std::unique_ptr<Ros1Bridge> ros1_bridge;
     if (ros1) {
@@ -230,6 +261,10 @@ int RunServeCommand(int argc, char** argv) {
         "(partsim serve --help)\n"
         "  clients are logged on stderr as they connect and leave; %s\n",
         url.c_str(), address.c_str(), bridge.GetPort(), url.c_str(), robot.GetName().c_str(), stop);
+    if (page)
+      std::printf(
+          "  viewer: open %s in a browser%s\n", page->GetUrl().c_str(),
+          page->GetWebRoot().empty() ? " (web page not built: bash scripts/build_web.sh)" : "");
     std::fflush(stdout);
 
     std::signal(SIGINT, OnSignal);
@@ -244,6 +279,7 @@ int RunServeCommand(int argc, char** argv) {
     sim.Stop();
     served.Close();
     bridge.Stop();
+    if (page) page->Stop();
 #ifdef PARTSIM_WITH_ROS1
     if (ros1_bridge) ros1_bridge->Stop();
 #endif
