@@ -769,17 +769,18 @@ struct Viewer::Impl {
     if (!internal::SafeBundlePath(path))
       return fail(400, "bad path '" + path +
                            "': only files of the web bundle are served (no '..', no '%')");
-    if (web_root.empty()) {
+    const fs::path file = fs::path(web_root.empty() ? "/nonexistent" : web_root) / path.substr(1);
+    std::error_code ec;
+    if (web_root.empty() || !fs::is_regular_file(file, ec)) {
+      // no bundle (or one without its page): say how to build it
       if (path == "/index.html") {
         *type = "text/html; charset=utf-8";
         *body = kNoBundlePage;
         return;
       }
-      return fail(404, "no web bundle: run bash scripts/build_web.sh");
+      return fail(404, "no file '" + path + "' in the web bundle (" +
+                           (web_root.empty() ? "none found" : web_root) + ")");
     }
-    const fs::path file = fs::path(web_root) / path.substr(1);
-    std::error_code ec;
-    if (!fs::is_regular_file(file, ec)) return fail(404, "no file '" + path + "' in the bundle");
     std::ifstream in(file, std::ios::binary);
     std::ostringstream ss;
     ss << in.rdbuf();

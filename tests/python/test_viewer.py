@@ -1,0 +1,169 @@
+"""partsim.Viewer and scene.create_viewer from Python: the binding surface (properties, the
+SAPIEN calls), HTTP and the WebSocket against the running server on loopback, render()
+blocking while the page pauses, and Ctrl-C while it blocks. The protocol itself is tested in C++
+(tests/viewer/viewer_test.cc)."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+import urllib.error
+import urllib.request
+
+import pytest
+
+import partsim
+
+websocket = pytest.importorskip("websocket")  # Debian's python3-websocket (scripts/setup.sh)
+
+
+@pytest.fixture
+def scene():
+    s = partsim.Scene()
+    s.add_ground(0.0)
+    b = s.create_actor_builder()
+    b.add_box_collision(half_size=[0.1, 0.1, 0.1])
+    b.add_box_visual(half_size=[0.1, 0.1, 0.1])
+    box = b.build()
+    box.set_name("box")
+    box.set_pose(partsim.Pose([0, 0, 1]))
+    return s
+
+
+def get(viewer, path, token=True):
+    url = f"http://127.0.0.1:{viewer.port}{path}"
+    if token:
+        url += "?token=" + viewer.token
+    with urllib.request.urlopen(url, timeout=10) as r:
+        return r.read()
+
+
+def connect(viewer):
+    ws = websocket.create_connection(f"ws://127.0.0.1:{viewer.port}/", timeout=10)
+    ws.send(json.dumps({"op": "auth", "mac": viewer.token}))
+    assert json.loads(ws.recv())["msg"] == "authenticated"
+    return ws
+
+
+def reply(ws, call_id):
+    while True:
+        m = json.loads(ws.recv())
+        if m.get("id") == call_id:
+            return m
+
+
+def test_viewer_serves_the_scene_and_streams_poses(scene, capfd):
+    viewer = partsim.Viewer(scene, token="tok")
+    assert "open http://127.0.0.1:%d/?token=tok" % viewer.port in capfd.readouterr().err
+    assert viewer.url == "http://127.0.0.1:%d/?token=tok" % viewer.port
+    assert viewer.token == "tok" and not viewer.closed and not viewer.paused
+    content = json.loads(get(viewer, "/api/scene.json"))
+    assert [b["name"] for b in content["bodies"]] == ["ground", "box"]
+    assert content["poses"][7 + 2] == pytest.approx(1.0)
+    with pytest.raises(urllib.error.HTTPError, match="403"):
+        get(viewer, "/api/scene.json", token=False)
+    mesh = get(viewer, "/api/mesh/%d.bin" % content["bodies"][1]["visuals"][0]["mesh"])
+    assert mesh[:4] == b"PSMH"
+
+    ws = connect(viewer)
+    ws.send(json.dumps({"op": "subscribe", "topic": "/partsim/poses"}))
+    first = json.loads(ws.recv())
+    assert first["msg"]["ids"] == [0, 1]
+    # SAPIEN's loop: the box falls, and only the box is sent
+    for _ in range(30):
+        scene.step()
+        scene.update_render()
+        viewer.render()
+        time.sleep(0.02)
+    moved = json.loads(ws.recv())
+    assert moved["msg"]["ids"] == [1] and moved["msg"]["poses"][2] < 1.0
+    ws.send(json.dumps({"op": "call_service", "service": "/partsim/close", "id": "c"}))
+    assert reply(ws, "c")["result"] is True
+    assert viewer.closed
+    ws.close()
+    viewer.stop()
+
+
+def test_render_blocks_while_the_page_pauses(scene):
+    viewer = scene.create_viewer()
+    assert isinstance(viewer, partsim.Viewer)
+    ws = connect(viewer)
+    ws.send(json.dumps({"op": "call_service", "service": "/partsim/pause", "id": "p"}))
+    assert reply(ws, "p")["result"] is True
+    assert viewer.paused
+    returned = []
+
+    def loop():
+        while not viewer.closed and len(returned) < 100:
+            viewer.render()
+            returned.append(1)
+            scene.step()
+
+    t = threading.Thread(target=loop)
+    t.start()
+    time.sleep(0.3)
+    assert not returned  # blocked
+    ws.send(json.dumps({"op": "call_service", "service": "/partsim/step", "args": {"n": 2},
+                        "id": "s"}))
+    reply(ws, "s")
+    time.sleep(0.3)
+    assert len(returned) == 2
+    ws.send(json.dumps({"op": "call_service", "service": "/partsim/close", "id": "c"}))
+    reply(ws, "c")
+    t.join(timeout=10)
+    assert not t.is_alive() and viewer.closed
+    ws.close()
+    viewer.stop()
+
+
+def test_sapien_viewer_calls(scene):
+    viewer = partsim.Viewer()  # SAPIEN 2: the scene comes later
+    with pytest.raises(urllib.error.HTTPError, match="503"):
+        get(viewer, "/api/scene.json")  # no scene yet
+    viewer.set_scene(scene)
+    viewer.set_camera_xyz(x=-2, y=0, z=1)
+    viewer.set_camera_rpy(r=0, p=-0.3, y=0)
+    content = json.loads(get(viewer, "/api/scene.json"))
+    assert content["initial_camera"] == {"position": [-2, 0, 1], "rpy": [0, -0.3, 0]}
+    assert len(content["bodies"]) == 2
+    viewer.toggle_axes(False)
+    viewer.toggle_camera_lines(False)
+    viewer.render()
+    viewer.close()
+    assert viewer.closed
+    with pytest.raises(partsim.PartsimError, match="finite"):
+        viewer.set_camera_xyz(float("nan"), 0, 0)
+    viewer.stop()
+
+
+def test_ctrl_c_while_paused_raises_keyboard_interrupt(tmp_path):
+    # a child process: a SAPIEN loop that the page has paused, then SIGINT
+    script = tmp_path / "loop.py"
+    script.write_text(
+        "import json, sys, websocket, partsim\n"
+        "scene = partsim.Scene()\n"
+        "viewer = scene.create_viewer()\n"
+        "ws = websocket.create_connection('ws://127.0.0.1:%d/' % viewer.port, timeout=10)\n"
+        "ws.send(json.dumps({'op': 'auth', 'mac': viewer.token}))\n"
+        "ws.send(json.dumps({'op': 'call_service', 'service': '/partsim/pause'}))\n"
+        "while not viewer.paused: pass\n"
+        "print('paused', flush=True)\n"
+        "try:\n"
+        "    while not viewer.closed:\n"
+        "        scene.step(); viewer.render()\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted, closed =', viewer.closed, flush=True)\n")
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(os.path.dirname(partsim.__file__)))
+    p = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True,
+                         env=env)
+    try:
+        assert p.stdout.readline().strip() == "paused"
+        time.sleep(0.3)
+        p.send_signal(signal.SIGINT)
+        out, _ = p.communicate(timeout=10)
+    finally:
+        p.kill()
+    assert "interrupted, closed = True" in out

@@ -1,0 +1,657 @@
+// The browser viewer's server against real clients on loopback: HTTP requests over a plain
+// socket, websocketpp's WebSocket client. The scene is a generated PartNet-Mobility cabinet on a
+// ground with a box falling onto it, viewed in synchronous mode (Render on the test's thread or
+// on one thread it starts) and in served mode (a SimServer).
+#include "partsim/viewer/viewer.h"
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+#include <websocketpp/client.hpp>
+#include <websocketpp/config/asio_no_tls_client.hpp>
+
+#include "partsim/assets/generator.h"
+#include "partsim/assets/partnet_mobility.h"
+#include "partsim/core/log.h"
+#include "partsim/physics/observer.h"
+#include "partsim/physics/scene.h"
+#include "partsim/render/camera.h"
+#include "partsim/render/camera_math.h"
+#include "partsim/render/image_read.h"
+#include "partsim/server/sim_server.h"
+#include "server/wait_for.h"
+
+namespace partsim {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using WsClient = websocketpp::client<websocketpp::config::asio_client>;
+using testing::WaitFor;
+
+struct HttpReply {
+  int status = 0;
+  std::string body;
+};
+
+/// GET `path` from 127.0.0.1:port with extra header lines ("Name: value\r\n").
+HttpReply HttpGet(int port, const std::string& path, const std::string& headers = "") {
+  HttpReply r;
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  timeval tv{5, 0};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
+    close(fd);
+    return r;
+  }
+  const std::string req = "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\n" + headers + "\r\n";
+  send(fd, req.data(), req.size(), 0);
+  std::string all;
+  char buf[65536];
+  while (true) {
+    const ssize_t n = recv(fd, buf, sizeof(buf), 0);
+    if (n <= 0) break;
+    all.append(buf, static_cast<size_t>(n));
+    // the whole body once Content-Length bytes have come
+    const size_t head = all.find("\r\n\r\n");
+    const size_t len = all.find("Content-Length: ");
+    if (head != std::string::npos && len != std::string::npos && len < head &&
+        all.size() >= head + 4 + std::stoul(all.substr(len + 16)))
+      break;
+  }
+  close(fd);
+  if (all.size() > 12) r.status = std::stoi(all.substr(9, 3));
+  const size_t head = all.find("\r\n\r\n");
+  if (head != std::string::npos) r.body = all.substr(head + 4);
+  return r;
+}
+
+std::string Base64Decode(const std::string& in) {
+  auto value = [](char c) -> int {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    return c == '+' ? 62 : c == '/' ? 63 : -1;
+  };
+  std::string out;
+  int bits = 0, acc = 0;
+  for (char c : in) {
+    const int v = value(c);
+    if (v < 0) continue;
+    acc = (acc << 6) | v;
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<char>((acc >> bits) & 255));
+    }
+  }
+  return out;
+}
+
+/// A WebSocket client on its own thread that keeps every message it receives.
+class TestClient {
+ public:
+  explicit TestClient(int port, const std::string& origin = "") {
+    c_.clear_access_channels(websocketpp::log::alevel::all);
+    c_.clear_error_channels(websocketpp::log::elevel::all);
+    c_.init_asio();
+    c_.set_open_handler([this](websocketpp::connection_hdl) { open_ = true; });
+    c_.set_close_handler([this](websocketpp::connection_hdl h) {
+      close_code_ = c_.get_con_from_hdl(h)->get_remote_close_code();
+      closed_ = true;
+    });
+    c_.set_fail_handler([this](websocketpp::connection_hdl) { closed_ = true; });
+    c_.set_message_handler([this](websocketpp::connection_hdl, WsClient::message_ptr m) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      messages_.push_back(json::parse(m->get_payload(), nullptr, false));
+    });
+    websocketpp::lib::error_code ec;
+    con_ = c_.get_connection("ws://127.0.0.1:" + std::to_string(port) + "/", ec);
+    if (!origin.empty()) con_->replace_header("Origin", origin);
+    c_.connect(con_);
+    thread_ = std::thread([this] { c_.run(); });
+  }
+  ~TestClient() {
+    websocketpp::lib::error_code ec;
+    if (open_ && !closed_) c_.close(con_->get_handle(), websocketpp::close::status::normal, "", ec);
+    WaitFor([this] { return closed_.load(); });
+    c_.stop();
+    thread_.join();
+  }
+  bool WaitOpen() {
+    return WaitFor([this] { return open_.load() || closed_.load(); }) && open_;
+  }
+  void Send(const std::string& text) {
+    websocketpp::lib::error_code ec;
+    c_.send(con_->get_handle(), text, websocketpp::frame::opcode::text, ec);
+  }
+  void Send(const json& j) { Send(j.dump()); }
+  void Auth(const std::string& token) {
+    Send(json{{"op", "auth"}, {"mac", token}});
+    ASSERT_FALSE(
+        WaitMessage([](const json& m) { return m.value("msg", "") == "authenticated"; }).is_null());
+  }
+  std::vector<json> Messages() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return messages_;
+  }
+  /// Waits for a message satisfying `pred` (up to 10 s); returns it, or null.
+  template <class F>
+  json WaitMessage(F pred) {
+    json found;
+    WaitFor([&] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (const json& m : messages_)
+        if (pred(m)) {
+          found = m;
+          return true;
+        }
+      return false;
+    });
+    return found;
+  }
+  /// The answer to call `id`.
+  json WaitReply(const std::string& id) {
+    return WaitMessage([&](const json& m) { return m.value("id", "") == id; });
+  }
+  void Clear() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    messages_.clear();
+  }
+  bool Closed() const { return closed_; }
+  int CloseCode() const { return close_code_; }
+
+ private:
+  WsClient c_;
+  WsClient::connection_ptr con_;
+  std::thread thread_;
+  std::mutex mutex_;
+  std::vector<json> messages_;
+  std::atomic<bool> open_{false}, closed_{false};
+  std::atomic<int> close_code_{0};
+};
+
+json Call(const std::string& service, const json& args, const std::string& id) {
+  return {{"op", "call_service"}, {"service", service}, {"args", args}, {"id", id}};
+}
+
+class ViewerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    SetLogLevel(LogLevel::kError);
+    dir_ = fs::temp_directory_path() /
+           ("partsim_viewer_test_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    WriteObject(GenerateObject("StorageFurniture", 0, 7), (dir_ / "cabinet").string());
+    scene_ = std::make_unique<Scene>();
+    scene_->AddGround(0.0);
+    PartNetMobilityLoader loader(scene_.get());
+    loader.urdf.fix_root_link = true;
+    cabinet_ = loader.Load((dir_ / "cabinet").string());
+    PlaceOnGround(cabinet_);  // its parts clear the ground
+    auto box = scene_->CreateActorBuilder();
+    box.AddBoxCollision(Pose(), Eigen::Vector3d(0.05, 0.05, 0.05));
+    box.AddBoxVisual(Pose(), Eigen::Vector3d(0.05, 0.05, 0.05));
+    box.SetInitialPose(Pose(Eigen::Vector3d(2, 0, 1)));
+    box.SetName("falling_box");
+    box_ = box.Build();
+  }
+  void TearDown() override {
+    viewer_.reset();
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+    SetLogLevel(LogLevel::kWarning);
+  }
+  Viewer& Start(const ViewerOptions& o = {}) {
+    viewer_ = std::make_unique<Viewer>(scene_.get(), o);
+    viewer_->Start();
+    return *viewer_;
+  }
+  std::string Api(const std::string& path) { return path + "?token=" + viewer_->GetToken(); }
+  json SceneJson() {
+    HttpReply r = HttpGet(viewer_->GetPort(), Api("/api/scene.json"));
+    EXPECT_EQ(r.status, 200) << r.body;
+    return json::parse(r.body, nullptr, false);
+  }
+  /// The first joint of the cabinet with a dof.
+  Joint MovableJoint() {
+    for (const Joint& j : cabinet_.GetActiveJoints())
+      if (std::isfinite(j.GetLimits()[0]) && std::isfinite(j.GetLimits()[1])) return j;
+    ADD_FAILURE() << "the cabinet has no limited joint";
+    return {};
+  }
+
+  fs::path dir_;
+  std::unique_ptr<Scene> scene_;
+  Articulation cabinet_;
+  Actor box_;
+  std::unique_ptr<Viewer> viewer_;
+};
+
+TEST_F(ViewerTest, SceneJsonDescribesEveryBodyJointAndLabel) {
+  Start();
+  const json j = SceneJson();
+  const std::vector<VisualBody> bodies = GetVisualBodies(*scene_);
+  ASSERT_EQ(j["bodies"].size(), bodies.size());
+  EXPECT_EQ(j["poses"].size(), 7 * bodies.size());
+  size_t labelled = 0;
+  for (size_t i = 0; i < bodies.size(); ++i) {
+    EXPECT_EQ(j["bodies"][i]["name"], bodies[i].name);
+    EXPECT_EQ(j["bodies"][i]["label"], bodies[i].semantic_label);
+    EXPECT_EQ(j["bodies"][i]["visuals"].size(), bodies[i].visuals.size());
+    labelled += !bodies[i].semantic_label.empty();
+  }
+  EXPECT_GT(labelled, 1u);  // the cabinet's parts carry PartNet labels
+  ASSERT_EQ(j["articulations"].size(), 1u);
+  const json& art = j["articulations"][0];
+  EXPECT_EQ(art["dof"], cabinet_.Dof());
+  ASSERT_EQ(art["joints"].size(), cabinet_.GetJoints().size());
+  for (size_t k = 0; k < art["joints"].size(); ++k) {
+    const Joint joint = cabinet_.GetJoints()[k];
+    const json& jj = art["joints"][k];
+    EXPECT_EQ(jj["name"], joint.GetName());
+    EXPECT_EQ(jj["dof_index"], joint.GetDofIndex());
+    if (joint.GetDofIndex() >= 0 && std::isfinite(joint.GetLimits()[1])) {
+      EXPECT_DOUBLE_EQ(jj["lower"].get<double>(), joint.GetLimits()[0]);
+      EXPECT_DOUBLE_EQ(jj["upper"].get<double>(), joint.GetLimits()[1]);
+    }
+    // the child body is the joint's child link
+    EXPECT_EQ(j["bodies"][jj["child"].get<int>()]["name"], joint.GetChildLink().GetName());
+  }
+  // the falling box's pose is where it starts
+  const json& poses = j["poses"];
+  EXPECT_NEAR(poses[7 * 1 + 2].get<double>(), 1.0, 1e-9);
+  EXPECT_TRUE(j["initial_camera"].is_null());
+}
+
+TEST_F(ViewerTest, MeshBinaryDecodesToTheVisualsVertexCount) {
+  Start();
+  const json j = SceneJson();
+  const std::vector<VisualBody> bodies = GetVisualBodies(*scene_);
+  int checked = 0;
+  for (size_t i = 0; i < bodies.size(); ++i)
+    for (size_t v = 0; v < bodies[i].visuals.size(); ++v) {
+      const VisualShape& shape = bodies[i].visuals[v];
+      if (shape.type != ShapeType::kConvexMesh || checked >= 5) continue;
+      const int k = j["bodies"][i]["visuals"][v]["mesh"];
+      HttpReply r = HttpGet(viewer_->GetPort(), Api("/api/mesh/" + std::to_string(k) + ".bin"));
+      ASSERT_EQ(r.status, 200);
+      ASSERT_GE(r.body.size(), 20u);
+      ASSERT_EQ(r.body.substr(0, 4), "PSMH");
+      uint32_t header[4];
+      std::memcpy(header, r.body.data() + 4, 16);
+      EXPECT_EQ(header[0], 1u);
+      EXPECT_EQ(header[1], shape.mesh->vertices.size());
+      EXPECT_EQ(header[2], 3 * shape.mesh->faces.size());
+      const size_t n = header[1];
+      const size_t floats = 3 * n + ((header[3] & 1) ? 3 * n : 0) + ((header[3] & 2) ? 2 * n : 0);
+      EXPECT_EQ(r.body.size(), 20 + 4 * (floats + header[2]));
+      // the first vertex as sent
+      float x;
+      std::memcpy(&x, r.body.data() + 20, 4);
+      EXPECT_EQ(x, shape.mesh->vertices[0].x());
+      ++checked;
+    }
+  EXPECT_GT(checked, 0);
+  EXPECT_EQ(HttpGet(viewer_->GetPort(), Api("/api/mesh/99999.bin")).status, 404);
+}
+
+TEST_F(ViewerTest, ApiNeedsTheToken) {
+  ViewerOptions o;
+  o.auth_token = "secret-token";
+  Viewer& v = Start(o);
+  EXPECT_EQ(v.GetToken(), "secret-token");
+  EXPECT_NE(v.GetUrl().find("?token=secret-token"), std::string::npos);
+  EXPECT_EQ(HttpGet(v.GetPort(), "/api/scene.json").status, 403);
+  EXPECT_EQ(HttpGet(v.GetPort(), "/api/scene.json?token=wrong").status, 403);
+  EXPECT_EQ(HttpGet(v.GetPort(), "/api/mesh/0.bin").status, 403);
+  EXPECT_EQ(HttpGet(v.GetPort(), "/api/scene.json?token=secret-token").status, 200);
+  EXPECT_EQ(HttpGet(v.GetPort(), "/api/scene.json", "X-Partsim-Token: secret-token\r\n").status,
+            200);
+  // a random token when none is given
+  Viewer other(scene_.get());
+  EXPECT_EQ(other.GetToken().size(), 32u);
+  EXPECT_NE(other.GetToken(), Viewer(scene_.get()).GetToken());
+}
+
+TEST_F(ViewerTest, BundleServesItsFilesAndRefusesPathsOutOfIt) {
+  const fs::path web = dir_ / "web";
+  fs::create_directories(web / "assets");
+  std::ofstream(web / "index.html") << "<html>viewer page</html>";
+  std::ofstream(web / "assets" / "app.js") << "console.log(1)";
+  std::ofstream(web / ".hidden") << "no";
+  std::ofstream(dir_ / "secret.txt") << "outside the bundle";
+  ViewerOptions o;
+  o.web_root = web.string();
+  Viewer& v = Start(o);
+  HttpReply index = HttpGet(v.GetPort(), "/");
+  EXPECT_EQ(index.status, 200);
+  EXPECT_NE(index.body.find("viewer page"), std::string::npos);
+  EXPECT_EQ(HttpGet(v.GetPort(), "/assets/app.js").status, 200);
+  EXPECT_EQ(HttpGet(v.GetPort(), "/missing.js").status, 404);
+  for (const char* bad : {"/../secret.txt", "/assets/../../secret.txt", "/%2e%2e/secret.txt",
+                          "/.hidden", "//secret.txt", "/assets/..%2fsecret.txt"}) {
+    HttpReply r = HttpGet(v.GetPort(), bad);
+    EXPECT_EQ(r.status, 400) << bad;
+    EXPECT_EQ(r.body.find("outside the bundle"), std::string::npos) << bad;
+  }
+}
+
+TEST_F(ViewerTest, WithoutABundleTheIndexSaysHowToBuildIt) {
+  ViewerOptions o;
+  o.web_root = (dir_ / "no_such_folder").string();
+  Viewer& v = Start(o);
+  HttpReply r = HttpGet(v.GetPort(), "/");
+  EXPECT_EQ(r.status, 200);
+  EXPECT_NE(r.body.find("scripts/build_web.sh"), std::string::npos);
+}
+
+TEST_F(ViewerTest, PagesOfOtherOriginsAreRefused) {
+  Viewer& v = Start();
+  EXPECT_EQ(HttpGet(v.GetPort(), Api("/api/scene.json"), "Origin: http://evil.example\r\n").status,
+            403);
+  EXPECT_EQ(
+      HttpGet(v.GetPort(), Api("/api/scene.json"), "Origin: http://localhost:5173\r\n").status,
+      200);
+  TestClient evil(v.GetPort(), "http://evil.example");
+  EXPECT_FALSE(evil.WaitOpen());
+  TestClient local(v.GetPort(), "http://127.0.0.1:8000");
+  EXPECT_TRUE(local.WaitOpen());
+}
+
+TEST_F(ViewerTest, WebSocketNeedsTheTokenFirst) {
+  Viewer& v = Start();
+  TestClient c(v.GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "subscribe"}, {"topic", "/partsim/poses"}, {"id", "s"}});
+  json e = c.WaitReply("s");
+  EXPECT_EQ(e["level"], "error");
+  EXPECT_NE(e["msg"].get<std::string>().find("authenticate first"), std::string::npos);
+  TestClient wrong(v.GetPort());
+  ASSERT_TRUE(wrong.WaitOpen());
+  wrong.Send(json{{"op", "auth"}, {"mac", "not-the-token"}});
+  EXPECT_TRUE(WaitFor([&] { return wrong.Closed(); }));
+  c.Auth(v.GetToken());
+}
+
+TEST_F(ViewerTest, PosesComeAllFirstThenOnlyWhatMoved) {
+  ViewerOptions o;
+  o.max_rate = 1000;  // a snapshot at every Render: the test counts messages, not time
+  Viewer& v = Start(o);
+  TestClient c(v.GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Auth(v.GetToken());
+  c.Send(json{{"op", "subscribe"}, {"topic", "/partsim/poses"}});
+  const size_t n = GetVisualBodies(*scene_).size();
+  json first =
+      c.WaitMessage([](const json& m) { return m.value("topic", "") == "/partsim/poses"; });
+  ASSERT_FALSE(first.is_null());
+  EXPECT_EQ(first["msg"]["ids"].size(), n);
+  EXPECT_EQ(first["msg"]["poses"].size(), 7 * n);
+  c.Clear();
+  // the box falls; the ground and the cabinet's fixed root stay
+  for (int i = 0; i < 50; ++i) {
+    scene_->Step();
+    v.Render();
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE(WaitFor([&] { return c.Messages().size() >= 10; }));
+  const int box_body = 1;  // actors come first: the ground, then the box
+  for (const json& m : c.Messages()) {
+    ASSERT_EQ(m["topic"], "/partsim/poses");
+    const auto ids = m["msg"]["ids"].get<std::vector<int>>();
+    EXPECT_LT(ids.size(), n);
+    EXPECT_EQ(std::count(ids.begin(), ids.end(), 0), 0) << "the ground never moves";
+    EXPECT_EQ(std::count(ids.begin(), ids.end(), box_body), 1) << "the falling box always does";
+  }
+  const json last = c.Messages().back()["msg"];
+  const std::vector<double> poses = last["poses"];
+  const auto ids = last["ids"].get<std::vector<int>>();
+  const size_t at = std::find(ids.begin(), ids.end(), box_body) - ids.begin();
+  EXPECT_NEAR(poses[7 * at + 2], box_.GetPose().p.z(), 1e-5);
+}
+
+TEST_F(ViewerTest, SetJointTargetDrivesTheJoint) {
+  Viewer& v = Start();
+  TestClient c(v.GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Auth(v.GetToken());
+  const Joint joint = MovableJoint();
+  const double target = 0.5 * (joint.GetLimits()[0] + joint.GetLimits()[1]);
+  c.Send(Call("/partsim/set_joint_target",
+              {{"articulation", 0}, {"joint", joint.GetName()}, {"position", target}}, "t"));
+  // synchronous mode: the answer comes once Render has applied it
+  json reply;
+  for (int i = 0; i < 500 && reply.is_null(); ++i) {
+    v.Render();
+    for (const json& m : c.Messages())
+      if (m.value("id", "") == "t") reply = m;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_FALSE(reply.is_null());
+  EXPECT_TRUE(reply["result"].get<bool>()) << reply;
+  EXPECT_TRUE(reply["values"]["success"].get<bool>());
+  EXPECT_GT(joint.GetDriveStiffness(), 0);
+  EXPECT_DOUBLE_EQ(joint.GetDriveTarget(), target);
+  for (int i = 0; i < 1500; ++i) {
+    scene_->Step();
+    v.Render();
+  }
+  EXPECT_NEAR(joint.GetQpos(), target, 0.05 * (joint.GetLimits()[1] - joint.GetLimits()[0]));
+}
+
+TEST_F(ViewerTest, PauseBlocksRenderUntilResumedOrStepped) {
+  Viewer& v = Start();
+  TestClient c(v.GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Auth(v.GetToken());
+  c.Send(Call("/partsim/pause", json::object(), "p"));
+  ASSERT_TRUE(c.WaitReply("p")["result"].get<bool>());
+  EXPECT_TRUE(v.IsPaused());
+  // the scene's thread: SAPIEN's loop, counting the Render calls that returned
+  std::atomic<int> returned{0};
+  std::atomic<bool> stop{false};
+  std::thread loop([&] {
+    while (!stop && !v.IsClosed()) {
+      if (!v.Render(0.05)) continue;  // still paused after 50 ms
+      ++returned;
+      scene_->Step();
+    }
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(returned, 0) << "Render returned while paused";
+  c.Send(Call("/partsim/step", {{"n", 3}}, "s"));
+  ASSERT_FALSE(c.WaitReply("s").is_null());
+  EXPECT_TRUE(WaitFor([&] { return returned >= 3; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(returned, 3) << "step {n: 3} returns exactly 3 times";
+  c.Send(Call("/partsim/resume", json::object(), "r"));
+  EXPECT_TRUE(WaitFor([&] { return returned > 50; }));
+  EXPECT_FALSE(v.IsPaused());
+  c.Send(Call("/partsim/close", json::object(), "c"));
+  EXPECT_TRUE(WaitFor([&] { return v.IsClosed(); }));
+  stop = true;
+  loop.join();
+}
+
+TEST_F(ViewerTest, CameraServiceAnswersAPngThatDecodes) {
+  Camera cam = scene_->AddCamera("front", 64, 48, 1.0, 0.05, 20.0);
+  cam.SetLocalPose(CameraLookAt(Eigen::Vector3d(2, -2, 1.5), Eigen::Vector3d(0, 0, 0.4)));
+  Viewer& v = Start();
+  EXPECT_EQ(SceneJson()["cameras"][0]["name"], "front");
+  TestClient c(v.GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Auth(v.GetToken());
+  int k = 0;
+  for (const char* picture : {"Color", "Depth", "Segmentation"}) {
+    const std::string id = "cam" + std::to_string(k++);
+    c.Send(Call("/partsim/camera", {{"name", "front"}, {"picture", picture}}, id));
+    json reply;
+    for (int i = 0; i < 1000 && reply.is_null(); ++i) {
+      v.Render();
+      for (const json& m : c.Messages())
+        if (m.value("id", "") == id) reply = m;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_FALSE(reply.is_null()) << picture;
+    ASSERT_TRUE(reply["result"].get<bool>()) << reply;
+    const fs::path png = dir_ / (id + ".png");
+    std::ofstream(png, std::ios::binary) << Base64Decode(reply["values"]["png"]);
+    int w = 0, h = 0;
+    const std::vector<uint8_t> rgb = ReadPng(png.string(), 3, &w, &h);
+    EXPECT_EQ(w, 64);
+    EXPECT_EQ(h, 48);
+    int lit = 0;
+    for (uint8_t b : rgb) lit += b > 0;
+    EXPECT_GT(lit, 100) << picture << ": the cabinet is in view";
+  }
+  c.Send(Call("/partsim/camera", {{"name", "nope"}}, "bad"));
+  json bad;
+  for (int i = 0; i < 200 && bad.is_null(); ++i) {
+    v.Render();
+    for (const json& m : c.Messages())
+      if (m.value("id", "") == "bad") bad = m;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_FALSE(bad.is_null());
+  EXPECT_FALSE(bad["result"].get<bool>());
+  EXPECT_NE(bad["values"].get<std::string>().find("no camera 'nope' (cameras: front)"),
+            std::string::npos);
+}
+
+TEST_F(ViewerTest, BadMessagesGetErrorsAndTheViewerGoesOn) {
+  ViewerOptions o;
+  o.max_message_bytes = 4096;
+  Viewer& v = Start(o);
+  TestClient c(v.GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Auth(v.GetToken());
+  const Joint joint = MovableJoint();
+  struct Case {
+    std::string text, words;
+  };
+  const std::vector<Case> cases = {
+      {"{not json", "malformed JSON"},
+      {"[1, 2]", "no 'op'"},
+      {R"({"op": "explode", "id": "x"})", "unknown op 'explode'"},
+      {R"({"op": "publish", "topic": "/x", "msg": {}})", "not supported"},
+      {R"({"op": "subscribe", "topic": 5})", "string 'topic'"},
+      {R"({"op": "subscribe", "topic": "/tf"})", "no topic '/tf'"},
+      {R"({"op": "call_service", "service": "/nope"})", "no service '/nope'"},
+      {R"({"op": "call_service", "service": "/partsim/step", "args": {"n": -3}})",
+       "n must be an integer"},
+      {R"({"op": "call_service", "service": "/partsim/set_joint_target", "args": {"articulation": 0, "joint": ")" +
+           joint.GetName() + R"(", "position": "nan"}})",
+       "number 'position'"},
+      {R"({"op": "call_service", "service": "/partsim/set_joint_target", "args": {"articulation": 0, "joint": ")" +
+           joint.GetName() + R"(", "position": 1e999}})",
+       "number overflow"},
+      {R"({"op": "call_service", "service": "/partsim/set_joint_target", "args": {"articulation": "a", "joint": "j", "position": 0}})",
+       "integer 'articulation'"},
+      {R"({"op": "call_service", "service": "/partsim/camera", "args": {"name": "front", "picture": "Infrared"}})",
+       "picture must be"},
+      {R"({"op": "call_service", "service": "/partsim/pause", "args": [1]})",
+       "args must be an object"},
+  };
+  for (const Case& k : cases) {
+    c.Clear();
+    c.Send(k.text);
+    const json e = c.WaitMessage([](const json& m) {
+      return m.value("level", "") == "error" || m.value("result", true) == false;
+    });
+    ASSERT_FALSE(e.is_null()) << k.text;
+    const std::string what = e.contains("msg") ? e["msg"].get<std::string>() : e["values"].dump();
+    EXPECT_NE(what.find(k.words), std::string::npos) << k.text << " -> " << what;
+  }
+  // an unknown joint fails when applied, naming the joints there are
+  c.Clear();
+  c.Send(Call("/partsim/set_joint_target",
+              {{"articulation", 0}, {"joint", "no_such_joint"}, {"position", 0}}, "j"));
+  json reply;
+  for (int i = 0; i < 500 && reply.is_null(); ++i) {
+    v.Render();
+    for (const json& m : c.Messages())
+      if (m.value("id", "") == "j") reply = m;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_FALSE(reply.is_null());
+  EXPECT_FALSE(reply["result"].get<bool>());
+  EXPECT_NE(reply["values"].get<std::string>().find("no joint 'no_such_joint'"), std::string::npos);
+  EXPECT_NE(reply["values"].get<std::string>().find(joint.GetName()), std::string::npos);
+  // a message over the bound closes that connection only
+  c.Send(std::string(8192, ' ') + "{}");
+  EXPECT_TRUE(WaitFor([&] { return c.Closed(); }));
+  EXPECT_EQ(c.CloseCode(), 1009);
+  TestClient after(v.GetPort());
+  ASSERT_TRUE(after.WaitOpen());
+  after.Auth(v.GetToken());
+  EXPECT_EQ(HttpGet(v.GetPort(), Api("/api/scene.json")).status, 200);
+  EXPECT_GT(v.GetStats().errors, 10);
+}
+
+TEST_F(ViewerTest, ServedModeFollowsTheSimServer) {
+  SimServerOptions so;
+  so.fast = false;
+  SimServer sim(scene_.get(), nullptr, so);
+  auto viewer = std::make_unique<Viewer>(scene_.get());
+  viewer->Attach(&sim);
+  viewer->Start();
+  EXPECT_THROW(viewer->Render(), Error);
+  sim.Start();
+  {
+    TestClient c(viewer->GetPort());
+    ASSERT_TRUE(c.WaitOpen());
+    c.Auth(viewer->GetToken());
+    c.Send(json{{"op", "subscribe"}, {"topic", "/partsim/joint_states"}});
+    c.Send(json{{"op", "subscribe"}, {"topic", "/partsim/status"}});
+    const Joint joint = MovableJoint();
+    const double target = joint.GetLimits()[1];
+    c.Send(Call("/partsim/set_joint_target",
+                {{"articulation", 0}, {"joint", joint.GetName()}, {"position", target}}, "t"));
+    ASSERT_TRUE(c.WaitReply("t")["result"].get<bool>());
+    // the joint's position as the page reads it
+    const int dof = joint.GetDofIndex();
+    const double span = joint.GetLimits()[1] - joint.GetLimits()[0];
+    EXPECT_FALSE(c.WaitMessage([&](const json& m) {
+                    return m.value("topic", "") == "/partsim/joint_states" &&
+                           std::abs(m["msg"]["position"][dof].get<double>() - target) < 0.1 * span;
+                  }).is_null());
+    c.Send(Call("/partsim/pause", json::object(), "p"));
+    ASSERT_FALSE(c.WaitReply("p").is_null());
+    EXPECT_TRUE(sim.IsPaused());
+    EXPECT_TRUE(viewer->IsPaused());
+    EXPECT_FALSE(c.WaitMessage([](const json& m) {
+                    return m.value("topic", "") == "/partsim/status" && m["msg"]["paused"] == true;
+                  }).is_null());
+    const long long steps = sim.GetClockSteps();
+    c.Send(Call("/partsim/step", {{"n", 7}}, "s"));
+    ASSERT_FALSE(c.WaitReply("s").is_null());
+    EXPECT_TRUE(WaitFor([&] { return sim.GetClockSteps() == steps + 7; }));
+  }
+  sim.Stop();
+  viewer->Stop();
+  EXPECT_TRUE(viewer->IsClosed());
+}
+
+}  // namespace
+}  // namespace partsim
