@@ -5,6 +5,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { Connection } from './connection.js';
 import { SceneModel } from './scene.js';
 import { Panels } from './panels.js';
+import { Gallery } from './gallery.js';
 
 THREE.Object3D.DEFAULT_UP.set(0, 0, 1); // partsim's world is z-up
 
@@ -81,10 +82,16 @@ class Viewer {
     this.lastFrame = 0;
     this.frames = 0;
     this.closed = false;
-    this.reloading = false;
+    this.loading = false;       // scene.json and its meshes are being (re)loaded
+    this.reloadAgain = false;   // a newer scene_version was seen while loading
+    this.latestVersion = null;  // the newest scene_version heard of (status, poses)
+    this.stashed = null;        // pose messages of a scene not loaded yet: {version, poses, messages}
+    this.reframe = false;       // frame the camera on the next scene loaded (a new object)
+    this.gridShown = false;     // the gallery's grid covers the viewer
     this.firstPosesApplied = false;
 
     this.panels = new Panels(this);
+    this.gallery = new Gallery(this);
     this.ready = new Promise((resolve, reject) => {
       this.resolveReady = resolve;
       this.rejectReady = reject;
@@ -99,6 +106,11 @@ class Viewer {
       this.connection.on('close', () => {
         if (!this.closed) this.panels.message('The connection to partsim was lost (the simulation ended?).');
       });
+      try {
+        await this.gallery.load();
+      } catch (e) {
+        this.panels.message(`Cannot load the gallery: ${e.message}`);
+      }
       await this.loadScene(true);
       this.connection.subscribe('/partsim/poses', 'partsim/Poses', (m) => this.onPoses(m));
       this.connection.subscribe('/partsim/joint_states', 'sensor_msgs/JointState', (m) => this.onJointStates(m));
@@ -114,15 +126,91 @@ class Viewer {
   }
 
   async loadScene(first) {
-    const desc = await this.model.load();
-    const n = this.model.bodies.length;
-    this.pending = new Float64Array(7 * n);
-    this.dirty = new Uint8Array(n);
-    this.dirtyIds = [];
-    this.buildGrid();
-    if (first) this.initialCamera(desc);
-    this.panels.sceneLoaded();
-    this.panels.reapplyToggles();
+    this.loading = true;
+    try {
+      const before = this.model.desc ? this.model.bodies.map((b) => (b ? b.desc.name : null)) : [];
+      const fresh = first || this.reframe || this.model.bodies.length === 0;
+      this.reframe = false;
+      const desc = await this.model.load();
+      const n = this.model.bodies.length;
+      this.pending = new Float64Array(7 * n);
+      this.dirty = new Uint8Array(n);
+      this.dirtyIds = [];
+      this.pendingMessages = [];
+      // joint positions as of the snapshot (joint_states then only say what moved)
+      this.jointStates.clear();
+      for (const a of desc.articulations || []) {
+        const map = new Map();
+        for (const j of a.joints || []) if (typeof j.position === 'number') map.set(j.name, j.position);
+        this.jointStates.set(a.id, map);
+      }
+      this.contacts?.update({});
+      this.buildGrid();
+      if (fresh && (first || n > 0)) this.initialCamera(desc);
+      this.panels.sceneLoaded(fresh ? null : before);
+      this.panels.reapplyToggles();
+      this.replayStashed();
+    } finally {
+      this.loading = false;
+    }
+    if (this.reloadAgain) {
+      this.reloadAgain = false;
+      if (this.latestVersion !== null && this.latestVersion !== this.model.desc?.scene_version) this.requestReload();
+    }
+  }
+
+  /** Reloads scene.json (after a scene_version change); one load at a time. */
+  requestReload() {
+    if (this.loading) {
+      this.reloadAgain = true;
+      return;
+    }
+    this.loadScene(false).catch((e) => this.panels.message(`Cannot reload the scene: ${e.message}`));
+  }
+
+  /** The gallery opens an object: a new scene is coming (camera framed, panels reset). */
+  expectNewScene() {
+    this.reframe = true;
+    this.panels.select(null);
+  }
+
+  /** The gallery's grid covers the page (true) or the viewer shows (false). */
+  galleryShown(on) {
+    this.gridShown = on;
+    document.body.classList.toggle('gallery-shown', on);
+    if (on) this.panels.select(null);
+  }
+
+  noteVersion(v) {
+    if (typeof v === 'number') this.latestVersion = v; // messages arrive in order on one socket
+  }
+
+  /** Keeps pose messages of a scene_version not loaded yet, merged per body. */
+  stashPoses(m, received) {
+    const v = m.scene_version;
+    if (!this.stashed || this.stashed.version !== v) this.stashed = { version: v, poses: new Map(), messages: [] };
+    const ids = m.ids || [];
+    const poses = m.poses || [];
+    for (let i = 0; i < ids.length; ++i) this.stashed.poses.set(ids[i], poses.slice(7 * i, 7 * i + 7));
+    this.stashed.messages.push({ step: m.step, time: m.time, received });
+    if (this.stashed.messages.length > DRAW_LOG_SIZE) this.stashed.messages.shift();
+  }
+
+  replayStashed() {
+    const s = this.stashed;
+    this.stashed = null;
+    if (!s || !this.model.desc || s.version !== this.model.desc.scene_version) return;
+    for (const [id, pose] of s.poses) this.setPending(id, pose, 0);
+    this.pendingMessages.push(...s.messages);
+  }
+
+  setPending(id, poses, offset) {
+    if (id < 0 || id >= this.dirty.length) return;
+    for (let k = 0; k < 7; ++k) this.pending[7 * id + k] = poses[offset + k];
+    if (!this.dirty[id]) {
+      this.dirty[id] = 1;
+      this.dirtyIds.push(id);
+    }
   }
 
   buildGrid() {
@@ -188,23 +276,25 @@ class Viewer {
 
   onPoses(m) {
     const received = now();
+    const v = m.scene_version;
+    this.noteVersion(v);
+    const current = this.model.desc ? this.model.desc.scene_version : undefined;
+    if (this.loading || (typeof v === 'number' && current !== undefined && v !== current)) {
+      // poses of a scene not loaded yet: applied once it is (its bodies' ids differ)
+      this.stashPoses(m, received);
+      if (!this.loading) this.requestReload();
+      return;
+    }
     const ids = m.ids || [];
     const poses = m.poses || [];
-    for (let i = 0; i < ids.length; ++i) {
-      const id = ids[i];
-      if (id < 0 || id >= this.dirty.length) continue;
-      for (let k = 0; k < 7; ++k) this.pending[7 * id + k] = poses[7 * i + k];
-      if (!this.dirty[id]) {
-        this.dirty[id] = 1;
-        this.dirtyIds.push(id);
-      }
-    }
+    for (let i = 0; i < ids.length; ++i) this.setPending(ids[i], poses, 7 * i);
     this.pendingMessages.push({ step: m.step, time: m.time, received });
     this.poseMessages += 1;
     this.lastPose = { step: m.step, time: m.time, count: ids.length, received };
   }
 
   onJointStates(m) {
+    if (this.loading) return; // the reloaded scene.json holds the positions
     let map = this.jointStates.get(m.articulation);
     if (!map) {
       map = new Map();
@@ -222,12 +312,10 @@ class Viewer {
       this.closed = true;
       this.panels.message('The viewer was closed.');
     }
-    if (this.model.desc && m.scene_version !== undefined &&
-        m.scene_version !== this.model.desc.scene_version && !this.reloading) {
-      this.reloading = true;
-      this.loadScene(false)
-        .catch((e) => this.panels.message(`Cannot reload the scene: ${e.message}`))
-        .finally(() => { this.reloading = false; });
+    this.noteVersion(m.scene_version);
+    if (this.model.desc && typeof m.scene_version === 'number' &&
+        m.scene_version !== this.model.desc.scene_version) {
+      this.requestReload();
     }
   }
 
@@ -263,7 +351,7 @@ class Viewer {
     this.pendingMessages = [];
 
     this.controls.update();
-    this.renderer.render(this.scene, this.camera);
+    if (!this.gridShown) this.renderer.render(this.scene, this.camera);
 
     if (drawn.length) {
       const at = now();
@@ -331,11 +419,25 @@ class Viewer {
         bodies: () => this.model.bodies.filter(Boolean).map((b) => ({
           id: b.desc.id, name: b.desc.name, label: b.desc.label || '', kind: b.desc.kind,
           articulation: b.desc.articulation, joint: b.joint ? b.joint.name : null,
+          visuals: b.visuals.length,
         })),
+        // each body's drawn pose [x, y, z, qw, qx, qy, qz] (what the last frame applied)
+        bodyPoses: () => this.model.bodies.filter(Boolean).map((b) => {
+          const p = b.group.position;
+          const q = b.group.quaternion;
+          return { id: b.desc.id, name: b.desc.name, pose: [p.x, p.y, p.z, q.w, q.x, q.y, q.z] };
+        }),
+        // three.js meshes under the scene's bodies (visuals and overlays): none left over after a reload
+        meshCount: () => {
+          let n = 0;
+          this.model.root.traverse((o) => { if (o.isMesh) n += 1; });
+          return n;
+        },
         jointPositions: (articulation) => Object.fromEntries(this.jointStates.get(articulation) || []),
         drawLog: () => this.drawLog.slice(),
         clearDrawLog: () => { this.drawLog.length = 0; },
         background: () => this.background.getHexString(),
+        ...this.gallery.api(),
         // for experiments from the console: the three.js objects
         internals: () => ({ scene: this.scene, renderer: this.renderer, camera: this.camera, model: this.model }),
       };

@@ -111,9 +111,14 @@ export class Panels {
     return Math.min(Math.max(extent * 0.08, 0.03), 0.5);
   }
 
-  sceneLoaded() {
+  /**
+   * After a (re)load. `before`: the previous scene's body names, or null for a new scene (the
+   * selection is dropped); the selection is kept only when its id names the same body.
+   */
+  sceneLoaded(before = null) {
     const model = this.viewer.model;
     const select = $('camera-name');
+    const previousCamera = select.value;
     select.textContent = '';
     for (const c of model.cameras) {
       const o = document.createElement('option');
@@ -121,9 +126,24 @@ export class Panels {
       o.textContent = `${c.name} (${c.width}×${c.height})`;
       select.appendChild(o);
     }
+    if (model.cameras.some((c) => c.name === previousCamera)) select.value = previousCamera;
     $('tg-cameras').disabled = model.cameras.length === 0;
-    if (this.selected !== null && !model.bodies[this.selected]) this.select(null);
-    else if (this.selected !== null) this.select(this.selected);
+    $('camera-image').removeAttribute('src');
+    $('camera-note').textContent = '';
+    if (model.cameras.length === 0 && this.toggled('cameras')) this.setToggle('cameras', false);
+    else if (this.toggled('cameras')) this.refreshCamera(true);
+
+    // sliders are rebuilt for the new joints (limits, names)
+    this.sliderArticulation = null;
+    this.sliders.clear();
+    $('joint-sliders').textContent = '';
+    $('joints').hidden = true;
+    const id = this.selected;
+    const body = id === null ? null : model.bodies[id];
+    const same = body && before && before[id] === body.desc.name;
+    this.selected = null; // the old body's highlight went with its material
+    if (same) this.select(id);
+    else this.select(null);
   }
 
   pick(x, y) {
@@ -274,6 +294,11 @@ export class Panels {
     $('ro-time').textContent = fmt(s.time, 3);
     $('ro-step').textContent = String(s.step ?? '–');
     $('ro-paused').textContent = s.paused ? '(paused)' : '';
+    // the simulation's state as partsim says it (a step while running pauses first)
+    const state = $('sim-state');
+    state.textContent = s.closed ? 'closed' : s.paused ? 'paused' : 'running';
+    state.classList.toggle('paused', !!s.paused || !!s.closed);
+    $('btn-pause').classList.toggle('active', !!s.paused);
   }
 
   frame(t) {

@@ -130,16 +130,21 @@ export class SceneModel {
     this.pickable.push(mesh);
   }
 
+  /** Removes every body and frees what it held on the GPU (geometries, materials, textures). */
   clear() {
-    for (const body of this.bodies) {
-      if (!body) continue;
-      body.group.traverse((o) => {
-        if (o.isMesh) {
-          o.userData.segMaterial?.dispose();
-          o.userData.material?.dispose();
-        }
-      });
-    }
+    const geometries = new Set();
+    const materials = new Set();
+    this.root.traverse((o) => {
+      if (o.geometry) geometries.add(o.geometry);
+      for (const m of [o.material, o.userData.material, o.userData.segMaterial].flat()) {
+        if (m) materials.add(m);
+      }
+    });
+    for (const m of materials) m.dispose();
+    for (const g of geometries) g.dispose();
+    // meshes and textures still loading are freed when they arrive
+    for (const p of this.meshCache.values()) p.then((g) => g.dispose(), () => {});
+    for (const p of this.textureCache.values()) p.then((t) => { t.dispose(); t.image?.close?.(); }, () => {});
     this.root.clear();
     this.bodies = [];
     this.pickable = [];
@@ -157,10 +162,20 @@ export class SceneModel {
     }
   }
 
+  /**
+   * World bounds of what the camera should frame: the bodies that can move (links, dynamic and
+   * kinematic actors); static actors (a ground plane, a table) count only when nothing else has
+   * a visual.
+   */
   bounds() {
     const box = new THREE.Box3();
     this.root.updateMatrixWorld(true);
-    for (const m of this.pickable) box.expandByObject(m);
+    const isStatic = (m) => {
+      const d = this.bodies[m.userData.bodyId]?.desc;
+      return d && d.kind === 'actor' && d.actor_type === 'static';
+    };
+    const moving = this.pickable.filter((m) => !isStatic(m));
+    for (const m of moving.length ? moving : this.pickable) box.expandByObject(m);
     if (box.isEmpty()) box.set(new THREE.Vector3(-0.5, -0.5, 0), new THREE.Vector3(0.5, 0.5, 1));
     return box;
   }
