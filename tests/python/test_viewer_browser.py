@@ -16,66 +16,30 @@ degrees or centimetres, a wrong axis convention or a missing part.
 PARTSIM_UPDATE_SCREENSHOT=1 copies the page's screenshot to docs/images/viewer.png.
 """
 
-import json
 import os
 import queue
 import shutil
 import subprocess
 import sys
-import threading
 import time
 
 import numpy as np
 import pytest
 
-
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "tests", "web"))
+
+from browser_session import WEB_ROOT, Lines, require_page, run_page_check, stop  # noqa: E402
+
 PYTHON_DIR = os.environ.get("PARTSIM_PYTHON_DIR", os.path.join(REPO, "build", "python"))
 SCRIPT = os.path.join(REPO, "tests", "web", "cabinet_viewer.py")
 CHECK = os.path.join(REPO, "tests", "web", "viewer_check.mjs")
-WEB_ROOT = os.path.join(REPO, "build", "web")
 IOU_THRESHOLD = 0.8
-
-
-class _Lines:
-    """Reads a process's standard output lines on a thread, JSON-decoded where possible."""
-
-    def __init__(self, proc):
-        self.q = queue.Queue()
-        self.all = []
-        self.thread = threading.Thread(target=self._read, args=(proc,), daemon=True)
-        self.thread.start()
-
-    def _read(self, proc):
-        for line in proc.stdout:
-            try:
-                obj = json.loads(line)
-            except ValueError:
-                obj = {"text": line.rstrip("\n")}
-            self.all.append(obj)
-            self.q.put(obj)
-        self.q.put(None)
-
-    def next(self, timeout):
-        return self.q.get(timeout=timeout)
-
-
-def _stop(proc):
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(timeout=10)
 
 
 @pytest.fixture(scope="module")
 def session(tmp_path_factory):
-    if not shutil.which("node"):
-        pytest.fail("node is not installed (scripts/setup.sh installs it)")
-    if not os.path.isfile(os.path.join(WEB_ROOT, "index.html")):
-        pytest.fail("build/web is missing: run bash scripts/build_web.sh")
+    require_page()
     out = str(tmp_path_factory.mktemp("viewer_browser"))
     env = dict(os.environ, PARTSIM_PYTHON_DIR=PYTHON_DIR, PARTSIM_WEB_DIR=WEB_ROOT)
     err_path = os.path.join(out, "loop_stderr.txt")
@@ -90,37 +54,29 @@ def session(tmp_path_factory):
             return f.read()[-3000:]
 
     try:
-        lines = _Lines(loop)
+        lines = Lines(loop)
         try:
             first = lines.next(timeout=90)
         except queue.Empty:
             pytest.fail("the viewer loop printed nothing in 90 s")
         if first is None or "url" not in first:
-            _stop(loop)
+            stop(loop)
             pytest.fail(f"the viewer loop failed: {first} {loop_stderr()}")
         config = {"url": first["url"], "camera": first["camera"], "out": out, "timeout_ms": 180000}
-        check = subprocess.run(["node", CHECK, json.dumps(config)], capture_output=True, text=True,
-                               timeout=240, cwd=REPO)
-        try:
-            page = json.loads(check.stdout.strip().splitlines()[-1])
-        except (ValueError, IndexError):
-            pytest.fail(f"viewer_check.mjs printed no JSON (rc {check.returncode}): "
-                        f"{check.stdout[-2000:]} {check.stderr[-3000:]}")
-        if check.returncode == 2 and page.get("skip"):
-            pytest.skip(f"Chromium cannot start: {page['skip']}")
+        returncode, page = run_page_check(CHECK, config, timeout=240)
         # the close button ends the loop; its last line says so
         deadline = time.time() + 30
         while loop.poll() is None and time.time() < deadline:
             time.sleep(0.1)
-        _stop(loop)
+        stop(loop)
         lines.thread.join(timeout=10)
-        if check.returncode != 0:
+        if returncode != 0:
             pytest.fail(f"the page check failed: {page.get('error')} (steps {page.get('steps')}; "
                         f"page errors {page.get('errors')}); loop stderr: "
                         f"{loop_stderr()}")
         return {"first": first, "page": page, "lines": lines.all, "out": out}
     finally:
-        _stop(loop)
+        stop(loop)
         err.close()
 
 

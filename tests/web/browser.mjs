@@ -71,33 +71,67 @@ export async function launch({ width = 1024, height = 768 } = {}) {
   }
 }
 
-/** Opens the viewer page; collects console errors and page errors into `errors`. */
-export async function openViewer(browser, url, { timeoutMs = 60000 } = {}) {
+/**
+ * Whether a URL is the page's gallery probe: the page asks /api/gallery.json once at start, and
+ * a 404 there is the documented answer of a viewer without a gallery (docs/viewer.md), not an
+ * error. The browser still logs it ("Failed to load resource"), so the helpers set it apart.
+ */
+export function isGalleryProbe(url) {
+  try {
+    return new URL(url).pathname === '/api/gallery.json';
+  } catch {
+    return false;
+  }
+}
+
+/**
+ * Opens the viewer page; collects console errors, page errors, failed requests and HTTP errors
+ * into `errors` (the gallery probe's 404 goes to `probes` instead). `waitFor`: 'ready' (the
+ * viewer's scene drawn), 'gallery' (the gallery's grid built, or known absent) or 'none';
+ * `viewport`: {width, height} of the page before it loads (default: the browser's).
+ */
+export async function openViewer(browser, url, { timeoutMs = 60000, waitFor = 'ready', viewport = null } = {}) {
   const page = await browser.newPage();
+  if (viewport) await page.setViewport({ deviceScaleFactor: 1, ...viewport });
   const errors = [];
   const warnings = [];
+  const probes = [];
   page.on('console', (m) => {
-    if (m.type() === 'error') errors.push(m.text());
-    else if (m.type() === 'warn' || m.type() === 'warning') warnings.push(m.text());
+    if (m.type() === 'error') {
+      if (/status of 404/.test(m.text()) && isGalleryProbe(m.location()?.url || '')) probes.push(m.text());
+      else errors.push(m.text());
+    } else if (m.type() === 'warn' || m.type() === 'warning') warnings.push(m.text());
   });
   page.on('pageerror', (e) => errors.push(`page error: ${e.message}`));
   page.on('requestfailed', (r) => errors.push(`request failed: ${r.url()} ${r.failure()?.errorText}`));
   page.on('response', (r) => {
-    if (r.status() >= 400) errors.push(`HTTP ${r.status()}: ${r.url()}`);
+    if (r.status() === 404 && isGalleryProbe(r.url())) probes.push(`HTTP 404: ${r.url()}`);
+    else if (r.status() >= 400) errors.push(`HTTP ${r.status()}: ${r.url()}`);
   });
   page.setDefaultTimeout(timeoutMs);
   try {
     await page.goto(url, { waitUntil: 'load', timeout: timeoutMs });
     await page.waitForFunction(() => window.partsimViewer !== undefined, { timeout: timeoutMs });
-    await page.evaluate((ms) => Promise.race([
-    window.partsimViewer.ready.then(() => true),
-    new Promise((_, reject) => setTimeout(() => reject(new Error(`viewer not ready in ${ms} ms`)), ms)),
-  ]), timeoutMs);
+    if (waitFor !== 'none') {
+      await page.evaluate((ms, what) => Promise.race([
+        (what === 'gallery' ? window.partsimViewer.galleryReady : window.partsimViewer.ready).then(() => true),
+        new Promise((_, reject) => setTimeout(() => reject(new Error(`viewer's ${what} not within ${ms} ms`)), ms)),
+      ]), timeoutMs, waitFor);
+    }
   } catch (e) {
     e.message += errors.length ? ` (page errors: ${errors.join(' | ')})` : '';
     throw e;
   }
-  return { page, errors, warnings };
+  return { page, errors, warnings, probes };
+}
+
+/** Waits until `fn(arg)` is truthy in the page; the error names `what`. */
+export async function waitFor(page, fn, arg, timeoutMs, what) {
+  try {
+    return await page.waitForFunction(fn, { timeout: timeoutMs, polling: 100 }, arg);
+  } catch (e) {
+    throw new Error(`${what}: not within ${timeoutMs} ms`);
+  }
 }
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));

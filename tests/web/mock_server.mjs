@@ -1,9 +1,11 @@
 // A stand-in for partsim's viewer endpoint (docs/viewer.md) for working on the page without the
 // C++ server: build/web, a scene.json of a box cabinet with one drawer, PSMH meshes, and a
 // rosbridge v2 WebSocket with /partsim/poses, /partsim/joint_states, /partsim/status and the
-// services. Usage: node tests/web/mock_server.mjs [PORT] ; prints {"url": ...} and serves until
-// killed (or 10 minutes).
+// services. Usage: node tests/web/mock_server.mjs [PORT] [--gallery] ; prints {"url": ...} and
+// serves until killed (or 10 minutes). --gallery: a stand-in for `partsim view --dataset` (six
+// made-up objects with grey thumbnails, /api/gallery.json, /partsim/open, /partsim/gallery).
 import http from 'node:http';
+import zlib from 'node:zlib';
 import fs from 'node:fs';
 import path from 'node:path';
 import { createRequire } from 'node:module';
@@ -44,13 +46,55 @@ function boxMesh() {
 }
 const MESH = boxMesh();
 
-const state = { q: 0, target: 0, step: 0, time: 0, paused: false, stepsLeft: 0, closed: false };
+const galleryMode = process.argv.includes('--gallery');
+const port = Number(process.argv.slice(2).find((a) => /^\d+$/.test(a)) || 0);
+const state = { q: 0, target: 0, step: 0, time: 0, paused: false, stepsLeft: 0, closed: false,
+  version: 1, open: galleryMode ? null : 0 };
 function poses() {
+  if (state.open === null) return [];
   return [0, 0, 0.4, 1, 0, 0, 0, 0.2 + state.q, 0, 0.6, 1, 0, 0, 0];
 }
+const GALLERY = {
+  root: '/made/up/tree',
+  objects: ['StorageFurniture', 'StorageFurniture', 'Faucet', 'Faucet', 'Door', 'Door'].map((c, i) => ({
+    index: i, name: `${1000 + i}`, category: c, parts: 1 + (i % 2),
+    labels: c === 'Faucet' ? ['switch'] : c === 'Door' ? ['rotation_door'] : ['drawer', 'drawer'].slice(0, 1 + (i % 2)),
+    thumbnail: `/api/thumbnail/${i}.png`,
+  })),
+  categories: { StorageFurniture: 2, Faucet: 2, Door: 2 },
+  errors: [{ name: 'broken', error: 'no mobility.urdf' }],
+};
+function crc32(buf) {
+  let c, crc = 0xffffffff;
+  for (const b of buf) {
+    c = (crc ^ b) & 0xff;
+    for (let k = 0; k < 8; ++k) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+    crc = (crc >>> 8) ^ c;
+  }
+  return (crc ^ 0xffffffff) >>> 0;
+}
+function png(width, height, grey) {
+  const chunk = (type, data) => {
+    const len = Buffer.alloc(4); len.writeUInt32BE(data.length);
+    const td = Buffer.concat([Buffer.from(type, 'ascii'), data]);
+    const crc = Buffer.alloc(4); crc.writeUInt32BE(crc32(td));
+    return Buffer.concat([len, td, crc]);
+  };
+  const ihdr = Buffer.alloc(13);
+  ihdr.writeUInt32BE(width, 0); ihdr.writeUInt32BE(height, 4);
+  ihdr[8] = 8; ihdr[9] = 0; // 8-bit grey
+  const raw = Buffer.alloc((width + 1) * height, grey);
+  for (let y = 0; y < height; ++y) raw[y * (width + 1)] = 0;
+  return Buffer.concat([Buffer.from([137, 80, 78, 71, 13, 10, 26, 10]), chunk('IHDR', ihdr),
+    chunk('IDAT', zlib.deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]);
+}
 function sceneJson() {
+  if (state.open === null) {
+    return { scene_version: state.version, timestep: 0.002, up: [0, 0, 1], bodies: [], articulations: [],
+      cameras: [], poses: [], initial_camera: null };
+  }
   return {
-    scene_version: 1, timestep: 0.002, up: [0, 0, 1],
+    scene_version: state.version, timestep: 0.002, up: [0, 0, 1],
     bodies: [
       { id: 0, name: 'body', kind: 'link', articulation: 0, link_index: 0, label: 'furniture_body',
         seg_color: [0.2, 0.6, 0.9],
@@ -79,6 +123,17 @@ const server = http.createServer((req, res) => {
   if (url.pathname === '/api/scene.json') {
     res.writeHead(200, { 'Content-Type': 'application/json' }); res.end(JSON.stringify(sceneJson())); return;
   }
+  if (url.pathname === '/api/gallery.json') {
+    if (!galleryMode) { res.writeHead(404); res.end('not a gallery'); return; }
+    res.writeHead(200, { 'Content-Type': 'application/json' });
+    res.end(JSON.stringify({ ...GALLERY, open: state.open })); return;
+  }
+  const thumb = /^\/api\/thumbnail\/(\d+)\.png$/.exec(url.pathname);
+  if (galleryMode && thumb && Number(thumb[1]) < GALLERY.objects.length) {
+    // partsim renders them on its main thread: they come after a while
+    setTimeout(() => { res.writeHead(200, { 'Content-Type': 'image/png' }); res.end(png(160, 120, 90 + 20 * Number(thumb[1]))); }, 300);
+    return;
+  }
   if (/^\/api\/mesh\/0\.bin$/.test(url.pathname)) {
     res.writeHead(200, { 'Content-Type': 'application/octet-stream' }); res.end(MESH); return;
   }
@@ -103,7 +158,7 @@ wss.on('connection', (ws) => {
     }
     if (m.op === 'subscribe') {
       client.topics.add(m.topic);
-      if (m.topic === '/partsim/poses') send(client, '/partsim/poses', { step: state.step, time: state.time, ids: [0, 1], poses: poses() });
+      if (m.topic === '/partsim/poses') send(client, '/partsim/poses', { step: state.step, time: state.time, scene_version: state.version, ids: state.open === null ? [] : [0, 1], poses: poses() });
     } else if (m.op === 'unsubscribe') client.topics.delete(m.topic);
     else if (m.op === 'call_service') {
       const a = m.args || {};
@@ -112,6 +167,12 @@ wss.on('connection', (ws) => {
       else if (m.service === '/partsim/pause') state.paused = true;
       else if (m.service === '/partsim/resume') state.paused = false;
       else if (m.service === '/partsim/step') { state.stepsLeft = a.n || 1; state.paused = false; }
+      else if (galleryMode && m.service === '/partsim/open') {
+        if (Number.isInteger(a.index) && a.index >= 0 && a.index < GALLERY.objects.length) {
+          state.open = a.index; state.version += 1; state.q = 0; state.target = 0.3;
+          values = { success: true, message: GALLERY.objects[a.index].name };
+        } else values = { success: false, message: `index ${a.index} not in [0, ${GALLERY.objects.length})` };
+      } else if (galleryMode && m.service === '/partsim/gallery') { state.open = null; state.version += 1; }
       else if (m.service === '/partsim/reset') { state.q = 0; state.target = 0; }
       else if (m.service === '/partsim/close') state.closed = true;
       else if (m.service === '/partsim/camera') values = { png: PNG };
@@ -125,7 +186,7 @@ function send(client, topic, msg) {
 }
 function status() {
   for (const c of clients) send(c, '/partsim/status', { paused: state.paused, time: state.time, step: state.step,
-    steps_per_second: state.paused ? 0 : 500, realtime_factor: state.paused ? 0 : 1, scene_version: 1, closed: state.closed });
+    steps_per_second: state.paused ? 0 : 500, realtime_factor: state.paused ? 0 : 1, scene_version: state.version, closed: state.closed });
 }
 setInterval(() => {
   if (!state.paused) {
@@ -135,15 +196,15 @@ setInterval(() => {
       state.step += 1; state.time += 0.002;
     }
     if (state.stepsLeft > 0 && (state.stepsLeft -= 8) <= 0) { state.stepsLeft = 0; state.paused = true; }
-    const moved = Math.abs(state.q - before) > 1e-9;
+    const moved = Math.abs(state.q - before) > 1e-9 && state.open !== null;
     for (const c of clients) {
-      send(c, '/partsim/poses', { step: state.step, time: state.time, ids: moved ? [1] : [], poses: moved ? poses().slice(7) : [] });
+      send(c, '/partsim/poses', { step: state.step, time: state.time, scene_version: state.version, ids: moved ? [1] : [], poses: moved ? poses().slice(7) : [] });
       if (moved) send(c, '/partsim/joint_states', { articulation: 0, name: ['drawer_0_joint'], position: [state.q], velocity: [0] });
     }
   }
 }, 16);
 setInterval(status, 250);
 setTimeout(() => process.exit(0), 600000);
-server.listen(Number(process.argv[2] || 0), '127.0.0.1', () => {
+server.listen(port, '127.0.0.1', () => {
   console.log(JSON.stringify({ url: `http://127.0.0.1:${server.address().port}/?token=${token}` }));
 });

@@ -6,7 +6,7 @@
 // Exit code 0 with {"ok": true, ...}; 2 with {"skip": reason} when Chromium cannot start; 1 with
 // {"error": ...} otherwise.
 import path from 'node:path';
-import { launch, openViewer, finish, sleep } from './browser.mjs';
+import { launch, openViewer, finish, sleep, waitFor } from './browser.mjs';
 
 const config = JSON.parse(process.argv[2]);
 const result = { ok: false, steps: [] };
@@ -18,14 +18,6 @@ const watchdog = setTimeout(async () => {
   try { await browser?.close(); } catch { /* exiting anyway */ }
   finish(result, 1);
 }, config.timeout_ms || 180000);
-
-async function waitFor(page, fn, arg, timeoutMs, what) {
-  try {
-    return await page.waitForFunction(fn, { timeout: timeoutMs, polling: 100 }, arg);
-  } catch (e) {
-    throw new Error(`${what}: not within ${timeoutMs} ms`);
-  }
-}
 
 async function main() {
   const cam = config.camera;
@@ -41,11 +33,23 @@ async function main() {
     throw e;
   }
   note('launched');
-  const { page, errors, warnings } = await openViewer(browser, config.url);
+  const { page, errors, warnings, probes } = await openViewer(browser, config.url);
   result.errors = errors;
   result.warnings = warnings;
+  result.probes = probes;
   note('ready');
   const viewer = (f, ...a) => page.evaluate(f, ...a);
+  // a viewer without a gallery (its /api/gallery.json answers 404) shows no gallery UI
+  result.gallery = await viewer(async () => ({
+    ready: await window.partsimViewer.galleryReady,
+    state: window.partsimViewer.galleryState(),
+    grid_hidden: document.getElementById('gallery').hidden,
+    button_hidden: document.getElementById('btn-gallery').hidden,
+  }));
+  if (result.gallery.ready.gallery || result.gallery.state.enabled || !result.gallery.grid_hidden ||
+      !result.gallery.button_hidden) {
+    throw new Error(`gallery UI without a gallery: ${JSON.stringify(result.gallery)}`);
+  }
   result.bodies = await viewer(() => window.partsimViewer.bodies());
   result.stats_at_load = await viewer(() => window.partsimViewer.stats());
 
