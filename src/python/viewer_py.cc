@@ -122,7 +122,11 @@ void BindViewer(py::module_& m) {
           },
           py::arg("r"), py::arg("p"), py::arg("y"),
           "How the page's camera starts: roll, pitch, yaw (rad); it looks along (cos p cos y, "
-          "cos p sin y, sin p), as SAPIEN's viewer.set_camera_rpy.");
+          "cos p sin y, sin p), as SAPIEN's viewer.set_camera_rpy.")
+      .def("set_fovy", &Viewer::SetInitialCameraFovy, py::arg("fovy"),
+           "The page's camera's vertical field of view (rad, in (0, pi)), as SAPIEN's "
+           "viewer.set_fovy; read by the page when it loads (scene.json's "
+           "initial_camera.fovy, null unless set).");
 
   py::type::of<Scene>().attr("create_viewer") = py::cpp_function(
       [](Scene& scene, int port, const std::string& address,

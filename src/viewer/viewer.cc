@@ -138,6 +138,7 @@ struct Viewer::Impl {
   std::shared_ptr<const SceneContent> shared_content;
   std::shared_ptr<const MotionSnapshot> latest;
   std::optional<Eigen::Vector3d> camera_position, camera_rpy;  ///< the page's initial camera
+  std::optional<double> camera_fovy;
   std::atomic<bool> closed{false};
   std::atomic<bool> want_contacts{false};
   std::atomic<bool> started{false};
@@ -156,6 +157,15 @@ struct Viewer::Impl {
   std::deque<RateSample> rate_samples;
   double steps_per_second = 0, realtime_factor = 0;
   int port = 0;
+
+  // ---- extensions (set before Start, then read only) ----
+  struct ApiRoute {
+    std::string prefix;
+    ViewerApiRoute route;
+    double timeout = 30;
+  };
+  std::vector<ApiRoute> api_routes;
+  std::map<std::string, ViewerService> services;
 
   std::atomic<long long> client_count{0}, sent{0}, dropped{0}, http_requests{0}, errors{0},
       snapshots{0};
@@ -672,15 +682,20 @@ struct Viewer::Impl {
         Answer(c, service, Json::object(), id);
         PublishStatus();
       } else if (service == "/partsim/step") {
+        // while running: pause first, then the n steps
         const long long n = internal::StepCountFromJson(args);
         if (sim) {
+          if (!sim->IsPaused()) sim->Pause();
           sim->StepN(n);
         } else {
           std::lock_guard<std::mutex> lock(mutex);
-          if (paused) pending_steps = std::min(pending_steps + n, SimServer::kMaxStepRequest);
+          if (!paused) pending_steps = 0;
+          paused = true;
+          pending_steps = std::min(pending_steps + n, SimServer::kMaxStepRequest);
         }
         cv.notify_all();
         Answer(c, service, Json::object(), id);
+        PublishStatus();
       } else if (service == "/partsim/reset") {
         if (sim) {
           sim->Reset();
@@ -707,10 +722,15 @@ struct Viewer::Impl {
         cv.notify_all();
         Answer(c, service, Json::object(), id);
         PublishStatus();
+      } else if (auto it = services.find(service); it != services.end()) {
+        CallExtraService(c, service, it->second, args, id);
       } else {
+        std::string extra;
+        for (const auto& [name, unused] : services) extra += ", " + name;
         throw Error("no service '" + service +
                     "' (the viewer's: /partsim/set_joint_target, /partsim/pause, /partsim/resume, "
-                    "/partsim/step, /partsim/reset, /partsim/camera, /partsim/close)");
+                    "/partsim/step, /partsim/reset, /partsim/camera, /partsim/close" +
+                    extra + ")");
       }
     } catch (const nlohmann::json::exception& e) {
       ++errors;
@@ -725,19 +745,36 @@ struct Viewer::Impl {
     }
   }
 
+  /// A call of an extension's service: its answer comes back from any thread.
+  void CallExtraService(const ClientPtr& c, const std::string& service,
+                        const ViewerService& handler, const Json& args, const Json& id) {
+    std::weak_ptr<ViewerClient> weak = c;
+    auto once = std::make_shared<std::atomic<bool>>(false);
+    ViewerServiceReply reply = [this, weak, service, id, once](bool ok, const std::string& text) {
+      if (once->exchange(true)) return;
+      Json answer;
+      if (ok) {
+        try {
+          answer =
+              internal::ServiceResponseToJson(service, internal::ParseJsonBounded(text), true, id);
+        } catch (const std::exception& e) {
+          ok = false;
+          answer = internal::ServiceResponseToJson(
+              service, service + ": bad answer from the service: " + e.what(), false, id);
+        }
+      } else {
+        answer = internal::ServiceResponseToJson(service, service + ": " + text, false, id);
+      }
+      if (!ok) ++errors;
+      PostReply(weak, Dump(answer));
+    };
+    handler(Dump(args.is_null() ? Json::object() : args), reply);
+  }
+
   // ---- HTTP ----
 
-  void HandleHttp(const WsServer::connection_ptr& con) {
-    ++http_requests;
-    int status = 200;
-    std::string body, type = "text/plain; charset=utf-8";
-    try {
-      Route(con, &status, &body, &type);
-    } catch (const std::exception& e) {
-      status = 500;
-      body = std::string("error: ") + e.what() + "\n";
-      type = "text/plain; charset=utf-8";
-    }
+  static void FillHttp(const WsServer::connection_ptr& con, int status, const std::string& type,
+                       const std::string& body) {
     con->set_status(static_cast<websocketpp::http::status_code::value>(status));
     con->append_header("Content-Type", type);
     con->append_header("Cache-Control", "no-store");
@@ -745,11 +782,59 @@ struct Viewer::Impl {
     con->set_body(body);
   }
 
-  void Route(const WsServer::connection_ptr& con, int* status, std::string* body,
+  void HandleHttp(const WsServer::connection_ptr& con) {
+    ++http_requests;
+    int status = 200;
+    std::string body, type = "text/plain; charset=utf-8";
+    try {
+      if (Route(con, &status, &body, &type)) return;  // answered later
+    } catch (const std::exception& e) {
+      status = 500;
+      body = std::string("error: ") + e.what() + "\n";
+      type = "text/plain; charset=utf-8";
+    }
+    FillHttp(con, status, type, body);
+  }
+
+  /// Hands a request to an extension's route; its answer (or 503 after the route's timeout)
+  /// is sent later, on the network thread.
+  void DeferToRoute(const WsServer::connection_ptr& con, const ApiRoute& r,
+                    const std::string& path) {
+    websocketpp::lib::error_code ec = con->defer_http_response();
+    if (ec) throw Error("cannot defer the answer: " + ec.message());
+    auto once = std::make_shared<std::atomic<bool>>(false);
+    auto timer = std::make_shared<boost::asio::steady_timer>(ws.get_io_service());
+    ViewerHttpRespond respond = [this, con, once, timer](ViewerHttpAnswer a) {
+      if (once->exchange(true) || !started) return;
+      boost::asio::post(ws.get_io_service(), [con, timer, a = std::move(a)] {
+        timer->cancel();
+        FillHttp(con, a.status, a.content_type, a.body);
+        websocketpp::lib::error_code unused;
+        con->send_http_response(unused);
+      });
+    };
+    timer->expires_after(std::chrono::milliseconds(static_cast<long long>(r.timeout * 1000)));
+    const double timeout = r.timeout;
+    timer->async_wait([respond, timeout](const boost::system::error_code& e) {
+      if (e) return;
+      char why[100];
+      std::snprintf(why, sizeof(why), "no answer within %g s; try again\n", timeout);
+      respond({503, "text/plain; charset=utf-8", why});
+    });
+    try {
+      r.route(path, respond);
+    } catch (const std::exception& e) {
+      respond({500, "text/plain; charset=utf-8", std::string("error: ") + e.what() + "\n"});
+    }
+  }
+
+  /// Fills the answer to a request, or returns true when an extension answers it later.
+  bool Route(const WsServer::connection_ptr& con, int* status, std::string* body,
              std::string* type) {
     auto fail = [&](int code, const std::string& why) {
       *status = code;
       *body = why + "\n";
+      return false;
     };
     if (con->get_request().get_method() != "GET") return fail(405, "only GET is served");
     // (a plain HTTP request has no WebSocket processor: get_origin() is not for it)
@@ -763,7 +848,13 @@ struct Viewer::Impl {
       if (given.empty()) given = con->get_request_header("X-Partsim-Token");
       if (!internal::SameToken(given, token))
         return fail(403, "missing or wrong token: add ?token=T (the token of the viewer's URL)");
-      return Api(path, status, body, type);
+      for (const ApiRoute& r : api_routes)
+        if (path.rfind(r.prefix, 0) == 0) {
+          DeferToRoute(con, r, path);
+          return true;
+        }
+      Api(path, status, body, type);
+      return false;
     }
     if (path == "/") path = "/index.html";
     if (!internal::SafeBundlePath(path))
@@ -776,7 +867,7 @@ struct Viewer::Impl {
       if (path == "/index.html") {
         *type = "text/html; charset=utf-8";
         *body = kNoBundlePage;
-        return;
+        return false;
       }
       return fail(404, "no file '" + path + "' in the web bundle (" +
                            (web_root.empty() ? "none found" : web_root) + ")");
@@ -786,6 +877,7 @@ struct Viewer::Impl {
     ss << in.rdbuf();
     *body = ss.str();
     *type = internal::ContentTypeOf(path);
+    return false;
   }
 
   /// Index K of "/api/mesh/K.bin" (prefix "/api/mesh/", suffix ".bin"), or -1.
@@ -823,8 +915,10 @@ struct Viewer::Impl {
         auto vec = [](const std::optional<Eigen::Vector3d>& v) {
           return v ? Json::array({v->x(), v->y(), v->z()}) : Json(nullptr);
         };
-        if (camera_position || camera_rpy)
-          j["initial_camera"] = {{"position", vec(camera_position)}, {"rpy", vec(camera_rpy)}};
+        if (camera_position || camera_rpy || camera_fovy)
+          j["initial_camera"] = {{"position", vec(camera_position)},
+                                 {"rpy", vec(camera_rpy)},
+                                 {"fovy", camera_fovy ? Json(*camera_fovy) : Json(nullptr)}};
         else
           j["initial_camera"] = nullptr;
       }
@@ -861,9 +955,11 @@ struct Viewer::Impl {
       *type = internal::ImageContentType(*body);
       return;
     }
+    std::string extra;
+    for (const ApiRoute& r : api_routes) extra += ", " + r.prefix + "...";
     *status = 404;
     *body = "no API path '" + path +
-            "' (there are /api/scene.json, /api/mesh/K.bin, /api/texture/K.png)\n";
+            "' (there are /api/scene.json, /api/mesh/K.bin, /api/texture/K.png" + extra + ")\n";
   }
 
   // ---- set-up ----
@@ -1078,6 +1174,14 @@ void Viewer::SetInitialCameraRpy(const Eigen::Vector3d& rpy) {
   impl_->camera_rpy = rpy;
 }
 
+void Viewer::SetInitialCameraFovy(double fovy) {
+  if (!(fovy > 0 && fovy < 3.14159265358979323846))
+    throw Error("Viewer: the camera's vertical field of view must be in (0, pi) rad, got " +
+                std::to_string(fovy));
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->camera_fovy = fovy;
+}
+
 Scene* Viewer::GetScene() const { return impl_->scene; }
 
 bool Viewer::IsClosed() const { return impl_->closed; }
@@ -1118,6 +1222,60 @@ ViewerStats Viewer::GetStats() const {
   std::lock_guard<std::mutex> lock(m.mutex);
   s.scene_version = m.shared_content ? m.shared_content->version : 0;
   return s;
+}
+
+}  // namespace partsim
+
+namespace partsim {
+
+void Viewer::AddApiRoute(const std::string& prefix, ViewerApiRoute route, double timeout) {
+  Impl& m = *impl_;
+  if (m.started) throw Error("Viewer::AddApiRoute: add routes before Start()");
+  if (prefix.rfind("/api/", 0) != 0 || prefix.size() <= 5)
+    throw Error("Viewer::AddApiRoute: '" + prefix + "' is not a path under /api/");
+  for (const char* own : {"/api/scene.json", "/api/mesh/", "/api/texture/"})
+    if (prefix.rfind(own, 0) == 0 || std::string(own).rfind(prefix, 0) == 0)
+      throw Error("Viewer::AddApiRoute: '" + prefix + "' overlaps the viewer's own " + own);
+  if (!route) throw Error("Viewer::AddApiRoute: the route is empty");
+  if (!(timeout > 0) || timeout > 1e6)
+    throw Error("Viewer::AddApiRoute: the timeout must be a positive number of seconds");
+  m.api_routes.push_back({prefix, std::move(route), timeout});
+}
+
+void Viewer::AddService(const std::string& name, ViewerService service) {
+  Impl& m = *impl_;
+  if (m.started) throw Error("Viewer::AddService: add services before Start()");
+  for (const char* own : {"/partsim/set_joint_target", "/partsim/pause", "/partsim/resume",
+                          "/partsim/step", "/partsim/reset", "/partsim/camera", "/partsim/close"})
+    if (name == own) throw Error("Viewer::AddService: '" + name + "' is the viewer's own");
+  if (name.empty() || name[0] != '/')
+    throw Error("Viewer::AddService: a service name starts with '/', got '" + name + "'");
+  if (!service) throw Error("Viewer::AddService: the service is empty");
+  if (!m.services.emplace(name, std::move(service)).second)
+    throw Error("Viewer::AddService: '" + name + "' was added already");
+}
+
+void Viewer::Post(std::function<void()> command) {
+  Impl& m = *impl_;
+  auto guarded = [command = std::move(command)] {
+    try {
+      command();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "partsim viewer: a posted command failed: %s\n", e.what());
+    }
+  };
+  if (m.sim) {
+    m.sim->Post([this, guarded] {
+      guarded();
+      impl_->Snapshot(true);
+    });
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(m.mutex);
+    m.commands.push_back(guarded);
+  }
+  m.cv.notify_all();
 }
 
 }  // namespace partsim

@@ -494,6 +494,90 @@ TEST_F(ViewerTest, PauseBlocksRenderUntilResumedOrStepped) {
   loop.join();
 }
 
+TEST_F(ViewerTest, ExtensionsAddApiRoutesServicesAndCommandsOnTheScenesThread) {
+  viewer_ = std::make_unique<Viewer>(scene_.get());
+  Viewer& v = *viewer_;
+  v.AddApiRoute(
+      "/api/extra/",
+      [](const std::string& path, ViewerHttpRespond respond) {
+        if (path == "/api/extra/now") respond({200, "text/plain", "now"});
+        // any other path is never answered: the route's timeout answers 503
+      },
+      0.3);
+  std::thread::id scene_thread;
+  v.AddService("/test/echo", [&](const std::string& args, ViewerServiceReply reply) {
+    v.Post([&, args, reply] {
+      scene_thread = std::this_thread::get_id();
+      reply(true, args);
+    });
+  });
+  v.AddService("/test/fail",
+               [](const std::string&, ViewerServiceReply reply) { reply(false, "it fails"); });
+  EXPECT_THROW(v.AddService("/partsim/pause", [](const std::string&, ViewerServiceReply) {}),
+               Error);
+  EXPECT_THROW(v.AddService("/test/echo", [](const std::string&, ViewerServiceReply) {}), Error);
+  EXPECT_THROW(v.AddApiRoute("/api/mesh/", [](const std::string&, ViewerHttpRespond) {}), Error);
+  EXPECT_THROW(v.AddApiRoute("/extra/", [](const std::string&, ViewerHttpRespond) {}), Error);
+  v.Start();
+  EXPECT_THROW(v.AddService("/test/late", [](const std::string&, ViewerServiceReply) {}), Error);
+
+  HttpReply r = HttpGet(v.GetPort(), Api("/api/extra/now"));
+  EXPECT_EQ(r.status, 200);
+  EXPECT_EQ(r.body, "now");
+  EXPECT_EQ(HttpGet(v.GetPort(), "/api/extra/now").status, 403) << "the token is checked";
+  const auto t0 = std::chrono::steady_clock::now();
+  r = HttpGet(v.GetPort(), Api("/api/extra/never"));
+  EXPECT_EQ(r.status, 503);
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 0.25);
+  r = HttpGet(v.GetPort(), Api("/api/nothing"));
+  EXPECT_EQ(r.status, 404);
+  EXPECT_NE(r.body.find("/api/extra/"), std::string::npos) << r.body;
+
+  TestClient c(v.GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Auth(v.GetToken());
+  c.Send(Call("/test/echo", {{"a", 1}}, "e"));
+  json reply;
+  for (int i = 0; i < 1000 && reply.is_null(); ++i) {
+    v.Render();  // the posted command runs here, on this thread
+    for (const json& m : c.Messages())
+      if (m.value("id", "") == "e") reply = m;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_FALSE(reply.is_null());
+  EXPECT_TRUE(reply["result"].get<bool>());
+  EXPECT_EQ(reply["values"], json({{"a", 1}}));
+  EXPECT_EQ(scene_thread, std::this_thread::get_id());
+  c.Send(Call("/test/fail", json::object(), "f"));
+  const json failed = c.WaitReply("f");
+  EXPECT_FALSE(failed["result"].get<bool>());
+  EXPECT_EQ(failed["values"], "/test/fail: it fails");
+  c.Send(Call("/test/none", json::object(), "n"));
+  EXPECT_NE(c.WaitReply("n")["values"].get<std::string>().find("/test/echo"), std::string::npos);
+}
+
+TEST_F(ViewerTest, StepWhileRunningPausesThenSteps) {
+  // served mode: the SimServer pauses, then takes the n steps
+  SimServer sim(scene_.get(), nullptr);
+  viewer_ = std::make_unique<Viewer>(scene_.get());
+  viewer_->Attach(&sim);
+  viewer_->Start();
+  sim.Start();
+  ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() > 10; }));
+  TestClient c(viewer_->GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Auth(viewer_->GetToken());
+  c.Send(Call("/partsim/step", {{"n", 7}}, "s"));
+  ASSERT_FALSE(c.WaitReply("s").is_null());
+  EXPECT_TRUE(sim.IsPaused());
+  EXPECT_TRUE(WaitFor([&] { return sim.GetPendingSteps() == 0; }));
+  const long long at = sim.GetClockSteps();
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(sim.GetClockSteps(), at) << "paused after the steps";
+  sim.Stop();
+  viewer_.reset();
+}
+
 TEST_F(ViewerTest, CameraServiceAnswersAPngThatDecodes) {
   Camera cam = scene_->AddCamera("front", 64, 48, 1.0, 0.05, 20.0);
   cam.SetLocalPose(CameraLookAt(Eigen::Vector3d(2, -2, 1.5), Eigen::Vector3d(0, 0, 0.4)));

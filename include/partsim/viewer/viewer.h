@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -49,6 +50,24 @@ struct ViewerStats {
   long long scene_version = 0;     ///< structure snapshots taken (1 after Start)
 };
 
+/// An HTTP answer of an extra API route (Viewer::AddApiRoute).
+struct ViewerHttpAnswer {
+  int status = 200;
+  std::string content_type = "text/plain; charset=utf-8";
+  std::string body;
+};
+/// Answers one request of an extra API route: call it once, from any thread, now or later.
+using ViewerHttpRespond = std::function<void(ViewerHttpAnswer answer)>;
+/// Handles GET `path` (an /api/ path, its token checked) on the network thread; it must return
+/// quickly and answers through `respond`.
+using ViewerApiRoute = std::function<void(const std::string& path, ViewerHttpRespond respond)>;
+/// Answers one call of an extra service, once, from any thread: on success `text` is the
+/// answer's "values" as JSON text (e.g. {"success": true, "message": ""}); on failure a message.
+using ViewerServiceReply = std::function<void(bool success, const std::string& text)>;
+/// Handles a call of an extra service on the network thread: `args_json` is its args (a JSON
+/// object's text); it must return quickly and answers through `reply`.
+using ViewerService = std::function<void(const std::string& args_json, ViewerServiceReply reply)>;
+
 class Viewer {
  public:
   /// Views `scene` (which must outlive the viewer; null: nothing until SetScene). Nothing is
@@ -89,6 +108,9 @@ class Viewer {
   /// its x forward, y left, z up frame; the view direction is (cos p cos y, cos p sin y, sin p),
   /// so a positive pitch looks up, as in SAPIEN's viewer.
   void SetInitialCameraRpy(const Eigen::Vector3d& rpy);
+  /// Where the page's camera starts: its vertical field of view (rad, in (0, pi)), SAPIEN's
+  /// viewer.set_fovy; scene.json's initial_camera.fovy (null unless set).
+  void SetInitialCameraFovy(double fovy);
   /// The viewed scene (null: none).
   Scene* GetScene() const;
 
@@ -106,6 +128,21 @@ class Viewer {
   /// The web bundle folder found, "" for none.
   std::string GetWebRoot() const;
   ViewerStats GetStats() const;
+
+  // ---- extensions: what a tool built on the viewer adds (partsim view --dataset's gallery) ----
+
+  /// Serves GET requests whose path starts with `prefix` (which starts with "/api/") by
+  /// `route`; the token is checked first. A request not answered within `timeout` seconds gets
+  /// 503. Before Start(); throws partsim::Error for a prefix outside /api/ or one the viewer
+  /// serves itself.
+  void AddApiRoute(const std::string& prefix, ViewerApiRoute route, double timeout = 30.0);
+  /// Answers the rosbridge service `name` (e.g. "/partsim/open") by `service`. Before Start();
+  /// throws partsim::Error for a name the viewer answers itself or one added already.
+  void AddService(const std::string& name, ViewerService service);
+  /// Runs `command` on the scene's thread: synchronous mode, at the next Render() (also while
+  /// it blocks paused), which then snapshots the scene; served mode, posted to the SimServer.
+  /// What it throws is written to stderr.
+  void Post(std::function<void()> command);
 
   struct Impl;
 
