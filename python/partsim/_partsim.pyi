@@ -3319,6 +3319,9 @@ class Viewer:
     def set_camera_xyz(self, x: float, y: float, z: float) -> None:
         """Where the page's camera starts (m, world), as SAPIEN's viewer.set_camera_xyz; read by the page when it loads."""
         ...
+    def set_fovy(self, fovy: float) -> None:
+        """The page's camera's vertical field of view (rad, in (0, pi)), as SAPIEN's viewer.set_fovy; read by the page when it loads (scene.json's initial_camera.fovy, null unless set)."""
+        ...
     def set_scene(self, scene: Scene) -> None:
         """Views another scene (SAPIEN's viewer.set_scene); the page reloads."""
         ...
@@ -3444,6 +3447,10 @@ def load_merged_mesh(path: str, scale: numpy.ndarray = ...) -> MeshData:
 
 def load_mesh_file(path: str, scale: numpy.ndarray = ...) -> typing.List[LoadedMesh]:
     """Every sub-mesh of a mesh file, node transforms applied, vertices multiplied by `scale` (3,), in metres."""
+    ...
+
+def make_cabinet_urdf(height: float = ..., width: float = ..., depth: float = ..., drawer_travel: float = ..., door_limit: float = ..., door_hinge_left: bool = ..., seed: int = ..., name: str = ...) -> str:
+    """The built-in cabinet (the CLI's default object) as a URDF string: links 'body', 'drawer_0' (prismatic joint 'drawer_0_joint' along +x, 0 to drawer_travel m) and 'door_0' (revolute 'door_0_joint', 0 to door_limit rad), boxes and cylinders only, with explicit inertials. Sizes in metres: its frame is the centre of its bottom face, x out of the front, z up. A non-zero seed varies the sizes within +-15% and picks the hinge side. Load it with scene.create_urdf_loader().load_from_string(urdf, '.'); raises PartsimError naming an option out of range."""
     ...
 
 def paper_statistics() -> typing.Dict[str, typing.Tuple[int, int]]:

@@ -3,7 +3,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cstdint>
+#include <string>
+
 #include "bindings.h"
+#include "partsim/assets/default_objects.h"
 #include "partsim/assets/mesh.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/assets/quality.h"
@@ -202,6 +206,33 @@ void BindAssets(py::module_& m) {
           "create_partnet_mobility_loader",
           [](Scene& scene) { return PartNetMobilityLoader(&scene); }, ka,
           "A PartNetMobilityLoader whose load() adds to this scene.");
+  m.def(
+      "make_cabinet_urdf",
+      [](double height, double width, double depth, double drawer_travel, double door_limit,
+         bool door_hinge_left, std::uint32_t seed, const std::string& name) {
+        CabinetOptions o;
+        o.height = height;
+        o.width = width;
+        o.depth = depth;
+        o.drawer_travel = drawer_travel;
+        o.door_limit = door_limit;
+        o.door_hinge_left = door_hinge_left;
+        o.seed = seed;
+        o.name = name;
+        return MakeCabinetUrdf(o);
+      },
+      py::arg("height") = CabinetOptions().height, py::arg("width") = CabinetOptions().width,
+      py::arg("depth") = CabinetOptions().depth,
+      py::arg("drawer_travel") = CabinetOptions().drawer_travel,
+      py::arg("door_limit") = CabinetOptions().door_limit, py::arg("door_hinge_left") = false,
+      py::arg("seed") = 0, py::arg("name") = "cabinet",
+      "The built-in cabinet (the CLI's default object) as a URDF string: links 'body', "
+      "'drawer_0' (prismatic joint 'drawer_0_joint' along +x, 0 to drawer_travel m) and 'door_0' "
+      "(revolute 'door_0_joint', 0 to door_limit rad), boxes and cylinders only, with explicit "
+      "inertials. Sizes in metres: its frame is the centre of its bottom face, x out of the "
+      "front, z up. A non-zero seed varies the sizes within +-15% and picks the hinge side. "
+      "Load it with scene.create_urdf_loader().load_from_string(urdf, '.'); raises PartsimError "
+      "naming an option out of range.");
   m.def("standing_root_pose", &StandingRootPose, py::arg("articulation"), py::arg("altitude") = 0.0,
         "Root pose that makes the articulation stand on z = altitude at its current joint "
         "positions (orientation and x, y kept).");

@@ -119,6 +119,42 @@ def test_render_blocks_while_the_page_pauses(scene):
     viewer.stop()
 
 
+def test_step_while_running_pauses_then_steps(scene):
+    viewer = scene.create_viewer()
+    ws = connect(viewer)
+    returned = []
+
+    def loop():
+        while not viewer.closed and len(returned) < 100000:
+            viewer.render()
+            returned.append(1)
+            scene.step()
+
+    t = threading.Thread(target=loop)
+    t.start()
+    time.sleep(0.2)
+    assert returned and not viewer.paused  # running
+    ws.send(json.dumps({"op": "call_service", "service": "/partsim/step", "args": {"n": 3},
+                        "id": "s"}))
+    assert reply(ws, "s")["result"] is True
+    assert viewer.paused
+    time.sleep(0.3)
+    count = len(returned)
+    time.sleep(0.3)
+    assert len(returned) == count  # blocked again after the 3 steps
+    ws.send(json.dumps({"op": "call_service", "service": "/partsim/step", "args": {"n": 2},
+                        "id": "s2"}))
+    reply(ws, "s2")
+    time.sleep(0.3)
+    assert len(returned) == count + 2
+    ws.send(json.dumps({"op": "call_service", "service": "/partsim/close", "id": "c"}))
+    reply(ws, "c")
+    t.join(timeout=10)
+    assert not t.is_alive()
+    ws.close()
+    viewer.stop()
+
+
 def test_sapien_viewer_calls(scene):
     viewer = partsim.Viewer()  # SAPIEN 2: the scene comes later
     with pytest.raises(urllib.error.HTTPError, match="503"):
@@ -127,7 +163,12 @@ def test_sapien_viewer_calls(scene):
     viewer.set_camera_xyz(x=-2, y=0, z=1)
     viewer.set_camera_rpy(r=0, p=-0.3, y=0)
     content = json.loads(get(viewer, "/api/scene.json"))
-    assert content["initial_camera"] == {"position": [-2, 0, 1], "rpy": [0, -0.3, 0]}
+    assert content["initial_camera"] == {"position": [-2, 0, 1], "rpy": [0, -0.3, 0],
+                                         "fovy": None}
+    viewer.set_fovy(0.9)
+    assert json.loads(get(viewer, "/api/scene.json"))["initial_camera"]["fovy"] == 0.9
+    with pytest.raises(partsim.PartsimError, match="field of view"):
+        viewer.set_fovy(0.0)
     assert len(content["bodies"]) == 2
     viewer.toggle_axes(False)
     viewer.toggle_camera_lines(False)
@@ -167,3 +208,17 @@ def test_ctrl_c_while_paused_raises_keyboard_interrupt(tmp_path):
     finally:
         p.kill()
     assert "interrupted, closed = True" in out
+
+
+def test_make_cabinet_urdf_is_the_built_in_cabinet():
+    urdf = partsim.make_cabinet_urdf()
+    scene = partsim.Scene()
+    loader = scene.create_urdf_loader()
+    loader.fix_root_link = True
+    cabinet = loader.load_from_string(urdf, ".")
+    assert [link.get_name() for link in cabinet.get_links()] == ["body", "drawer_0", "door_0"]
+    assert [j.get_name() for j in cabinet.get_active_joints()] == ["drawer_0_joint",
+                                                                  "door_0_joint"]
+    assert partsim.make_cabinet_urdf(seed=3) != urdf
+    with pytest.raises(partsim.PartsimError, match="height"):
+        partsim.make_cabinet_urdf(height=-1)
