@@ -1,5 +1,6 @@
 // `partsim view`: an asset (or a scene file, or the built-in cabinet) simulated in real time on a
-// SimServer, with the browser viewer attached.
+// SimServer, with the browser viewer attached; `partsim view --dataset ROOT`: the gallery of a
+// PartNet-Mobility tree (partsim/viewer/gallery.h), the viewer in synchronous mode on this thread.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -17,6 +18,7 @@
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/server/sim_server.h"
+#include "partsim/viewer/gallery.h"
 #include "partsim/viewer/viewer.h"
 
 namespace partsim::tools {
@@ -25,7 +27,8 @@ namespace {
 constexpr char kViewUsage[] = R"(usage:
   partsim view [FILE.urdf | FOLDER | SCENE.json] [--port P] [--address A] [--paused]
                [--rate R] [--token T] [--allow-origin O]... [--duration S]
-  partsim view --dataset ROOT        (a gallery of a PartNet-Mobility tree: not built yet)
+  partsim view --dataset ROOT [--category C] [--port P] [--address A] [--rate R] [--token T]
+               [--allow-origin O]... [--duration S]
 
 Simulates the asset in real time (a URDF file or a PartNet-Mobility folder at the origin with its
 root fixed, a JSON scene file's objects at their poses, or with nothing given the built-in
@@ -33,10 +36,17 @@ cabinet) on a ground under lights, with a camera "front" looking at it, and serv
 viewer (docs/viewer.md): open the printed URL. The page orbits the camera, moves joints with
 sliders, pauses, steps and resets the simulation, and shows the camera's pictures. For a remote
 machine: ssh -L 8000:127.0.0.1:8000 HOST, then open the URL on your own.
+
+With --dataset, the page is a gallery of the PartNet-Mobility tree under ROOT (every folder
+holding a mobility.urdf, at any depth; real or from partsim assets generate): thumbnails rendered
+by partsim, a category and a text filter; a click opens the object, simulated with its joints
+sweeping their ranges (one cycle per 4 s). Folders that cannot be read are listed on the page.
+  --dataset ROOT    the tree to show
+  --category C      only objects of category C (meta.json model_cat, e.g. StorageFurniture)
   --port P          the page's port (default 8000; 0 picks a free one)
   --address A       interface to listen on (default 127.0.0.1; anything else is reachable from
                     other machines, which still need the token)
-  --paused          start paused (the page's resume and step buttons run it)
+  --paused          start paused (the page's resume and step buttons run it; not with --dataset)
   --rate R          physics rate in Hz (default 500)
   --token T         the token the page must carry (default: a random one, in the URL)
   --allow-origin O  web pages of origin O may connect (repeatable; default: pages of this
@@ -47,10 +57,69 @@ machine: ssh -L 8000:127.0.0.1:8000 HOST, then open the URL on your own.
 std::atomic<bool> g_stop{false};
 void OnSignal(int) { g_stop = true; }
 
+/// partsim view --dataset: the gallery, the viewer in synchronous mode on this thread.
+int RunGallery(const std::string& root, const std::string& category, double timestep,
+               const std::string& address, int port, const std::string& token,
+               const std::vector<std::string>& origins, double duration) {
+  std::unique_ptr<Gallery> gallery;
+  try {
+    GalleryOptions go;
+    go.root = root;
+    go.category = category;
+    go.timestep = timestep;
+    const auto t0 = std::chrono::steady_clock::now();
+    gallery = std::make_unique<Gallery>(go);
+    std::printf("partsim view: %zu objects under %s (%zu folders could not be read) in %.1f s\n",
+                gallery->Objects().size(), root.c_str(), gallery->Errors().size(),
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    for (const GalleryError& e : gallery->Errors())
+      std::fprintf(stderr, "partsim view: %s: %s\n", e.name.c_str(), e.error.c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "partsim view: %s\n", e.what());
+    return 2;
+  }
+  try {
+    ViewerOptions vo;
+    vo.address = address;
+    vo.port = port;
+    vo.auth_token = token;
+    vo.allowed_origins = origins;
+    Viewer viewer(nullptr, vo);
+    gallery->AttachTo(&viewer);
+    try {
+      viewer.Start();
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string(e.what()) +
+                               "; choose another port with --port P, or --port 0 for a free one");
+    }
+    std::printf("  open %s in a browser%s; stop with Ctrl-C\n", viewer.GetUrl().c_str(),
+                viewer.GetWebRoot().empty()
+                    ? " (web page not built: bash scripts/build_web.sh; the gallery is served)"
+                    : "");
+    std::fflush(stdout);
+    std::signal(SIGINT, OnSignal);
+    std::signal(SIGTERM, OnSignal);
+    const auto t0 = std::chrono::steady_clock::now();
+    gallery->Run([&] {
+      return !g_stop &&
+             !(duration > 0 &&
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >=
+                   duration);
+    });
+    viewer.Stop();
+    std::printf("partsim view: stopped%s\n",
+                g_stop || duration > 0 ? "" : "; the page closed the viewer");
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "partsim view: %s\n", e.what());
+    return 1;
+  }
+}
+
 }  // namespace
 
 int RunViewCommand(int argc, char** argv) {
-  std::string file, address = "127.0.0.1", token, dataset;
+  std::string file, address = "127.0.0.1", token, dataset, category;
   std::vector<std::string> origins;
   int port = 8000;
   double rate = 500, duration = 0;
@@ -75,18 +144,24 @@ int RunViewCommand(int argc, char** argv) {
     p.Option("--token", [&](const FlagValue& v) { token = v.NonEmpty("a non-empty token"); });
     p.Option("--allow-origin", [&](const FlagValue& v) { origins.push_back(v.Text()); });
     p.Option("--duration", [&](const FlagValue& v) { duration = v.Number(0, false, 1e9); });
-    p.Option("--dataset", [&](const FlagValue& v) { dataset = v.Text(); });
+    p.Option("--dataset", [&](const FlagValue& v) { dataset = v.NonEmpty("a folder"); });
+    p.Option("--category", [&](const FlagValue& v) { category = v.NonEmpty("a category"); });
     p.Switch("--help", [] {});  // answered above; declared to be suggested
     p.Parse(args);
     return 0;
   });
   if (parsed != 0) return parsed;
-  if (!dataset.empty()) {
-    std::fprintf(stderr,
-                 "partsim view: --dataset (the gallery of a PartNet-Mobility tree) is not built "
-                 "yet; open one object with partsim view %s/<object folder>\n",
-                 dataset.c_str());
-    return 2;
+  if (!dataset.empty() || !category.empty()) {
+    if (dataset.empty()) {
+      std::fprintf(stderr, "partsim view: --category needs --dataset ROOT\n");
+      return 2;
+    }
+    if (!file.empty() || paused) {
+      std::fprintf(stderr, "partsim view: --dataset takes no %s\n",
+                   file.empty() ? "--paused" : ("FILE ('" + file + "')").c_str());
+      return 2;
+    }
+    return RunGallery(dataset, category, 1.0 / rate, address, port, token, origins, duration);
   }
 
   try {
