@@ -248,7 +248,7 @@ class Viewer {
     const box = this.model.bounds();
     const centre = box.getCenter(new THREE.Vector3());
     const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 0.1);
-    const fovy = 45;
+    const fovy = c && typeof c.fovy === 'number' ? THREE.MathUtils.radToDeg(c.fovy) : 45;
     const distance = (radius / Math.sin(THREE.MathUtils.degToRad(fovy) / 2)) * 1.3;
     const dir = new THREE.Vector3(1.6, 1.0, 0.9).normalize();
     const eye = centre.clone().addScaledVector(dir, distance);
