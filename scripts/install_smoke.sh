@@ -52,4 +52,20 @@ partsim learn --help | grep -q "partsim learn train" || { echo "partsim learn --
 /usr/bin/python3 -c "import partsim.learn.protocol as p, os, sys; \
 assert os.path.realpath(p.__file__).startswith(os.path.realpath(sys.argv[1]) + '/'), p.__file__" \
   "$prefix"
+echo "-- the viewer's page, installed, found by the installed package (from $work)"
+[ -f "$prefix/share/partsim/web/index.html" ] || { echo "no $prefix/share/partsim/web/index.html"; exit 1; }
+/usr/bin/python3 - "$prefix" <<'PY'
+import os, sys, urllib.request
+import partsim
+prefix = os.path.realpath(sys.argv[1])
+viewer = partsim.Viewer(partsim.Scene())
+try:
+    root = os.path.realpath(viewer.web_root)
+    assert root == os.path.join(prefix, "share/partsim/web"), root
+    page = urllib.request.urlopen(f"http://127.0.0.1:{viewer.port}/", timeout=10).read()
+    assert b"viewer.js" in page, page[:200]
+finally:
+    viewer.close()
+print("viewer page:", root)
+PY
 echo "install smoke test: all passed ($prefix)"

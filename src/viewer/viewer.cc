@@ -1,5 +1,7 @@
 #include "partsim/viewer/viewer.h"
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -101,6 +103,19 @@ std::string FindWebRoot(const std::string& web_root) {
   if (!web_root.empty()) return web_root;
   std::vector<std::string> candidates;
   if (const char* env = std::getenv("PARTSIM_WEB_DIR")) candidates.push_back(env);
+  // an installed copy beside the binary that holds this code, wherever the prefix is (a .deb
+  // in /usr, cmake --install to any PREFIX): PREFIX/bin/partsim, PREFIX/lib/libpartsim.so and
+  // PREFIX/lib/python3/dist-packages/partsim/_partsim*.so all find PREFIX/share/partsim/web
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<const void*>(&FindWebRoot), &info) != 0 &&
+      info.dli_fname != nullptr) {
+    std::error_code ec;
+    const fs::path dir = fs::canonical(fs::path(info.dli_fname), ec).parent_path();
+    if (!ec) {
+      candidates.push_back((dir / "../share/partsim/web").lexically_normal().string());
+      candidates.push_back((dir / "../../../../share/partsim/web").lexically_normal().string());
+    }
+  }
 #ifdef PARTSIM_BUILD_WEB_DIR
   candidates.push_back(PARTSIM_BUILD_WEB_DIR);
 #endif

@@ -29,9 +29,9 @@ struct ViewerOptions {
   /// The token that /api/* requests (?token=T or the header X-Partsim-Token) and the
   /// WebSocket's first op ({"op": "auth", "mac": T}) must carry. "": a random one (GetToken).
   std::string auth_token;
-  /// Folder of the web bundle (index.html, viewer.js, ...). "": $PARTSIM_WEB_DIR, else the build
-  /// tree's web/, else PREFIX/share/partsim/web; without one, / answers a page that says how
-  /// to build it.
+  /// Folder of the web bundle (index.html, viewer.js, ...). "": $PARTSIM_WEB_DIR, else
+  /// share/partsim/web beside the installed binary, else the build tree's web/; without one, /
+  /// answers a page that says how to build it.
   std::string web_root;
   double max_rate = 60.0;                 ///< most pose messages per second (Hz), > 0
   size_t max_clients = 32;                ///< WebSocket connections at once; more get HTTP 503
@@ -151,7 +151,9 @@ class Viewer {
 };
 
 /// The web bundle folder for a viewer with option `web_root`: web_root if given, else
-/// $PARTSIM_WEB_DIR, else the build tree's web/, else PREFIX/share/partsim/web, the first that
+/// $PARTSIM_WEB_DIR, else PREFIX/share/partsim/web for the prefix the binary holding this code
+/// is installed in (found at run time), else the build tree's web/, else the configured
+/// install prefix's share/partsim/web, the first that
 /// holds an index.html; "" when none does (a given web_root is returned even then).
 std::string FindWebRoot(const std::string& web_root);
 
