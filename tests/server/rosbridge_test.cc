@@ -29,13 +29,14 @@
 #include "partsim/render/camera_math.h"
 #include "partsim/robot/robots.h"
 #include "server/wait_for.h"
+#include "server/ws_test_client.h"
 
 namespace partsim {
 namespace {
 
 using json = nlohmann::json;
 using namespace std::chrono_literals;
-using WsClient = websocketpp::client<websocketpp::config::asio_client>;
+using WsClient = testing::WsTestClient::Client;
 
 using testing::WaitFor;
 
@@ -43,88 +44,17 @@ using testing::WaitFor;
 class TestClient {
  public:
   /// `origin`: the Origin header a browser would send ("" sends none).
-  explicit TestClient(int port, const std::string& origin = "") {
-    c_.clear_access_channels(websocketpp::log::alevel::all);
-    c_.clear_error_channels(websocketpp::log::elevel::all);
-    c_.init_asio();
-    c_.set_open_handler([this](websocketpp::connection_hdl) { open_ = true; });
-    c_.set_close_handler([this](websocketpp::connection_hdl h) {
-      close_code_ = c_.get_con_from_hdl(h)->get_remote_close_code();
-      closed_ = true;
-    });
-    c_.set_fail_handler([this](websocketpp::connection_hdl) { closed_ = true; });
-    c_.set_message_handler([this](websocketpp::connection_hdl, WsClient::message_ptr m) {
-      // published messages are counted (the clock and the last joint state kept); the others
-      // are kept whole
-      const std::string& text = m->get_payload();
-      if (m->get_opcode() == websocketpp::frame::opcode::binary) {  // CBOR
-        json j = json::from_cbor(text, true, false);
-        std::lock_guard<std::mutex> lock(mutex_);
-        if (!j.is_discarded()) j["cbor"] = true;
-        messages_.push_back(j);
-        return;
-      }
-      const size_t at = text.rfind("\"topic\":\"");
-      const std::string topic = at == std::string::npos ? "" : text.substr(at + 9);
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (!count_topic_.empty() && topic.rfind(count_topic_ + "\"", 0) == 0) {
-        ++counted_;
-      } else if (topic.rfind("/tf\"", 0) == 0) {
-        ++tf_count_;
-        if (keep_tf_) messages_.push_back(json::parse(text, nullptr, false));
-      } else if (topic.rfind("/clock\"", 0) == 0) {
-        json j = json::parse(text, nullptr, false);
-        last_clock_ = j["msg"]["clock"]["secs"].get<double>() +
-                      1e-9 * j["msg"]["clock"]["nsecs"].get<double>();
-      } else if (topic.rfind("/joint_states\"", 0) == 0) {
-        if (keep_joint_states_) messages_.push_back(json::parse(text, nullptr, false));
-      } else {
-        messages_.push_back(json::parse(text, nullptr, false));
-      }
-    });
-    websocketpp::lib::error_code ec;
-    con_ = c_.get_connection("ws://127.0.0.1:" + std::to_string(port), ec);
-    if (!origin.empty()) con_->replace_header("Origin", origin);
-    c_.connect(con_);
-    thread_ = std::thread([this] { c_.run(); });
-  }
-  ~TestClient() {
-    websocketpp::lib::error_code ec;
-    if (open_ && !closed_) c_.close(con_->get_handle(), websocketpp::close::status::normal, "", ec);
-    WaitFor([this] { return closed_.load(); });
-    c_.stop();
-    thread_.join();
-  }
-  bool WaitOpen() {
-    return WaitFor([this] { return open_.load() || closed_.load(); }) && open_;
-  }
-  void Send(const std::string& text) {
-    websocketpp::lib::error_code ec;
-    c_.send(con_->get_handle(), text, websocketpp::frame::opcode::text, ec);
-  }
+  explicit TestClient(int port, const std::string& origin = "")
+      : ws_(port, origin, [this](const WsClient::message_ptr& m) { OnMessage(m); }) {}
+  bool WaitOpen() { return ws_.WaitOpen(); }
+  void Send(const std::string& text) { ws_.Send(text); }
   void Send(const json& j) { Send(j.dump()); }
-  void SendBinary(const std::string& bytes) {
-    websocketpp::lib::error_code ec;
-    c_.send(con_->get_handle(), bytes, websocketpp::frame::opcode::binary, ec);
-  }
-  std::vector<json> Messages() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return messages_;
-  }
+  void SendBinary(const std::string& bytes) { ws_.Send(bytes, websocketpp::frame::opcode::binary); }
+  std::vector<json> Messages() { return log_.All(); }
   /// Waits for a message satisfying `pred`; returns it (null if none came).
   template <class F>
   json WaitMessage(F pred) {
-    json found;
-    WaitFor([&] {
-      std::lock_guard<std::mutex> lock(mutex_);
-      for (const json& m : messages_)
-        if (pred(m)) {
-          found = m;
-          return true;
-        }
-      return false;
-    });
-    return found;
+    return log_.Wait(pred);
   }
   /// Last /clock time seen (s), or -1.
   double LastClock() {
@@ -148,29 +78,50 @@ class TestClient {
   void KeepJointStates() { keep_joint_states_ = true; }
   /// Keep /tf messages (set before subscribing).
   void KeepTf() { keep_tf_ = true; }
-  bool Closed() const { return closed_; }
+  bool Closed() const { return ws_.Closed(); }
   /// Closes the connection and waits until it is closed.
-  void Close() {
-    websocketpp::lib::error_code ec;
-    c_.close(con_->get_handle(), websocketpp::close::status::normal, "", ec);
-    WaitFor([this] { return closed_.load(); });
-  }
-  int CloseCode() const { return close_code_; }
+  void Close() { ws_.Close(); }
+  int CloseCode() const { return ws_.CloseCode(); }
 
  private:
-  WsClient c_;
-  WsClient::connection_ptr con_;
-  std::thread thread_;
-  std::mutex mutex_;
-  std::vector<json> messages_;
+  // published messages are counted (the clock and the last joint state kept); the others are
+  // kept whole
+  void OnMessage(const WsClient::message_ptr& m) {
+    const std::string& text = m->get_payload();
+    if (m->get_opcode() == websocketpp::frame::opcode::binary) {  // CBOR
+      json j = json::from_cbor(text, true, false);
+      if (!j.is_discarded()) j["cbor"] = true;
+      log_.Add(j);
+      return;
+    }
+    const size_t at = text.rfind("\"topic\":\"");
+    const std::string topic = at == std::string::npos ? "" : text.substr(at + 9);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!count_topic_.empty() && topic.rfind(count_topic_ + "\"", 0) == 0) {
+      ++counted_;
+    } else if (topic.rfind("/tf\"", 0) == 0) {
+      ++tf_count_;
+      if (keep_tf_) log_.Add(json::parse(text, nullptr, false));
+    } else if (topic.rfind("/clock\"", 0) == 0) {
+      json j = json::parse(text, nullptr, false);
+      last_clock_ =
+          j["msg"]["clock"]["secs"].get<double>() + 1e-9 * j["msg"]["clock"]["nsecs"].get<double>();
+    } else if (topic.rfind("/joint_states\"", 0) == 0) {
+      if (keep_joint_states_) log_.Add(json::parse(text, nullptr, false));
+    } else {
+      log_.Add(json::parse(text, nullptr, false));
+    }
+  }
+
+  std::mutex mutex_;  // the counters and settings below
+  testing::MessageLog log_;
   double last_clock_ = -1;
   long long tf_count_ = 0;
   std::string count_topic_;
   long long counted_ = 0;
   std::atomic<bool> keep_joint_states_{false};
   std::atomic<bool> keep_tf_{false};
-  std::atomic<bool> open_{false}, closed_{false};
-  std::atomic<int> close_code_{0};
+  testing::WsTestClient ws_;  // last: its thread stops before the members above go
 };
 
 bool IsError(const json& m) {

@@ -35,13 +35,14 @@
 #include "partsim/render/image_read.h"
 #include "partsim/server/sim_server.h"
 #include "server/wait_for.h"
+#include "server/ws_test_client.h"
 
 namespace partsim {
 namespace {
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
-using WsClient = websocketpp::client<websocketpp::config::asio_client>;
+using WsClient = testing::WsTestClient::Client;
 using testing::WaitFor;
 
 struct HttpReply {
@@ -110,84 +111,38 @@ std::string Base64Decode(const std::string& in) {
 /// A WebSocket client on its own thread that keeps every message it receives.
 class TestClient {
  public:
-  explicit TestClient(int port, const std::string& origin = "") {
-    c_.clear_access_channels(websocketpp::log::alevel::all);
-    c_.clear_error_channels(websocketpp::log::elevel::all);
-    c_.init_asio();
-    c_.set_open_handler([this](websocketpp::connection_hdl) { open_ = true; });
-    c_.set_close_handler([this](websocketpp::connection_hdl h) {
-      close_code_ = c_.get_con_from_hdl(h)->get_remote_close_code();
-      closed_ = true;
-    });
-    c_.set_fail_handler([this](websocketpp::connection_hdl) { closed_ = true; });
-    c_.set_message_handler([this](websocketpp::connection_hdl, WsClient::message_ptr m) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      messages_.push_back(json::parse(m->get_payload(), nullptr, false));
-    });
-    websocketpp::lib::error_code ec;
-    con_ = c_.get_connection("ws://127.0.0.1:" + std::to_string(port) + "/", ec);
-    if (!origin.empty()) con_->replace_header("Origin", origin);
-    c_.connect(con_);
-    thread_ = std::thread([this] { c_.run(); });
-  }
-  ~TestClient() {
-    websocketpp::lib::error_code ec;
-    if (open_ && !closed_) c_.close(con_->get_handle(), websocketpp::close::status::normal, "", ec);
-    WaitFor([this] { return closed_.load(); });
-    c_.stop();
-    thread_.join();
-  }
-  bool WaitOpen() {
-    return WaitFor([this] { return open_.load() || closed_.load(); }) && open_;
-  }
-  void Send(const std::string& text) {
-    websocketpp::lib::error_code ec;
-    c_.send(con_->get_handle(), text, websocketpp::frame::opcode::text, ec);
-  }
+  explicit TestClient(int port, const std::string& origin = "")
+      : ws_(
+            port, origin,
+            [this](const WsClient::message_ptr& m) {
+              log_.Add(json::parse(m->get_payload(), nullptr, false));
+            },
+            "/") {}
+  bool WaitOpen() { return ws_.WaitOpen(); }
+  void Send(const std::string& text) { ws_.Send(text); }
   void Send(const json& j) { Send(j.dump()); }
   void Auth(const std::string& token) {
     Send(json{{"op", "auth"}, {"mac", token}});
     ASSERT_FALSE(
         WaitMessage([](const json& m) { return m.value("msg", "") == "authenticated"; }).is_null());
   }
-  std::vector<json> Messages() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return messages_;
-  }
+  std::vector<json> Messages() { return log_.All(); }
   /// Waits for a message satisfying `pred` (up to 10 s); returns it, or null.
   template <class F>
   json WaitMessage(F pred) {
-    json found;
-    WaitFor([&] {
-      std::lock_guard<std::mutex> lock(mutex_);
-      for (const json& m : messages_)
-        if (pred(m)) {
-          found = m;
-          return true;
-        }
-      return false;
-    });
-    return found;
+    return log_.Wait(pred);
   }
   /// The answer to call `id`.
   json WaitReply(const std::string& id) {
     return WaitMessage([&](const json& m) { return m.value("id", "") == id; });
   }
-  void Clear() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    messages_.clear();
-  }
-  bool Closed() const { return closed_; }
-  int CloseCode() const { return close_code_; }
+  void Clear() { log_.Clear(); }
+  bool Closed() const { return ws_.Closed(); }
+  int CloseCode() const { return ws_.CloseCode(); }
 
  private:
-  WsClient c_;
-  WsClient::connection_ptr con_;
-  std::thread thread_;
-  std::mutex mutex_;
-  std::vector<json> messages_;
-  std::atomic<bool> open_{false}, closed_{false};
-  std::atomic<int> close_code_{0};
+  testing::MessageLog log_;
+  testing::WsTestClient ws_;  // last: its thread stops before the members above go
 };
 
 json Call(const std::string& service, const json& args, const std::string& id) {
