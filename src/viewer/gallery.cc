@@ -17,6 +17,7 @@
 #include "partsim/physics/scene.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "viewer/http_util.h"
 #include "viewer/png_encode.h"
 
 // The gallery lives on two threads: the network thread answers /api/gallery.json from what the
@@ -74,18 +75,6 @@ void WorldBox(const Pose& X_WB, const Eigen::Vector3d& lo, const Eigen::Vector3d
     *wlo = k ? wlo->cwiseMin(w) : w;
     *whi = k ? whi->cwiseMax(w) : w;
   }
-}
-
-/// Index I of "/api/thumbnail/I.png", or -1.
-long long ThumbnailIndex(const std::string& path) {
-  const std::string prefix = "/api/thumbnail/", suffix = ".png";
-  if (path.rfind(prefix, 0) != 0 || path.size() <= prefix.size() + suffix.size() ||
-      path.compare(path.size() - suffix.size(), suffix.size(), suffix) != 0)
-    return -1;
-  const std::string digits =
-      path.substr(prefix.size(), path.size() - prefix.size() - suffix.size());
-  if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return -1;
-  return std::stoll(digits);
 }
 
 }  // namespace
@@ -199,7 +188,7 @@ void Gallery::AttachTo(Viewer* viewer) {
     r({200, "application/json", GalleryJson()});
   });
   viewer->AddApiRoute("/api/thumbnail/", [this](const std::string& path, ViewerHttpRespond r) {
-    const long long i = ThumbnailIndex(path);
+    const long long i = internal::PathIndex(path, "/api/thumbnail/", ".png");
     if (i < 0 || i >= static_cast<long long>(objects_.size()))
       return r({404, "text/plain; charset=utf-8",
                 "no thumbnail '" + path + "': the gallery has objects 0 to " +

@@ -70,4 +70,14 @@ std::string ImageContentType(const std::string& bytes) {
   return "application/octet-stream";
 }
 
+long long PathIndex(const std::string& path, const std::string& prefix, const std::string& suffix) {
+  if (path.rfind(prefix, 0) != 0 || path.size() <= prefix.size() + suffix.size() ||
+      path.compare(path.size() - suffix.size(), suffix.size(), suffix) != 0)
+    return -1;
+  const std::string digits =
+      path.substr(prefix.size(), path.size() - prefix.size() - suffix.size());
+  if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return -1;
+  return std::stoll(digits);
+}
+
 }  // namespace partsim::internal

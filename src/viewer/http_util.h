@@ -18,6 +18,10 @@ std::string QueryValue(const std::string& query, const std::string& key);
 /// leaves the bundle folder ("/../", "%2e%2e", "\\", "//" and hidden files are refused).
 bool SafeBundlePath(const std::string& path);
 
+/// K of a path "PREFIX" + K + "SUFFIX" ("/api/mesh/12.bin" with "/api/mesh/" and ".bin": 12),
+/// K a decimal of at most 9 digits; -1 for any other path.
+long long PathIndex(const std::string& path, const std::string& prefix, const std::string& suffix);
+
 /// Content-Type of a file by its extension (".js" -> "text/javascript; charset=utf-8");
 /// "application/octet-stream" for others.
 std::string ContentTypeOf(const std::string& path);

@@ -895,18 +895,6 @@ struct Viewer::Impl {
     return false;
   }
 
-  /// Index K of "/api/mesh/K.bin" (prefix "/api/mesh/", suffix ".bin"), or -1.
-  static long long IndexIn(const std::string& path, const std::string& prefix,
-                           const std::string& suffix) {
-    if (path.rfind(prefix, 0) != 0 || path.size() <= prefix.size() + suffix.size() ||
-        path.compare(path.size() - suffix.size(), suffix.size(), suffix) != 0)
-      return -1;
-    const std::string digits =
-        path.substr(prefix.size(), path.size() - prefix.size() - suffix.size());
-    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return -1;
-    return std::stoll(digits);
-  }
-
   void Api(const std::string& path, int* status, std::string* body, std::string* type) {
     std::shared_ptr<const SceneContent> ct;
     std::shared_ptr<const MotionSnapshot> snap;
@@ -941,7 +929,7 @@ struct Viewer::Impl {
       *type = "application/json";
       return;
     }
-    const long long mesh = IndexIn(path, "/api/mesh/", ".bin");
+    const long long mesh = internal::PathIndex(path, "/api/mesh/", ".bin");
     if (mesh >= 0) {
       if (mesh >= static_cast<long long>(ct->meshes.size())) {
         *status = 404;
@@ -953,7 +941,7 @@ struct Viewer::Impl {
       *type = "application/octet-stream";
       return;
     }
-    const long long tex = IndexIn(path, "/api/texture/", ".png");
+    const long long tex = internal::PathIndex(path, "/api/texture/", ".png");
     if (tex >= 0 && tex < static_cast<long long>(ct->textures.size())) {
       const std::string& file = ct->textures[tex];
       std::error_code ec;

@@ -35,5 +35,16 @@ TEST(ViewerHttpTest, ContentTypesByExtensionAndSignature) {
   EXPECT_EQ(ImageContentType("GIF89a"), "application/octet-stream");
 }
 
+TEST(ViewerHttpTest, PathIndexReadsOnlyPlainDecimals) {
+  EXPECT_EQ(PathIndex("/api/mesh/12.bin", "/api/mesh/", ".bin"), 12);
+  EXPECT_EQ(PathIndex("/api/mesh/0.bin", "/api/mesh/", ".bin"), 0);
+  EXPECT_EQ(PathIndex("/api/mesh/.bin", "/api/mesh/", ".bin"), -1);
+  EXPECT_EQ(PathIndex("/api/mesh/-1.bin", "/api/mesh/", ".bin"), -1);
+  EXPECT_EQ(PathIndex("/api/mesh/1e3.bin", "/api/mesh/", ".bin"), -1);
+  EXPECT_EQ(PathIndex("/api/mesh/1234567890.bin", "/api/mesh/", ".bin"), -1);
+  EXPECT_EQ(PathIndex("/api/mesh/7.png", "/api/mesh/", ".bin"), -1);
+  EXPECT_EQ(PathIndex("/api/thumbnail/7.png", "/api/mesh/", ".png"), -1);
+}
+
 }  // namespace
 }  // namespace partsim::internal
