@@ -145,6 +145,10 @@ int RunServeCommand(int argc, char** argv) {
     return 0;
   });
   if (parsed != 0) return parsed;
+  // from here on Ctrl-C and SIGTERM end the server cleanly, whenever they come: a client that
+  // reads the printed address may stop it at once
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
 #ifndef PARTSIM_WITH_ROS1
   if (ros1) {
     std::fprintf(stderr,
@@ -267,8 +271,6 @@ int RunServeCommand(int argc, char** argv) {
           page->GetWebRoot().empty() ? " (web page not built: bash scripts/build_web.sh)" : "");
     std::fflush(stdout);
 
-    std::signal(SIGINT, OnSignal);
-    std::signal(SIGTERM, OnSignal);
     auto t0 = std::chrono::steady_clock::now();
     while (!g_stop) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));

@@ -97,8 +97,6 @@ int RunGallery(const std::string& root, const std::string& category, double time
                     ? " (web page not built: bash scripts/build_web.sh; the gallery is served)"
                     : "");
     std::fflush(stdout);
-    std::signal(SIGINT, OnSignal);
-    std::signal(SIGTERM, OnSignal);
     const auto t0 = std::chrono::steady_clock::now();
     gallery->Run([&] {
       return !g_stop &&
@@ -151,6 +149,10 @@ int RunViewCommand(int argc, char** argv) {
     return 0;
   });
   if (parsed != 0) return parsed;
+  // from here on Ctrl-C and SIGTERM end the command cleanly (exit 0), whenever they come: a
+  // client that reads the printed URL may stop it at once
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
   if (!dataset.empty() || !category.empty()) {
     if (dataset.empty()) {
       std::fprintf(stderr, "partsim view: --category needs --dataset ROOT\n");
@@ -200,8 +202,6 @@ int RunViewCommand(int argc, char** argv) {
                     : "");
     std::fflush(stdout);
 
-    std::signal(SIGINT, OnSignal);
-    std::signal(SIGTERM, OnSignal);
     const auto t0 = std::chrono::steady_clock::now();
     while (!g_stop && !viewer.IsClosed()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
