@@ -75,7 +75,7 @@ bash scripts/build_web.sh
 
 # the Debian package (build/partsim_<version>_<arch>.deb), again only when something in it changed
 deb=$(ls build/partsim_*.deb 2>/dev/null | head -n 1 || true)
-if [ -z "$deb" ] || [ -n "$(find build/partsim build/libpartsim.so* build/python/partsim include \
+if [ -z "$deb" ] || [ -n "$(find build/partsim build/libpartsim.so* build/python/partsim build/web include \
     -newer "$deb" -print -quit 2>/dev/null)" ]; then
   (cd build && cpack -G DEB >/dev/null) && echo "partsim setup: built $(ls build/partsim_*.deb)"
 fi
