@@ -1,7 +1,7 @@
 // A stand-in for partsim's viewer endpoint (docs/viewer.md) for working on the page without the
 // C++ server: build/web, a scene.json of a box cabinet with one drawer, PSMH meshes, and a
 // rosbridge v2 WebSocket with /partsim/poses, /partsim/joint_states, /partsim/status and the
-// services. Usage: node tests/web/mock_server.mjs [PORT] [--gallery] ; prints {"url": ...} and
+// services. Usage: node web/dev/mock_server.mjs [PORT] [--gallery] ; prints {"url": ...} and
 // serves until killed (or 10 minutes). --gallery: a stand-in for `partsim view --dataset` (six
 // made-up objects with grey thumbnails, /api/gallery.json, /partsim/open, /partsim/gallery).
 import http from 'node:http';
