@@ -135,3 +135,46 @@ export async function waitFor(page, fn, arg, timeoutMs, what) {
 }
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+/**
+ * Runs one browser check and ends the process with its result as one JSON line: launches
+ * Chromium at `viewport`, then `body(browser, result, note)` fills `result` (note(step) records
+ * how far it got). Exit 0 when body returns, 2 with {"skip": reason} when Chromium cannot start,
+ * 1 with {"error": ...} when body throws or `timeoutMs` passes.
+ */
+export function runCheck({ timeoutMs = 180000, viewport } = {}, body) {
+  const result = { ok: false, steps: [] };
+  const note = (s) => result.steps.push(s);
+  let browser = null;
+  const watchdog = setTimeout(async () => {
+    result.error = `timed out after ${timeoutMs} ms (last step: ${result.steps.at(-1)})`;
+    try { await browser?.close(); } catch { /* exiting anyway */ }
+    finish(result, 1);
+  }, timeoutMs);
+  const run = async () => {
+    try {
+      browser = await launch(viewport);
+    } catch (e) {
+      if (e.cannotStart) {
+        result.skip = e.message;
+        return 2;
+      }
+      throw e;
+    }
+    note('launched');
+    await body(browser, result, note);
+    return 0;
+  };
+  run()
+    .then(async (code) => {
+      clearTimeout(watchdog);
+      await browser?.close();
+      finish(result, code);
+    })
+    .catch(async (e) => {
+      clearTimeout(watchdog);
+      result.error = e.stack || String(e);
+      try { await browser?.close(); } catch { /* reported already */ }
+      finish(result, 1);
+    });
+}
