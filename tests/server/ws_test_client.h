@@ -2,6 +2,11 @@
 // a loopback port, running on a thread of its own.
 #pragma once
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <functional>
 #include <mutex>
@@ -80,6 +85,65 @@ class WsTestClient {
   std::thread thread_;
   std::atomic<bool> open_{false}, closed_{false};
   std::atomic<int> close_code_{0};
+};
+
+/// A raw TCP connection to a loopback port that performs the WebSocket handshake (to `path`) and
+/// then writes frames by hand and reads nothing: what a hostile or stuck client does.
+class RawSocket {
+ public:
+  explicit RawSocket(int port, const std::string& path = "/") {
+    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<uint16_t>(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ok_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0;
+    int small = 4096;  // a small receive buffer so that the server's writes back up
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
+    std::string req =
+        "GET " + path +
+        " HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
+    Write(req);
+    // read the handshake response only
+    std::string resp;
+    char ch;
+    while (resp.find("\r\n\r\n") == std::string::npos && ::read(fd_, &ch, 1) == 1) resp += ch;
+    ok_ = ok_ && resp.find(" 101 ") != std::string::npos;
+  }
+  ~RawSocket() { Close(); }
+  bool Ok() const { return ok_; }
+  void Write(const std::string& bytes) {
+    size_t off = 0;
+    while (off < bytes.size()) {
+      ssize_t n = ::send(fd_, bytes.data() + off, bytes.size() - off, MSG_NOSIGNAL);
+      if (n <= 0) return;
+      off += static_cast<size_t>(n);
+    }
+  }
+  /// Header of a masked text frame (mask 0, so the payload goes as it is) of `len` bytes.
+  static std::string FrameHeader(size_t len) {
+    std::string h;
+    h += static_cast<char>(0x81);
+    if (len < 126) {
+      h += static_cast<char>(0x80 | len);
+    } else {
+      h += static_cast<char>(0x80 | 126);
+      h += static_cast<char>((len >> 8) & 0xff);
+      h += static_cast<char>(len & 0xff);
+    }
+    h += std::string(4, '\0');
+    return h;
+  }
+  void SendText(const std::string& text) { Write(FrameHeader(text.size()) + text); }
+  void Close() {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+
+ private:
+  int fd_ = -1;
+  bool ok_ = false;
 };
 
 /// The JSON messages a test client kept, shared between its thread and the test's.

@@ -611,6 +611,11 @@ TEST_F(ViewerTest, BadMessagesGetErrorsAndTheViewerGoesOn) {
        "picture must be"},
       {R"({"op": "call_service", "service": "/partsim/pause", "args": [1]})",
        "args must be an object"},
+      // hostile: nesting past the parser's bound, an id of 1e300, non-ASCII garbage in a name
+      {std::string(200, '[') + std::string(200, ']'), "nested deeper than"},
+      {R"({"op": "call_service", "service": "/partsim/set_joint_target", "args": {"articulation": 1e300, "joint": "j", "position": 0}})",
+       "integer 'articulation'"},
+      {"{\"op\": \"subscribe\", \"topic\": \"/\u00e9\u00e8\u4e2d\u6587\"}", "no topic"},
   };
   for (const Case& k : cases) {
     c.Clear();
@@ -646,6 +651,72 @@ TEST_F(ViewerTest, BadMessagesGetErrorsAndTheViewerGoesOn) {
   after.Auth(v.GetToken());
   EXPECT_EQ(HttpGet(v.GetPort(), Api("/api/scene.json")).status, 200);
   EXPECT_GT(v.GetStats().errors, 10);
+}
+
+TEST_F(ViewerTest, BytesThatAreNotUtf8CloseThatConnectionOnly) {
+  Viewer& v = Start();
+  testing::RawSocket raw(v.GetPort());
+  ASSERT_TRUE(raw.Ok());
+  raw.SendText("{\"op\": \"auth\", \"mac\": \"\xff\xfe\xc0\x80\"}");  // invalid UTF-8
+  raw.SendText(std::string("\xff\xfe\xfd garbage \x80\x81", 14));
+  for (int i = 0; i < 20; ++i) {
+    scene_->Step();
+    v.Render();
+  }
+  TestClient after(v.GetPort());
+  ASSERT_TRUE(after.WaitOpen());
+  after.Auth(v.GetToken());
+  EXPECT_EQ(HttpGet(v.GetPort(), Api("/api/scene.json")).status, 200);
+}
+
+TEST_F(ViewerTest, ClientThatNeverReadsStallsNeitherRenderNorOthers) {
+  // 300 kinematic boxes, all moved at every step: each pose message is about 20 kB
+  std::vector<Actor> boxes;
+  for (int k = 0; k < 300; ++k) {
+    auto b = scene_->CreateActorBuilder();
+    b.AddBoxVisual(Pose(), Eigen::Vector3d(0.01, 0.01, 0.01));
+    b.SetInitialPose(Pose(Eigen::Vector3d(0.05 * k, 3, 0.5)));
+    boxes.push_back(b.BuildKinematic());
+  }
+  auto move = [&](int step) {
+    for (size_t k = 0; k < boxes.size(); ++k)
+      boxes[k].SetPose(Pose(Eigen::Vector3d(0.05 * k, 3, 0.5 + 0.001 * (step % 100))));
+    scene_->Step();
+  };
+  ViewerOptions o;
+  o.max_rate = 1000;                 // a pose message at nearly every Render()
+  o.max_client_buffered = 64 << 10;  // drops begin after 64 kB wait in the sleeper's socket
+  Viewer& v = Start(o);
+  testing::RawSocket sleeper(v.GetPort());  // subscribes, then reads nothing
+  ASSERT_TRUE(sleeper.Ok());
+  sleeper.SendText(json{{"op", "auth"}, {"mac", v.GetToken()}}.dump());
+  sleeper.SendText(json{{"op", "subscribe"}, {"topic", "/partsim/poses"}}.dump());
+  TestClient reader(v.GetPort());
+  ASSERT_TRUE(reader.WaitOpen());
+  reader.Auth(v.GetToken());
+  reader.Send(json{{"op", "subscribe"}, {"topic", "/partsim/poses"}});
+  double slowest = 0;
+  int step = 0;
+  for (; step < 5000 && v.GetStats().messages_dropped == 0; ++step) {
+    move(step);
+    const auto t0 = std::chrono::steady_clock::now();
+    v.Render();
+    slowest = std::max(
+        slowest, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  EXPECT_GT(v.GetStats().messages_dropped, 0) << "no drop after " << step << " steps";
+  EXPECT_LT(slowest, 0.25) << "Render() waited for the network";
+  // the reader still gets what moves after the drops began
+  reader.Clear();
+  for (int i = 0; i < 20; ++i) {
+    move(step + i);
+    v.Render();
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_FALSE(
+      reader.WaitMessage([](const json& m) { return m.value("topic", "") == "/partsim/poses"; })
+          .is_null());
 }
 
 TEST_F(ViewerTest, ServedModeFollowsTheSimServer) {
