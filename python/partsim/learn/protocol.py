@@ -225,17 +225,21 @@ def _read_run(run: str) -> dict:
     return doc
 
 
-def _agent_and_buffer(config: RunConfig, env):
-    from .replay import ReplayBuffer
+def _make_agent(config: RunConfig, env):
+    """A fresh SAC agent for the run's options and the environment's spaces."""
     from .sac import SAC, SACConfig
 
     sac = SACConfig(hidden_sizes=tuple(config.hidden_sizes), lr=config.lr,
                     batch_size=config.batch_size, init_alpha=config.init_alpha)
-    agent = SAC(env.single_observation_space, env.single_action_space, sac, seed=config.seed)
+    return SAC(env.single_observation_space, env.single_action_space, sac, seed=config.seed)
+
+
+def _make_buffer(config: RunConfig, env, action_dim: int):
+    """The run's replay buffer (training only: evaluation needs none)."""
+    from .replay import ReplayBuffer
+
     capacity = config.buffer_size or (20_000 if config.obs == "visual" else 1_000_000)
-    buffer = ReplayBuffer(capacity, env.single_observation_space, agent.action_dim,
-                          seed=config.seed)
-    return agent, buffer
+    return ReplayBuffer(capacity, env.single_observation_space, action_dim, seed=config.seed)
 
 
 def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
@@ -285,7 +289,8 @@ def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
         torch.set_num_threads(1)
     env = _make_env(config, train_objs, config.num_envs)
     try:
-        agent, buffer = _agent_and_buffer(config, env)
+        agent = _make_agent(config, env)
+        buffer = _make_buffer(config, env, agent.action_dim)
         loop = TrainConfig(total_steps=config.steps, warmup_steps=config.warmup_steps,
                            updates_per_step=config.updates_per_step,
                            checkpoint_interval=config.checkpoint_interval,
@@ -323,7 +328,7 @@ def _load_agent(run: str, config: RunConfig, env):
 
     from .trainer import POINTER
 
-    agent, _ = _agent_and_buffer(config, env)
+    agent = _make_agent(config, env)
     pointer = os.path.join(run, POINTER)
     try:
         with open(pointer, encoding="utf-8") as f:
