@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -36,10 +37,14 @@ constexpr char kDetectionDatasetUsage[] =
 )";
 
 constexpr char kMotionDatasetUsage[] =
-    R"(  partsim vision motion-dataset --dataset ROOT --out DIR [the options above]
-      Motion-attribute data: per door (hinge) and drawer (slider) of the objects under ROOT,
-      --views samples (RGB, depth, the part's mask) and DIR/motion_train.json and
-      motion_test.json with the label vector m in the camera frame, as evaluate-motion reads.
+    R"(  partsim vision motion-dataset --dataset ROOT --out DIR [--parts door,drawer]
+                 [the options above]
+      Motion-attribute data: per target part of the objects under ROOT, --views samples (RGB,
+      depth, the part's mask) and DIR/motion_train.json and motion_test.json with the label
+      vector m in the camera frame, as evaluate-motion reads. The targets are the parts whose
+      label contains a word of --parts (default door,drawer: the paper's set; e.g. lid, or
+      knob,button) and that move on a hinge or a slider (one that also turns, a screw cap,
+      counts as a slider).
 )";
 
 constexpr char kEvaluateDetectionUsage[] =
@@ -177,6 +182,17 @@ vision::DatasetOptions ParseDatasetArgs(const std::string& name, vision::Dataset
     o.backend = v.Choice({"rasterizer", "pathtracer"});
   });
   p.Switch("--no-point-clouds", [&] { o.point_clouds = false; });
+  if (kind == vision::DatasetKind::kMotion)
+    p.Option("--parts", [&](const FlagValue& v) {
+      o.motion_parts.clear();
+      std::stringstream words(v.NonEmpty("label words separated by commas"));
+      for (std::string w; std::getline(words, w, ',');) {
+        if (w.empty() || w.find_first_of(" \t") != std::string::npos)
+          p.Fail("--parts wants label words separated by commas (e.g. door,drawer), got '" +
+                 v.Text() + "'");
+        o.motion_parts.push_back(w);
+      }
+    });
   p.Switch("--merge-only", [&] { o.merge_only = true; });
   p.Switch("--quiet", [&] { o.progress = false; });
   p.Parse(args);

@@ -2,6 +2,7 @@
 #include "partsim/vision/dataset.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -46,19 +48,44 @@ constexpr std::uint64_t kMaxDatasetFileBytes = std::uint64_t{1} << 30;
 // ---------------------------------------------------------------------------------------------
 // the objects of a dataset
 
-// A link that is a door (a hinge whose label names a door) or a drawer (a slider whose label
-// names a drawer): the targets of the motion dataset.
-enum class Target { kNone, kDoor, kDrawer };
+// The motion dataset's targets: labelled links whose label contains one of
+// DatasetOptions::motion_parts and that move on a hinge (a revolute or continuous joint) or a
+// slider (a prismatic joint; also one that turns as it slides, whose slide is its helper link's
+// joint). The paper's set is doors and drawers.
+enum class Motion { kNone, kHinge, kSlider };
 
-Target TargetOf(const PartNetLink& link) {
-  const std::string& label = link.semantic_label;
+bool IsHinge(JointType type) {
+  return type == JointType::kRevolute || type == JointType::kContinuous;
+}
+
+Motion MotionOf(const PartNetLink& link, const std::vector<std::string>& words) {
+  if (std::none_of(words.begin(), words.end(), [&](const std::string& w) {
+        return link.semantic_label.find(w) != std::string::npos;
+      }))
+    return Motion::kNone;
   const JointType type = PartNetMobilityObject::MotionJointType(link);
-  if ((type == JointType::kRevolute || type == JointType::kContinuous) &&
-      label.find("door") != std::string::npos)
-    return Target::kDoor;
-  if (type == JointType::kPrismatic && label.find("drawer") != std::string::npos)
-    return Target::kDrawer;
-  return Target::kNone;
+  if (IsHinge(type)) return Motion::kHinge;
+  if (type == JointType::kPrismatic) return Motion::kSlider;
+  return Motion::kNone;
+}
+
+// The link whose joint is the motion of labelled link `link` of `desc`: the link itself, or its
+// helper parent for a slider that turns; -1 when mobility.urdf's joint there is not of the
+// motion's kind (the loader has warned about the disagreement).
+int MotionLink(const ArticulationDesc& desc, const PartNetLink& pl, int link) {
+  const int m = pl.rotates ? desc.links[static_cast<std::size_t>(link)].parent : link;
+  if (m < 0) return -1;
+  const JointType want = PartNetMobilityObject::MotionJointType(pl);
+  const JointType have = desc.links[static_cast<std::size_t>(m)].joint.type;
+  return (IsHinge(want) ? IsHinge(have) : have == want) ? m : -1;
+}
+
+// "'a'", "'a' or 'b'", "'a', 'b' or 'c'"
+std::string OneOf(const std::vector<std::string>& words) {
+  std::string out;
+  for (std::size_t k = 0; k < words.size(); ++k)
+    out += (k == 0 ? "" : k + 1 == words.size() ? " or " : ", ") + ("'" + words[k] + "'");
+  return out;
 }
 
 struct ObjectInfo {
@@ -66,8 +93,8 @@ struct ObjectInfo {
   std::string name;                 // unique in the dataset: its path under the root, '/' -> '_'
   std::string category;             // meta.json model_cat, "Unknown" when absent
   std::vector<std::string> labels;  // "Category/label" of its labelled links
-  int doors = 0, drawers = 0;
-  double max_slider_range = 0;  // of its drawers, m
+  int hinges = 0, sliders = 0;      // motion targets
+  double max_slider_range = 0;      // of its slider targets, m
   bool train = true;
 };
 
@@ -174,6 +201,31 @@ void RunParts(int jobs, int count, const std::function<void(int)>& part) {
   pool.Start(count, part);
   pool.Wait();
 }
+
+// One step of work at a time on a second thread, in the order given: an object's views are
+// written there while the next view renders (a view's files and masks cost about as much CPU as
+// its picture, so a worker that waited for both left the cores idle while llvmpipe's threads
+// synchronised). Submit waits for the step before (rethrowing what it threw); Finish waits for
+// the last; destroying the stage waits too, so that no step outlives the buffers it reads.
+class BackgroundStage {
+ public:
+  BackgroundStage() = default;
+  BackgroundStage(const BackgroundStage&) = delete;
+  BackgroundStage& operator=(const BackgroundStage&) = delete;
+  ~BackgroundStage() {
+    if (pending_.valid()) pending_.wait();
+  }
+  void Submit(std::function<void()> step) {
+    Finish();
+    pending_ = std::async(std::launch::async, std::move(step));
+  }
+  void Finish() {
+    if (pending_.valid()) pending_.get();
+  }
+
+ private:
+  std::future<void> pending_;
+};
 
 // ---------------------------------------------------------------------------------------------
 // rendering one object
@@ -488,91 +540,100 @@ json RenderDetectionObject(const DatasetOptions& options, const std::string& fol
     labelled[static_cast<std::size_t>(link)] = pl;
     category_of[static_cast<std::size_t>(link)] = category_ids.at(PartCategory(category, *pl));
   }
+  std::vector<std::string> link_names(num_links);
+  for (std::size_t link = 0; link < num_links; ++link)
+    link_names[link] = r.GetArticulation().GetLink(static_cast<int>(link)).GetName();
   for (const char* sub : {"rgb", "depth", "instances", "cloud"})
     fs::create_directories(dir + "/" + sub);
   Random rng(Hash(options.seed, name));
   const double min_pixels = options.min_area_fraction * options.size * options.size;
   json views = json::array();
-  View v;
+  // the scratch of the writing step, one step at a time
   std::vector<long> pixels(num_links);
   std::vector<int> instance_of(num_links);  // link -> instance number (1-based), 0 none
   std::vector<std::uint16_t> instance_map;
+  // view k renders into buffer k % 2 while view k - 1 is written from the other
+  std::array<View, 2> buffers;
+  BackgroundStage writing;
   for (int k = 0; k < options.views; ++k) {
-    const Eigen::VectorXd q = r.DrawJointPositions(&rng);
-    r.Render(q, &rng, &v);
+    View& v = buffers[static_cast<std::size_t>(k % 2)];
+    r.Render(r.DrawJointPositions(&rng), &rng, &v);
     ++*views_rendered;
-    const std::string stem = Two(k);
-    WriteViewPictures(dir, stem, v);
-    // pixel counts of the labelled links seen; instances numbered in link order
-    std::fill(pixels.begin(), pixels.end(), 0);
-    for (int l : v.link)
-      if (l >= 0) ++pixels[static_cast<std::size_t>(l)];
-    std::fill(instance_of.begin(), instance_of.end(), 0);
-    std::vector<std::size_t> instance_links;  // instance number - 1 -> link
-    for (std::size_t link = 0; link < num_links; ++link) {
-      if (!labelled[link] || pixels[link] == 0) continue;
-      if (static_cast<double>(pixels[link]) < min_pixels) continue;
-      instance_links.push_back(link);
-      instance_of[link] = static_cast<int>(instance_links.size());
-    }
-    const std::size_t n = v.link.size();
-    instance_map.assign(n, 0);
-    for (std::size_t i = 0; i < n; ++i)
-      if (v.link[i] >= 0)
-        instance_map[i] =
-            static_cast<std::uint16_t>(instance_of[static_cast<std::size_t>(v.link[i])]);
-    const std::vector<Rle> rles =
-        EncodeInstances(instance_map, v.width, v.height, static_cast<int>(instance_links.size()));
-    json instances = json::array();
-    for (std::size_t m = 0; m < instance_links.size(); ++m) {
-      const std::size_t link = instance_links[m];
-      const PartNetLink& pl = *labelled[link];
-      const Rle& rle = rles[m + 1];
-      const std::array<double, 4> box = RleBoundingBox(rle);
-      instances.push_back({{"instance", m + 1},
-                           {"link", r.GetArticulation().GetLink(static_cast<int>(link)).GetName()},
-                           {"label", pl.semantic_label},
-                           {"category", PartCategory(category, pl)},
-                           {"joint", pl.joint},
-                           {"area", RleArea(rle)},
-                           {"bbox", {box[0], box[1], box[2], box[3]}},
-                           {"segmentation", RleJson(rle)}});
-    }
-    WritePng16(dir + "/instances/" + stem + ".png", v.width, v.height, instance_map.data(),
-               kPngCompression);
-    if (options.point_clouds) {
-      // every pixel that sees a surface, in pixel order
-      std::size_t m = 0;
-      for (float d : v.depth) m += d > 0 ? 1 : 0;
-      std::vector<float> xyz(3 * m);
-      std::vector<std::uint8_t> rgb(3 * m);
-      std::vector<std::int32_t> instance(m), label(m);
-      for (std::size_t i = 0, j = 0; i < n; ++i) {
-        if (!(v.depth[i] > 0)) continue;
-        for (int c = 0; c < 3; ++c) {
-          xyz[3 * j + c] = v.point[i][c];
-          rgb[3 * j + c] = v.rgb[3 * i + c];
-        }
-        instance[j] = instance_map[i];
-        label[j] = instance_map[i] ? category_of[static_cast<std::size_t>(v.link[i])] : 0;
-        ++j;
+    writing.Submit([&, k, &v = v] {
+      const std::string stem = Two(k);
+      WriteViewPictures(dir, stem, v);
+      // pixel counts of the labelled links seen; instances numbered in link order
+      std::fill(pixels.begin(), pixels.end(), 0);
+      for (int l : v.link)
+        if (l >= 0) ++pixels[static_cast<std::size_t>(l)];
+      std::fill(instance_of.begin(), instance_of.end(), 0);
+      std::vector<std::size_t> instance_links;  // instance number - 1 -> link
+      for (std::size_t link = 0; link < num_links; ++link) {
+        if (!labelled[link] || pixels[link] == 0) continue;
+        if (static_cast<double>(pixels[link]) < min_pixels) continue;
+        instance_links.push_back(link);
+        instance_of[link] = static_cast<int>(instance_links.size());
       }
-      internal::WriteNpz(
-          dir + "/cloud/" + stem + ".npz",
-          {internal::MakeNpyArray("xyz", xyz, {m, 3}), internal::MakeNpyArray("rgb", rgb, {m, 3}),
-           internal::MakeNpyArray("instance", instance, {m}),
-           internal::MakeNpyArray("label", label, {m})});
-    }
-    views.push_back({{"view", k},
-                     {"rgb", "rgb/" + stem + ".png"},
-                     {"depth", "depth/" + stem + ".png"},
-                     {"depth_npy", "depth/" + stem + ".npy"},
-                     {"instances_png", "instances/" + stem + ".png"},
-                     {"cloud", options.point_clouds ? "cloud/" + stem + ".npz" : ""},
-                     {"camera", CameraJson(v)},
-                     {"qpos", std::vector<double>(q.data(), q.data() + q.size())},
-                     {"instances", instances}});
+      const std::size_t n = v.link.size();
+      instance_map.assign(n, 0);
+      for (std::size_t i = 0; i < n; ++i)
+        if (v.link[i] >= 0)
+          instance_map[i] =
+              static_cast<std::uint16_t>(instance_of[static_cast<std::size_t>(v.link[i])]);
+      const std::vector<Rle> rles =
+          EncodeInstances(instance_map, v.width, v.height, static_cast<int>(instance_links.size()));
+      json instances = json::array();
+      for (std::size_t m = 0; m < instance_links.size(); ++m) {
+        const std::size_t link = instance_links[m];
+        const PartNetLink& pl = *labelled[link];
+        const Rle& rle = rles[m + 1];
+        const std::array<double, 4> box = RleBoundingBox(rle);
+        instances.push_back({{"instance", m + 1},
+                             {"link", link_names[link]},
+                             {"label", pl.semantic_label},
+                             {"category", PartCategory(category, pl)},
+                             {"joint", pl.joint},
+                             {"area", RleArea(rle)},
+                             {"bbox", {box[0], box[1], box[2], box[3]}},
+                             {"segmentation", RleJson(rle)}});
+      }
+      WritePng16(dir + "/instances/" + stem + ".png", v.width, v.height, instance_map.data(),
+                 kPngCompression);
+      if (options.point_clouds) {
+        // every pixel that sees a surface, in pixel order
+        std::size_t m = 0;
+        for (float d : v.depth) m += d > 0 ? 1 : 0;
+        std::vector<float> xyz(3 * m);
+        std::vector<std::uint8_t> rgb(3 * m);
+        std::vector<std::int32_t> instance(m), label(m);
+        for (std::size_t i = 0, j = 0; i < n; ++i) {
+          if (!(v.depth[i] > 0)) continue;
+          for (int c = 0; c < 3; ++c) {
+            xyz[3 * j + c] = v.point[i][c];
+            rgb[3 * j + c] = v.rgb[3 * i + c];
+          }
+          instance[j] = instance_map[i];
+          label[j] = instance_map[i] ? category_of[static_cast<std::size_t>(v.link[i])] : 0;
+          ++j;
+        }
+        internal::WriteNpz(
+            dir + "/cloud/" + stem + ".npz",
+            {internal::MakeNpyArray("xyz", xyz, {m, 3}), internal::MakeNpyArray("rgb", rgb, {m, 3}),
+             internal::MakeNpyArray("instance", instance, {m}),
+             internal::MakeNpyArray("label", label, {m})});
+      }
+      views.push_back({{"view", k},
+                       {"rgb", "rgb/" + stem + ".png"},
+                       {"depth", "depth/" + stem + ".png"},
+                       {"depth_npy", "depth/" + stem + ".npy"},
+                       {"instances_png", "instances/" + stem + ".png"},
+                       {"cloud", options.point_clouds ? "cloud/" + stem + ".npz" : ""},
+                       {"camera", CameraJson(v)},
+                       {"qpos", std::vector<double>(v.qpos.data(), v.qpos.data() + v.qpos.size())},
+                       {"instances", instances}});
+    });
   }
+  writing.Finish();
   return {{"object", name}, {"category", category}, {"views", views}};
 }
 
@@ -589,14 +650,21 @@ json RenderMotionObject(const DatasetOptions& options, const std::string& folder
   Random rng(Hash(options.seed, name));
   const double min_pixels = options.min_area_fraction * options.size * options.size;
   json samples = json::array();
-  View v;
+  // a sample renders into one buffer while the one before is written from the other
+  std::array<View, 2> buffers;
+  std::size_t next = 0;
+  BackgroundStage writing;
   for (const auto& [link, pl] : LabelledLinks(o)) {
-    const Target target = TargetOf(*pl);
-    if (target == Target::kNone) continue;
-    const Joint joint = art.GetJoint(link);
+    const Motion motion = MotionOf(*pl, options.motion_parts);
+    const int motion_link = motion == Motion::kNone ? -1 : MotionLink(o.articulation, *pl, link);
+    if (motion_link < 0) continue;
+    const Joint joint = art.GetJoint(motion_link);
     const int dof = joint.GetDofIndex();
     if (dof < 0) continue;
+    const std::string link_name = art.GetLink(link).GetName();
+    const double lower = joint.GetLimits()[0];
     for (int k = 0; k < options.views; ++k) {
+      View& v = buffers[next];
       bool seen = false;
       for (int attempt = 0; attempt < 10 && !seen; ++attempt) {
         r.Render(r.DrawJointPositions(&rng), &rng, &v);
@@ -605,50 +673,56 @@ json RenderMotionObject(const DatasetOptions& options, const std::string& folder
         seen = static_cast<double>(count) >= min_pixels;
       }
       if (!seen) continue;
-      const std::string stem = art.GetLink(link).GetName() + "_" + Two(k);
-      WriteViewPictures(dir, stem, v);
-      std::vector<std::uint8_t> mask(v.link.size());
-      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-      long count = 0;
-      for (std::size_t i = 0; i < v.link.size(); ++i) {
-        mask[i] = v.link[i] == link ? 255 : 0;
-        if (mask[i] && v.depth[i] > 0) {
-          centroid += v.point[i].cast<double>();
-          ++count;
-        }
-      }
-      if (count > 0) centroid /= static_cast<double>(count);
-      WritePng(dir + "/mask/" + stem + ".png", v.width, v.height, 1, mask.data(), kPngCompression);
-      // the joint's axis in the OpenCV camera frame; the pivot is the point of the axis nearest
-      // the centroid of the part's visible points
+      next = 1 - next;
+      // the joint's frame at the sample's joint positions (what Render left), read here: the
+      // scene stays on this thread
       art.SetQpos(v.qpos);
       const Pose X_WJ = joint.GetGlobalPose();
-      const Eigen::Matrix3d R = v.extrinsic.leftCols<3>();
-      const Eigen::Vector3d t = v.extrinsic.col(3);
-      const Eigen::Vector3d origin = R * X_WJ.p + t;
-      const Eigen::Vector3d axis = (R * (X_WJ.q * Eigen::Vector3d::UnitX())).normalized();
-      const Eigen::Vector3d pivot = origin + axis * axis.dot(centroid - origin);
-      const double lower = joint.GetLimits()[0];
-      // the opening from the lower limit; a hinge without limits (continuous) from 0, in
-      // [0, 2 pi)
-      double state = v.qpos[dof] - (std::isfinite(lower) ? lower : 0.0);
-      if (!std::isfinite(lower)) state = std::fmod(std::fmod(state, 2 * kPi) + 2 * kPi, 2 * kPi);
-      samples.push_back(
-          {{"sample_id", name + "/" + stem},
-           {"link", art.GetLink(link).GetName()},
-           {"label", pl->semantic_label},
-           {"type", target == Target::kDoor ? "hinge" : "slider"},
-           {"rgb", "rgb/" + stem + ".png"},
-           {"depth", "depth/" + stem + ".png"},
-           {"depth_npy", "depth/" + stem + ".npy"},
-           {"mask", "mask/" + stem + ".png"},
-           {"camera", CameraJson(v)},
-           {"qpos", std::vector<double>(v.qpos.data(), v.qpos.data() + v.qpos.size())},
-           {"pivot", {pivot.x(), pivot.y(), pivot.z()}},
-           {"axis", {axis.x(), axis.y(), axis.z()}},
-           {"state", state}});
+      writing.Submit([&, k, link = link, pl = pl, motion, dof, lower, link_name, X_WJ, &v = v] {
+        const std::string stem = link_name + "_" + Two(k);
+        WriteViewPictures(dir, stem, v);
+        std::vector<std::uint8_t> mask(v.link.size());
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        long count = 0;
+        for (std::size_t i = 0; i < v.link.size(); ++i) {
+          mask[i] = v.link[i] == link ? 255 : 0;
+          if (mask[i] && v.depth[i] > 0) {
+            centroid += v.point[i].cast<double>();
+            ++count;
+          }
+        }
+        if (count > 0) centroid /= static_cast<double>(count);
+        WritePng(dir + "/mask/" + stem + ".png", v.width, v.height, 1, mask.data(),
+                 kPngCompression);
+        // the joint's axis in the OpenCV camera frame; the pivot is the point of the axis
+        // nearest the centroid of the part's visible points
+        const Eigen::Matrix3d R = v.extrinsic.leftCols<3>();
+        const Eigen::Vector3d t = v.extrinsic.col(3);
+        const Eigen::Vector3d origin = R * X_WJ.p + t;
+        const Eigen::Vector3d axis = (R * (X_WJ.q * Eigen::Vector3d::UnitX())).normalized();
+        const Eigen::Vector3d pivot = origin + axis * axis.dot(centroid - origin);
+        // the opening from the lower limit; a hinge without limits (continuous) from 0, in
+        // [0, 2 pi)
+        double state = v.qpos[dof] - (std::isfinite(lower) ? lower : 0.0);
+        if (!std::isfinite(lower)) state = std::fmod(std::fmod(state, 2 * kPi) + 2 * kPi, 2 * kPi);
+        samples.push_back(
+            {{"sample_id", name + "/" + stem},
+             {"link", link_name},
+             {"label", pl->semantic_label},
+             {"type", motion == Motion::kHinge ? "hinge" : "slider"},
+             {"rgb", "rgb/" + stem + ".png"},
+             {"depth", "depth/" + stem + ".png"},
+             {"depth_npy", "depth/" + stem + ".npy"},
+             {"mask", "mask/" + stem + ".png"},
+             {"camera", CameraJson(v)},
+             {"qpos", std::vector<double>(v.qpos.data(), v.qpos.data() + v.qpos.size())},
+             {"pivot", {pivot.x(), pivot.y(), pivot.z()}},
+             {"axis", {axis.x(), axis.y(), axis.z()}},
+             {"state", state}});
+      });
     }
   }
+  writing.Finish();
   return {{"object", name}, {"category", CategoryOf(o)}, {"samples", samples}};
 }
 
@@ -773,20 +847,27 @@ void CheckOptions(const DatasetOptions& o) {
                        "vision dataset: the minimum area fraction must be in [0, 1)");
   PARTSIM_THROW_UNLESS(o.fovy_degrees > 1 && o.fovy_degrees < 170,
                        "vision dataset: the field of view must be in (1, 170) degrees");
+  PARTSIM_THROW_UNLESS(!o.motion_parts.empty(), "vision dataset: --parts names no label word");
+  for (const std::string& w : o.motion_parts)
+    PARTSIM_THROW_UNLESS(
+        !w.empty() && w.find_first_of(" ,\t\n") == std::string::npos,
+        "vision dataset: --parts takes label words without spaces, got '" + w + "'");
 }
 
 // The options that decide the bytes of a dataset, as dataset.json records them; a run into an
 // existing dataset must agree with them.
 json DefiningOptions(const DatasetOptions& o) {
-  return {{"kind", o.kind == DatasetKind::kDetection ? "detection" : "motion"},
-          {"views", o.views},
-          {"size", o.size},
-          {"seed", o.seed},
-          {"split", o.split},
-          {"backend", o.backend},
-          {"min_area_fraction", o.min_area_fraction},
-          {"fovy_degrees", o.fovy_degrees},
-          {"point_clouds", o.point_clouds}};
+  json options = {{"kind", o.kind == DatasetKind::kDetection ? "detection" : "motion"},
+                  {"views", o.views},
+                  {"size", o.size},
+                  {"seed", o.seed},
+                  {"split", o.split},
+                  {"backend", o.backend},
+                  {"min_area_fraction", o.min_area_fraction},
+                  {"fovy_degrees", o.fovy_degrees},
+                  {"point_clouds", o.point_clouds}};
+  if (o.kind == DatasetKind::kMotion) options["parts"] = o.motion_parts;
+  return options;
 }
 
 std::string Duration(double seconds) {
@@ -824,11 +905,13 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
       info.category = CategoryOf(o);
       for (const auto& [link, pl] : LabelledLinks(o)) {
         info.labels.push_back(PartCategory(info.category, *pl));
-        const Target t = TargetOf(*pl);
-        if (t == Target::kDoor) ++info.doors;
-        if (t == Target::kDrawer) {
-          ++info.drawers;
-          const JointDesc& j = o.articulation.links[link].joint;
+        const Motion motion = MotionOf(*pl, options.motion_parts);
+        const int m = motion == Motion::kNone ? -1 : MotionLink(o.articulation, *pl, link);
+        if (m < 0) continue;
+        if (motion == Motion::kHinge) ++info.hinges;
+        if (motion == Motion::kSlider) {
+          ++info.sliders;
+          const JointDesc& j = o.articulation.links[static_cast<std::size_t>(m)].joint;
           if (std::isfinite(j.upper - j.lower))
             info.max_slider_range = std::max(info.max_slider_range, j.upper - j.lower);
         }
@@ -848,14 +931,16 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
       continue;
     }
     ObjectInfo& info = parsed[f];
-    if (options.kind == DatasetKind::kMotion && info.doors + info.drawers == 0) continue;
+    if (options.kind == DatasetKind::kMotion && info.hinges + info.sliders == 0) continue;
     objects.push_back(std::move(info));
   }
   if (objects.empty())
     throw Error("vision dataset: none of the " + std::to_string(folders.size()) +
                 " objects under '" + options.dataset_root + "' can be used" +
                 (options.kind == DatasetKind::kMotion
-                     ? " (the motion dataset needs doors or drawers)"
+                     ? " (the motion dataset needs parts whose label contains " +
+                           OneOf(options.motion_parts) +
+                           " on a hinge or a slider; --parts chooses the words)"
                      : "") +
                 (summary.errors.empty() ? "" : "; first error: " + summary.errors.front()));
   summary.objects = static_cast<int>(objects.size());

@@ -251,9 +251,41 @@ TEST(DatasetTest, BadOptionsAreRefusedByName) {
   b.split = 1.5;
   refused(b, "--split");
   b = o;
+  b.motion_parts = {};
+  refused(b, "--parts");
+  b = o;
+  b.motion_parts = {"door", "left door"};
+  refused(b, "--parts");
+  b = o;
   b.dataset_root = Temp("empty");
   fs::create_directories(b.dataset_root);
   refused(b, "no PartNet-Mobility object");
+}
+
+// DatasetOptions::motion_parts (--parts) chooses the targets by a word of their label: with
+// {"drawer"} every sample is a slider and the doors are left out.
+TEST(DatasetTest, MotionPartsChooseTheTargetsByLabel) {
+  const std::string out = Temp("motion_parts");
+  DatasetOptions o = SmallOptions(out, DatasetKind::kMotion);
+  o.views = 1;
+  o.motion_parts = {"drawer"};
+  const DatasetSummary s = GenerateDataset(o);
+  EXPECT_GT(s.objects, 0);
+  const MotionGroundTruth train = LoadMotionGroundTruth(out + "/motion_train.json");
+  ASSERT_FALSE(train.samples.empty());
+  for (const MotionSample& m : train.samples) {
+    EXPECT_EQ(m.m[kMotionSlider], 1) << m.sample_id;
+    EXPECT_EQ(m.m[kMotionHinge], 0) << m.sample_id;
+  }
+  // a word no label holds: nothing to render, said with the words
+  o.out = Temp("motion_parts_none");
+  o.motion_parts = {"no-such-part"};
+  try {
+    GenerateDataset(o);
+    ADD_FAILURE() << "expected the dataset to be refused";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'no-such-part'"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

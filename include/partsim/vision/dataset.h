@@ -32,8 +32,8 @@ struct DatasetOptions {
   std::string dataset_root;  ///< folder holding PartNet-Mobility object folders, at any depth
   std::string out;           ///< output folder
   DatasetKind kind = DatasetKind::kDetection;
-  /// Detection: views per object. Motion: samples per door or drawer, over every object with
-  /// one (a hinge labelled as a door, a slider labelled as a drawer).
+  /// Detection: views per object. Motion: samples per target part (motion_parts), over every
+  /// object with one.
   int views = 20;
   int size = 512;  ///< picture width and height, pixels
   std::uint64_t seed = 0;
@@ -47,8 +47,14 @@ struct DatasetOptions {
   double min_area_fraction = 1.0 / 4096.0;
   double fovy_degrees = 35.0;  ///< vertical field of view of the cameras
   bool point_clouds = true;    ///< detection: write cloud/NN.npz
-  bool merge_only = false;     ///< render nothing: rebuild the split files from DONE objects
-  bool progress = true;        ///< progress lines on stderr
+  /// Motion: the target parts, by words of their label. A labelled link whose label contains
+  /// one of them is a target when it moves on a hinge (revolute or continuous: a "hinge"
+  /// sample) or a slider (prismatic: a "slider" sample; a slider that also turns, such as a
+  /// screw cap, is one, its state the slide). The paper's set, the default, is doors and
+  /// drawers; {"lid"}, {"knob", "button"} or {"door", "drawer", "lid"} choose others.
+  std::vector<std::string> motion_parts = {"door", "drawer"};
+  bool merge_only = false;  ///< render nothing: rebuild the split files from DONE objects
+  bool progress = true;     ///< progress lines on stderr
 };
 
 /// What a run did.
