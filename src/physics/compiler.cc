@@ -61,17 +61,23 @@ class MjcfWriter {
     // needed (SceneImpl::Step doubles them when a step fills them), not from its size: memory
     // grows with the contacts, not with the square of the bodies. The rows always cover every
     // contact (4 rows each: condim 3, pyramidal cone), so contacts overflow before rows do.
-    const int nconmax = std::max(scene_.contact_capacity, kBaseContacts);
+    // A scene without collision shapes has no contacts (a rendered dataset object, a
+    // kinematic model): its buffers start small instead of at about 20 MB, which mj_makeData
+    // zeroes, and grow like the others if a step needs more.
+    const bool contacts = num_collision_geoms_ > 0;
+    const int nconmax = std::max(scene_.contact_capacity, contacts ? kBaseContacts : 4);
     const int njmax =
         4 * nconmax + 4 * num_limits_ + 6 * num_equalities_ + 2 * num_friction_dofs_ + 100;
     // MuJoCo's scratch stack: its own default scales with njmax and came out too small with
     // the buffers above ("Stack overflow" at compile). MuJoCo 2.2.2's implicit integrator works
     // on dense nv x nv matrices: 300 free boxes (nv 1,800) need 33-36 M numbers, about 11 nv^2;
-    // the explicit integrators need under nv^2 / 36 (1,000 boxes: 0.5-1 M)
+    // the explicit integrators need under nv^2 / 36 (1,000 boxes: 0.5-1 M). Without contacts,
+    // the constraint projection's njmax x nv block bounds the rest
     const long long nv = num_dofs_;
     const long long dense = c.integrator == Integrator::kImplicit ? 12 * nv * nv : nv * nv / 32;
+    const long long floor = contacts ? 1000000 : 50000 + nv * njmax;
     const long long nstack =
-        std::max(1000000 + 60 * nv + 20ll * njmax + dense, scene_.stack_capacity);
+        std::max(floor + 60 * nv + 20ll * njmax + dense, scene_.stack_capacity);
     out << "  <size nconmax=\"" << nconmax << "\" njmax=\"" << njmax << "\" nstack=\"" << nstack
         << "\"/>\n";
     if (!assets_.str().empty()) out << "  <asset>\n" << assets_.str() << "  </asset>\n";

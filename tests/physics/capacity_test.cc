@@ -110,6 +110,31 @@ TEST(CapacityTest, ContactBuffersGrowWhenAStepFillsThem) {
   EXPECT_EQ(copy->GetMjModel()->nconmax, scene.GetMjModel()->nconmax);
 }
 
+// A scene without collision shapes cannot have contacts: MuJoCo's buffers start small (a
+// rendered dataset object compiles without its ~20 MB), the chain still steps and answers
+// dynamics queries, and once shapes that can touch are added the buffers are the usual ones.
+TEST(CapacityTest, ASceneWithoutCollisionShapesStartsWithSmallBuffers) {
+  Scene scene;
+  ArticulationDesc chain = Chain(30);
+  for (LinkDesc& l : chain.links) l.collisions.clear();
+  Articulation a = scene.AddArticulation(chain);
+  a.SetQpos(Eigen::VectorXd::Constant(a.Dof(), 0.3));
+  scene.Step(50);
+  EXPECT_TRUE(a.GetQpos().allFinite());
+  EXPECT_LT(scene.GetMjModel()->nconmax, 16);
+  EXPECT_LT(scene.GetMjModel()->nstack, 200000);
+  const Eigen::MatrixXd mass = a.ComputeManipulatorInertiaMatrix();
+  EXPECT_EQ(mass.rows(), a.Dof());
+  EXPECT_TRUE(mass.allFinite());
+  EXPECT_GT(mass.diagonal().minCoeff(), 0.0);
+
+  scene.AddGround(0.0);
+  scene.AddActor(Box("box", Eigen::Vector3d(3, 0, 0.2)));
+  scene.Step(300);
+  EXPECT_GE(scene.GetMjModel()->nconmax, internal::kBaseContacts);
+  EXPECT_NEAR(scene.GetActors().back().GetPose().p.z(), 0.05, 2e-3);  // resting, not through
+}
+
 // An actor MuJoCo refuses (an inertia that breaks A + B >= C, which only the compiler checks)
 // is named when the scene next compiles and left out; the actors added with it stay in.
 TEST(CapacityTest, AnActorMuJoCoRefusesIsLeftOutAndTheOthersStay) {
