@@ -1,7 +1,8 @@
 #!/bin/bash
-# Builds the URDF fuzz target with clang, libFuzzer and AddressSanitizer in build-fuzz/ and runs it
-# on tests/fuzz/corpus for a bounded time. Exits non-zero when the fuzzer finds a crash, a leak or
-# a sanitizer error. Usage: scripts/run_fuzz.sh [seconds (default 60)] [extra libFuzzer flags...]
+# Builds the fuzz targets with clang, libFuzzer and AddressSanitizer in build-fuzz/ and runs each
+# for a bounded time: the URDF parser on tests/fuzz/corpus, then the OBJ reader on
+# tests/fuzz/obj_corpus for half as long. Exits non-zero when a fuzzer finds a crash, a leak or a
+# sanitizer error. Usage: scripts/run_fuzz.sh [seconds (default 60)] [extra libFuzzer flags...]
 set -euo pipefail
 
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -16,7 +17,7 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DPARTSIM_FUZZ=ON -DPARTSIM_BUILD_PYTHON=OFF -DPARTSIM_BUILD_TESTS=OFF -DPARTSIM_WERROR=OFF \
   -DPARTSIM_BUILD_BENCH=OFF >"$build.configure.log" 2>&1 ||
   { cat "$build.configure.log"; exit 1; }
-cmake --build "$build" -j2 --target urdf_fuzz
+cmake --build "$build" -j2 --target urdf_fuzz obj_fuzz
 
 # run on a scratch copy of the corpus so that new inputs stay out of the repository unless
 # they are copied back on purpose (crash files land in $build/artifacts)
@@ -27,3 +28,10 @@ cd "$build"
 ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" "$build/tests/fuzz/urdf_fuzz" "$work" \
   -max_total_time="$seconds" -max_len=16384 -timeout=10 -rss_limit_mb=4096 \
   -dict="$root/tests/fuzz/urdf.dict" -artifact_prefix="$build/artifacts/" -print_final_stats=1 "$@"
+
+obj_work="$build/obj_corpus"
+mkdir -p "$obj_work"
+cp -n "$root"/tests/fuzz/obj_corpus/* "$obj_work"/ 2>/dev/null || true
+ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" "$build/tests/fuzz/obj_fuzz" "$obj_work" \
+  -max_total_time="$(((seconds + 1) / 2))" -max_len=16384 -timeout=10 -rss_limit_mb=4096 \
+  -artifact_prefix="$build/artifacts/obj-" -print_final_stats=1 "$@"

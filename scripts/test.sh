@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs, builds (from scratch on a clean checkout, else what changed) and runs the whole test
 # suite: GoogleTest through CTest, pytest, the source format check, the installed partsim (a
-# temporary prefix and the Debian package, each used from outside the tree) and the URDF fuzzer
-# under AddressSanitizer.
+# temporary prefix and the Debian package, each used from outside the tree) and the URDF and OBJ
+# fuzzers under AddressSanitizer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -59,5 +59,5 @@ else
   [ "$status" -eq 0 ]
 fi
 
-echo "== URDF fuzzer (libFuzzer + AddressSanitizer)"
+echo "== URDF and OBJ fuzzers (libFuzzer + AddressSanitizer)"
 bash scripts/run_fuzz.sh

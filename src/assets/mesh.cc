@@ -19,6 +19,7 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "assets/obj_reader.h"
 #include "core/file_read.h"
 #include "partsim/assets/convex_decomposition.h"
 #include "partsim/core/error.h"
@@ -36,11 +37,11 @@ Eigen::Matrix4d ToEigen(const aiMatrix4x4& m) {
   return r;
 }
 
-bool IsCollada(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  return ext == ".dae";
+// Whether `path` ends in `ext` (".obj"), in any case.
+bool HasExtension(const std::string& path, const char* ext) {
+  std::string e = fs::path(path).extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e == ext;
 }
 
 // Render material of an assimp material; texture paths made absolute against `dir`.
@@ -75,59 +76,75 @@ RenderMaterial ConvertMaterial(const aiMaterial* m, const fs::path& dir) {
   return out;
 }
 
+// A sub-mesh in the file's frame placed by X_FN = `x` and multiplied by `scale`, appended to
+// `out` when it has triangles.
+void AppendSubMesh(const internal::FileSubMesh& sub, const Eigen::Matrix4d& x,
+                   const Eigen::Vector3d& scale, const std::string& path,
+                   std::vector<LoadedMesh>* out) {
+  if (sub.triangles.empty()) return;
+  const Eigen::Matrix3d normal_matrix = x.topLeftCorner<3, 3>().inverse().transpose();
+  auto mesh = std::make_shared<MeshData>();
+  mesh->source = path;
+  mesh->name = sub.name;
+
+  // vertices in the file frame, then scaled
+  mesh->vertices.reserve(sub.positions.size());
+  for (const Eigen::Vector3f& a : sub.positions) {
+    Eigen::Vector3d p = (x * Eigen::Vector4d(a.x(), a.y(), a.z(), 1.0)).head<3>();
+    mesh->vertices.push_back(p.cwiseProduct(scale).cast<float>());
+  }
+  if (!sub.normals.empty()) {
+    // normals of a scaled mesh transform with the inverse scale
+    const Eigen::Vector3d inv_scale = scale.cwiseInverse();
+    mesh->normals.reserve(sub.normals.size());
+    for (const Eigen::Vector3f& a : sub.normals) {
+      Eigen::Vector3d n = (normal_matrix * a.cast<double>()).cwiseProduct(inv_scale);
+      double len = n.norm();
+      mesh->normals.push_back((len > 0 ? n / len : n).cast<float>());
+    }
+  }
+  mesh->uvs = sub.uvs;
+
+  // a mirroring scale flips the winding back to counter-clockwise
+  const bool flip = (x.topLeftCorner<3, 3>().determinant() * scale.prod()) < 0;
+  mesh->faces = sub.triangles;
+  if (flip)
+    for (Eigen::Vector3i& t : mesh->faces) std::swap(t[1], t[2]);
+  out->push_back(LoadedMesh{mesh, sub.material});
+}
+
 // Collects the triangles of every mesh instance under `node`, transformed by X_FN.
 void CollectNode(const aiScene* scene, const aiNode* node, const Eigen::Matrix4d& parent,
                  const Eigen::Vector3d& scale, const std::string& path, const fs::path& dir,
                  std::vector<LoadedMesh>* out) {
   const Eigen::Matrix4d x = parent * ToEigen(node->mTransformation);
-  const Eigen::Matrix3d normal_matrix = x.topLeftCorner<3, 3>().inverse().transpose();
   for (unsigned k = 0; k < node->mNumMeshes; ++k) {
     const aiMesh* am = scene->mMeshes[node->mMeshes[k]];
-    auto mesh = std::make_shared<MeshData>();
-    mesh->source = path;
-    mesh->name = am->mName.length > 0 ? am->mName.C_Str() : node->mName.C_Str();
-
-    // vertices in the file frame, then scaled
-    mesh->vertices.reserve(am->mNumVertices);
-    for (unsigned i = 0; i < am->mNumVertices; ++i) {
-      const aiVector3D& a = am->mVertices[i];
-      Eigen::Vector3d p = (x * Eigen::Vector4d(a.x, a.y, a.z, 1.0)).head<3>();
-      mesh->vertices.push_back(p.cwiseProduct(scale).cast<float>());
-    }
+    internal::FileSubMesh sub;
+    sub.name = am->mName.length > 0 ? am->mName.C_Str() : node->mName.C_Str();
+    sub.positions.reserve(am->mNumVertices);
+    for (unsigned i = 0; i < am->mNumVertices; ++i)
+      sub.positions.emplace_back(am->mVertices[i].x, am->mVertices[i].y, am->mVertices[i].z);
     if (am->HasNormals()) {
-      // normals of a scaled mesh transform with the inverse scale
-      const Eigen::Vector3d inv_scale = scale.cwiseInverse();
-      mesh->normals.reserve(am->mNumVertices);
-      for (unsigned i = 0; i < am->mNumVertices; ++i) {
-        const aiVector3D& a = am->mNormals[i];
-        Eigen::Vector3d n =
-            (normal_matrix * Eigen::Vector3d(a.x, a.y, a.z)).cwiseProduct(inv_scale);
-        double len = n.norm();
-        mesh->normals.push_back((len > 0 ? n / len : n).cast<float>());
-      }
+      sub.normals.reserve(am->mNumVertices);
+      for (unsigned i = 0; i < am->mNumVertices; ++i)
+        sub.normals.emplace_back(am->mNormals[i].x, am->mNormals[i].y, am->mNormals[i].z);
     }
     if (am->HasTextureCoords(0)) {
-      mesh->uvs.reserve(am->mNumVertices);
-      for (unsigned i = 0; i < am->mNumVertices; ++i) {
-        mesh->uvs.emplace_back(am->mTextureCoords[0][i].x, am->mTextureCoords[0][i].y);
-      }
+      sub.uvs.reserve(am->mNumVertices);
+      for (unsigned i = 0; i < am->mNumVertices; ++i)
+        sub.uvs.emplace_back(am->mTextureCoords[0][i].x, am->mTextureCoords[0][i].y);
     }
-
-    // triangles only: points and lines left by triangulation are dropped; a mirroring scale
-    // flips the winding back to counter-clockwise
-    const bool flip = (x.topLeftCorner<3, 3>().determinant() * scale.prod()) < 0;
+    // triangles only: points and lines left by triangulation are dropped
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       const aiFace& face = am->mFaces[f];
       if (face.mNumIndices != 3) continue;
-      Eigen::Vector3i t(face.mIndices[0], face.mIndices[1], face.mIndices[2]);
-      if (flip) std::swap(t[1], t[2]);
-      mesh->faces.push_back(t);
+      sub.triangles.emplace_back(face.mIndices[0], face.mIndices[1], face.mIndices[2]);
     }
-    if (mesh->faces.empty()) continue;
-
     const aiMaterial* mat =
         am->mMaterialIndex < scene->mNumMaterials ? scene->mMaterials[am->mMaterialIndex] : nullptr;
-    out->push_back(LoadedMesh{mesh, ConvertMaterial(mat, dir)});
+    sub.material = ConvertMaterial(mat, dir);
+    AppendSubMesh(sub, x, scale, path, out);
   }
   for (unsigned c = 0; c < node->mNumChildren; ++c) {
     CollectNode(scene, node->mChildren[c], x, scale, path, dir, out);
@@ -318,10 +335,10 @@ ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh) {
   return out;
 }
 
-std::vector<LoadedMesh> LoadMeshFile(const std::string& path, const Eigen::Vector3d& scale) {
-  internal::CheckReadableFile(path, "mesh file", internal::kMaxDataFileBytes);
-  if (!scale.allFinite()) throw Error("mesh file '" + path + "': scale is not finite");
+namespace internal {
 
+std::vector<LoadedMesh> LoadMeshFileWithAssimp(const std::string& path,
+                                               const Eigen::Vector3d& scale) {
   Assimp::Importer importer;
   // no points or lines: they are not surfaces
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
@@ -336,13 +353,30 @@ std::vector<LoadedMesh> LoadMeshFile(const std::string& path, const Eigen::Vecto
   // assimp scales Collada by its <unit> and turns its up axis into +y; partsim is z-up, so turn
   // +y back into +z: a Z_UP file comes out as written, a Y_UP file stands up
   Eigen::Matrix4d root = Eigen::Matrix4d::Identity();
-  if (IsCollada(path)) {
+  if (HasExtension(path, ".dae")) {
     root.topLeftCorner<3, 3>() << 1, 0, 0, 0, 0, -1, 0, 1, 0;
   }
 
   std::vector<LoadedMesh> out;
   const fs::path dir = fs::absolute(fs::path(path)).parent_path();
   CollectNode(scene, scene->mRootNode, root, scale, path, dir, &out);
+  return out;
+}
+
+}  // namespace internal
+
+std::vector<LoadedMesh> LoadMeshFile(const std::string& path, const Eigen::Vector3d& scale) {
+  internal::CheckReadableFile(path, "mesh file", internal::kMaxDataFileBytes);
+  if (!scale.allFinite()) throw Error("mesh file '" + path + "': scale is not finite");
+
+  std::vector<LoadedMesh> out;
+  if (HasExtension(path, ".obj")) {
+    // partsim's own reader: the sub-meshes assimp gave, without its 48 MB of buffers per file
+    for (const internal::FileSubMesh& sub : internal::ReadObjFile(path))
+      AppendSubMesh(sub, Eigen::Matrix4d::Identity(), scale, path, &out);
+  } else {
+    out = internal::LoadMeshFileWithAssimp(path, scale);
+  }
   if (out.empty()) throw Error("mesh file '" + path + "' holds no triangles");
   for (const LoadedMesh& m : out) {
     for (const Eigen::Vector3f& v : m.mesh->vertices) {
