@@ -374,6 +374,20 @@ TEST(RasterTest, DirectionalShadowDarkensTheGroundBehindTheBox) {
   EXPECT_GT(lit.color[4 * top], 0.3f);
 }
 
+// A fresh backend draws unshadowed pictures with a 1 x 1 stand-in for the shadow maps, and makes
+// the maps at its first shadowed picture: the unshadowed picture is the same before and after.
+TEST(RasterTest, ShadowMapsAreMadeAtTheFirstShadowedPicture) {
+  std::unique_ptr<RenderBackend> fresh = MakeRasterBackend();
+  CameraParams cam = CameraAbove(64, 64, {1.5, 0, 2});
+  Picture before, shadowed, after;
+  fresh->Render(ShadowWorld(false), cam, &before);
+  fresh->Render(ShadowWorld(true), cam, &shadowed);
+  fresh->Render(ShadowWorld(false), cam, &after);
+  EXPECT_EQ(before.color, after.color);
+  const size_t behind = Pixel(before, Project(cam, {1.7, 0, 0}));
+  EXPECT_LT(shadowed.color[4 * behind], 0.3f * before.color[4 * behind]);
+}
+
 TEST(RasterTest, SpotLightLightsInsideItsConeOnly) {
   CameraParams cam = CameraAbove(96, 96, {1.5, 0, 3});
   for (bool shadow : {false, true}) {

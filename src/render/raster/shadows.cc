@@ -51,27 +51,40 @@ Eigen::Matrix4d Perspective(double fovy, double n, double f) {
   return p;
 }
 
+// A depth array texture of `size` x `size` x `layers` that compares for a shadow sampler.
+GLuint MakeDepthArray(int size, int layers) {
+  GLuint tex = 0;
+  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &tex);
+  glTextureStorage3D(tex, 1, GL_DEPTH_COMPONENT32F, size, size, layers);
+  glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(tex, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(tex, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(tex, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTextureParameteri(tex, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  return tex;
+}
+
 }  // namespace
 
 void ShadowMaps::Create() { glCreateFramebuffers(1, &fbo_); }
 
 void ShadowMaps::Delete() {
   glDeleteTextures(1, &maps_);
+  glDeleteTextures(1, &stand_in_);
   glDeleteFramebuffers(1, &fbo_);
-  maps_ = fbo_ = 0;
+  maps_ = stand_in_ = fbo_ = 0;
+}
+
+GLuint ShadowMaps::Maps() {
+  if (maps_ == 0) maps_ = MakeDepthArray(size_, kMaxShadows);
+  return maps_;
 }
 
 GLuint ShadowMaps::Texture() {
   if (maps_ != 0) return maps_;
-  glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &maps_);
-  glTextureStorage3D(maps_, 1, GL_DEPTH_COMPONENT32F, size_, size_, kMaxShadows);
-  glTextureParameteri(maps_, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(maps_, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(maps_, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(maps_, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(maps_, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-  glTextureParameteri(maps_, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-  return maps_;
+  if (stand_in_ == 0) stand_in_ = MakeDepthArray(1, 1);
+  return stand_in_;
 }
 
 int ShadowMaps::Render(const RenderWorld& world, const CameraParams& camera,
@@ -132,8 +145,7 @@ int ShadowMaps::Render(const RenderWorld& world, const CameraParams& camera,
       texel = Eigen::Vector2d(0, 2 * std::tan(fovy / 2) / size_);
     }
     Eigen::Matrix4d view_proj = proj * view;
-    Texture();
-    glNamedFramebufferTextureLayer(fbo_, GL_DEPTH_ATTACHMENT, maps_, 0, count);
+    glNamedFramebufferTextureLayer(fbo_, GL_DEPTH_ATTACHMENT, Maps(), 0, count);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, size_, size_);
     glEnable(GL_DEPTH_TEST);

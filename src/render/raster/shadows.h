@@ -35,8 +35,10 @@ class ShadowMaps {
   /// No maps for this picture: every one of `num_lights` lights is unshadowed.
   void Clear(size_t num_lights) { layer_.assign(num_lights, -1); }
 
-  /// The depth array texture, made on first use (the lighting's sampler needs one even without
-  /// shadows).
+  /// The texture for the lighting's shadow sampler: the depth maps once a picture has drawn
+  /// any, else a 1 x 1 stand-in (the sampler needs a texture even without shadows, and the
+  /// maps, `size` squared times kMaxShadows depths, cost time to make that unshadowed pictures
+  /// need not spend).
   GLuint Texture();
   /// Map layer of light `i` of the last picture, -1 for none.
   int layer(size_t i) const { return layer_[i]; }
@@ -46,8 +48,11 @@ class ShadowMaps {
   const std::array<Eigen::Vector2f, kMaxShadows>& texels() const { return texel_; }
 
  private:
+  /// The depth maps, made when a picture first draws one.
+  GLuint Maps();
+
   int size_;
-  GLuint fbo_ = 0, maps_ = 0;
+  GLuint fbo_ = 0, maps_ = 0, stand_in_ = 0;
   std::array<Eigen::Matrix4f, kMaxShadows> matrix_;
   std::array<Eigen::Vector2f, kMaxShadows> texel_;
   std::vector<int> layer_;
