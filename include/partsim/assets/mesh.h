@@ -1,4 +1,5 @@
-// Mesh files (OBJ, STL, DAE, glTF, PLY, ...) read through assimp.
+// Mesh files: OBJ (with its MTL libraries) through partsim's own reader, the other formats (STL,
+// DAE, glTF, PLY, ...) through assimp.
 #pragma once
 
 #include <Eigen/Core>
