@@ -3155,6 +3155,20 @@ class TaskType:
     def value(self) -> int: ...
 
 
+class TrajectorySampler:
+    """A JointTrajectory ready to be sampled many times: each segment's polynomial is computed once (the spline of a positions-only trajectory too), so sample() costs the same whatever the number of waypoints; JointTrajectory.sample fits the spline again at every call. Same values as JointTrajectory.sample."""
+    def __init__(self, trajectory: JointTrajectory) -> None:
+        """Copies `trajectory`; raises PartsimError when it has no waypoints or positions for fewer or more times."""
+        ...
+    def sample(self, t: float) -> tuple:
+        """(q, qd, qdd) at time t in s, as JointTrajectory.sample gives them."""
+        ...
+    @property
+    def trajectory(self) -> JointTrajectory:
+        """The JointTrajectory sampled (a copy)."""
+        ...
+
+
 class UrdfLinkOverride:
     """Per-link overrides of a UrdfLoader."""
     def __init__(self, density: typing.Optional[float] = ..., material: typing.Optional[PhysicalMaterial] = ...) -> None:

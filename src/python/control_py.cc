@@ -120,6 +120,25 @@ void BindControl(py::module_& m) {
           "(q, qd, qdd) at time t in s (clamped to [0, duration]), each (dof,): quintic "
           "between waypoints with velocities and accelerations, cubic with velocities only, a "
           "C2 cubic spline at rest at both ends with positions only.");
+  py::class_<TrajectorySampler>(
+      m, "TrajectorySampler",
+      "A JointTrajectory ready to be sampled many times: each segment's polynomial is computed "
+      "once (the spline of a positions-only trajectory too), so sample() costs the same "
+      "whatever the number of waypoints; JointTrajectory.sample fits the spline again at every "
+      "call. Same values as JointTrajectory.sample.")
+      .def(py::init<JointTrajectory>(), py::arg("trajectory"),
+           "Copies `trajectory`; raises PartsimError when it has no waypoints or positions for "
+           "fewer or more times.")
+      .def_property_readonly("trajectory", &TrajectorySampler::trajectory,
+                             "The JointTrajectory sampled (a copy).")
+      .def(
+          "sample",
+          [](const TrajectorySampler& s, double time) {
+            Eigen::VectorXd q, qd, qdd;
+            s.Sample(time, &q, &qd, &qdd);
+            return py::make_tuple(q, qd, qdd);
+          },
+          py::arg("t"), "(q, qd, qdd) at time t in s, as JointTrajectory.sample gives them.");
   m.def("time_parameterize", &TimeParameterize, py::arg("path"), py::arg("velocity_limits"),
         py::arg("acceleration_limits"),
         "Times a path (list of (dof,) positions) so that it starts and ends at rest and no "

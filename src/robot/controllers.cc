@@ -330,7 +330,7 @@ void JointTrajectoryController::SetTrajectory(const JointTrajectory& trajectory)
     for (int i = 0; i < NumJoints(); ++i) {
       if (p[i] >= limits(i, 0) && p[i] <= limits(i, 1)) continue;
       // refuse the whole trajectory: hold where the robot is
-      trajectory_ = JointTrajectory();
+      trajectory_ = TrajectorySampler();
       started_ = false;
       SetTargets(robot_, joint_names_, GetQpos(), nullptr);
       status_.state = ControllerState::kFailed;
@@ -340,7 +340,7 @@ void JointTrajectoryController::SetTrajectory(const JointTrajectory& trajectory)
       return;
     }
   }
-  trajectory_ = trajectory;
+  trajectory_ = TrajectorySampler(trajectory);
   start_time_ = robot_.GetScene()->GetTime();
   started_ = true;
   status_.state = ControllerState::kRunning;
@@ -394,13 +394,13 @@ void JointTrajectoryController::Update() {
   Eigen::VectorXd mqdd = robot_.ComputeManipulatorInertiaMatrix() * qacc, ff(NumJoints());
   for (int i = 0; i < NumJoints(); ++i) ff[i] = mqdd[dofs_[i]];
   WriteQf(robot_, dofs_, ff, options_.gravity_compensation);
-  if (t < trajectory_.Duration()) return;
+  const double duration = trajectory_.trajectory().Duration();
+  if (t < duration) return;
   const Eigen::VectorXd qd_now = GetQvel();
   if (err.cwiseAbs().maxCoeff() <= options_.position_tolerance &&
       qd_now.cwiseAbs().maxCoeff() <= options_.velocity_tolerance) {
     status_.state = ControllerState::kReached;
-  } else if (status_.state == ControllerState::kRunning &&
-             t > trajectory_.Duration() + options_.timeout) {
+  } else if (status_.state == ControllerState::kRunning && t > duration + options_.timeout) {
     int w = Worst(err);
     status_.state = ControllerState::kFailed;
     status_.message = "joint '" + joint_names_[w] + "' did not settle at the last waypoint (" +

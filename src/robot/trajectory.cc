@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "partsim/core/check.h"
 #include "partsim/core/error.h"
@@ -68,36 +69,34 @@ void ClampedSpline(const std::vector<double>& times, const std::vector<Eigen::Ve
 
 // Polynomial coefficients (ascending powers of the time since the segment's start) of a
 // segment of duration h: quintic when accelerations are given, else cubic Hermite.
-struct Segment {
-  Eigen::VectorXd c[6];
-};
+using Segment = std::array<Eigen::VectorXd, 6>;
 
 Segment MakeSegment(double h, const Eigen::VectorXd& p0, const Eigen::VectorXd& p1,
                     const Eigen::VectorXd& v0, const Eigen::VectorXd& v1, const Eigen::VectorXd* a0,
                     const Eigen::VectorXd* a1) {
   Segment s;
   const Eigen::Index dof = p0.size();
-  for (auto& c : s.c) c = Eigen::VectorXd::Zero(dof);
-  s.c[0] = p0;
-  s.c[1] = v0;
+  for (auto& c : s) c = Eigen::VectorXd::Zero(dof);
+  s[0] = p0;
+  s[1] = v0;
   if (a0 && a1) {
     double h2 = h * h, h3 = h2 * h;
-    s.c[2] = *a0 / 2;
-    s.c[3] = (20 * (p1 - p0) - (8 * v1 + 12 * v0) * h - (3 * *a0 - *a1) * h2) / (2 * h3);
-    s.c[4] = (30 * (p0 - p1) + (14 * v1 + 16 * v0) * h + (3 * *a0 - 2 * *a1) * h2) / (2 * h3 * h);
-    s.c[5] = (12 * (p1 - p0) - 6 * (v1 + v0) * h - (*a0 - *a1) * h2) / (2 * h3 * h2);
+    s[2] = *a0 / 2;
+    s[3] = (20 * (p1 - p0) - (8 * v1 + 12 * v0) * h - (3 * *a0 - *a1) * h2) / (2 * h3);
+    s[4] = (30 * (p0 - p1) + (14 * v1 + 16 * v0) * h + (3 * *a0 - 2 * *a1) * h2) / (2 * h3 * h);
+    s[5] = (12 * (p1 - p0) - 6 * (v1 + v0) * h - (*a0 - *a1) * h2) / (2 * h3 * h2);
   } else {
-    s.c[2] = (3 * (p1 - p0) / h - 2 * v0 - v1) / h;
-    s.c[3] = (2 * (p0 - p1) / h + v0 + v1) / (h * h);
+    s[2] = (3 * (p1 - p0) / h - 2 * v0 - v1) / h;
+    s[3] = (2 * (p0 - p1) / h + v0 + v1) / (h * h);
   }
   return s;
 }
 
 void Evaluate(const Segment& s, double t, Eigen::VectorXd* q, Eigen::VectorXd* qd,
               Eigen::VectorXd* qdd) {
-  if (q) *q = s.c[0] + t * (s.c[1] + t * (s.c[2] + t * (s.c[3] + t * (s.c[4] + t * s.c[5]))));
-  if (qd) *qd = s.c[1] + t * (2 * s.c[2] + t * (3 * s.c[3] + t * (4 * s.c[4] + t * 5 * s.c[5])));
-  if (qdd) *qdd = 2 * s.c[2] + t * (6 * s.c[3] + t * (12 * s.c[4] + t * 20 * s.c[5]));
+  if (q) *q = s[0] + t * (s[1] + t * (s[2] + t * (s[3] + t * (s[4] + t * s[5]))));
+  if (qd) *qd = s[1] + t * (2 * s[2] + t * (3 * s[3] + t * (4 * s[4] + t * 5 * s[5])));
+  if (qdd) *qdd = 2 * s[2] + t * (6 * s[3] + t * (12 * s[4] + t * 20 * s[5]));
 }
 
 }  // namespace
@@ -130,37 +129,80 @@ void JointTrajectory::Validate(int dof) const {
 
 double JointTrajectory::Duration() const { return times.empty() ? 0.0 : times.back(); }
 
-void JointTrajectory::Sample(double t, Eigen::VectorXd* q, Eigen::VectorXd* qd,
-                             Eigen::VectorXd* qdd) const {
-  if (times.empty() || positions.size() != times.size())
+namespace {
+
+// Sampling outside the segments: t at or before the first waypoint, at or after the last, or a
+// single waypoint: the hold (with the given end velocity and acceleration at the waypoint's own
+// time). Returns false, with the segment that holds t in *segment, otherwise.
+bool SampleEnds(const JointTrajectory& tr, double t, Eigen::VectorXd* q, Eigen::VectorXd* qd,
+                Eigen::VectorXd* qdd, size_t* segment) {
+  const std::vector<double>& times = tr.times;
+  if (times.empty() || tr.positions.size() != times.size())
     throw Error("JointTrajectory::Sample: the trajectory has no valid waypoints");
   if (std::isnan(t)) throw Error("JointTrajectory::Sample: t is NaN");
-  const Eigen::Index dof = positions[0].size();
+  const Eigen::Index dof = tr.positions[0].size();
   const size_t n = times.size();
-  const bool has_vel = velocities.size() == n, has_acc = has_vel && accelerations.size() == n;
-  // before the first waypoint or at the end: hold (with the given end velocity)
+  const bool has_vel = tr.velocities.size() == n, has_acc = has_vel && tr.accelerations.size() == n;
   if (n == 1 || t <= times[0] || t >= times.back()) {
     size_t i = (n == 1 || t <= times[0]) ? 0 : n - 1;
     bool inside = t == times[i];
-    if (q) *q = positions[i];
-    if (qd) *qd = inside && has_vel ? velocities[i] : Eigen::VectorXd::Zero(dof);
-    if (qdd) *qdd = inside && has_acc ? accelerations[i] : Eigen::VectorXd::Zero(dof);
-    return;
+    if (q) *q = tr.positions[i];
+    if (qd) *qd = inside && has_vel ? tr.velocities[i] : Eigen::VectorXd::Zero(dof);
+    if (qdd) *qdd = inside && has_acc ? tr.accelerations[i] : Eigen::VectorXd::Zero(dof);
+    return true;
   }
   size_t i = static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
-  i = std::min(std::max<size_t>(i, 1), n - 1) - 1;
-  double h = times[i + 1] - times[i];
-  Segment s;
-  if (has_vel) {
-    s = MakeSegment(h, positions[i], positions[i + 1], velocities[i], velocities[i + 1],
-                    has_acc ? &accelerations[i] : nullptr,
-                    has_acc ? &accelerations[i + 1] : nullptr);
-  } else {
-    std::vector<Eigen::VectorXd> v, a;
-    ClampedSpline(times, positions, &v, &a);
-    s = MakeSegment(h, positions[i], positions[i + 1], v[i], v[i + 1], &a[i], &a[i + 1]);
-  }
-  Evaluate(s, t - times[i], q, qd, qdd);
+  *segment = std::min(std::max<size_t>(i, 1), n - 1) - 1;
+  return false;
+}
+
+// The polynomials of all segments: the given velocities (and accelerations), else the clamped
+// spline's.
+std::vector<Segment> Segments(const JointTrajectory& tr) {
+  const size_t n = tr.times.size();
+  const bool has_vel = tr.velocities.size() == n, has_acc = has_vel && tr.accelerations.size() == n;
+  std::vector<Eigen::VectorXd> spline_v, spline_a;
+  if (!has_vel && n > 1) ClampedSpline(tr.times, tr.positions, &spline_v, &spline_a);
+  const std::vector<Eigen::VectorXd>& v = has_vel ? tr.velocities : spline_v;
+  const std::vector<Eigen::VectorXd>& a = has_vel ? tr.accelerations : spline_a;
+  const bool quintic = has_acc || !has_vel;
+  std::vector<Segment> out;
+  out.reserve(n > 0 ? n - 1 : 0);
+  for (size_t i = 0; i + 1 < n; ++i)
+    out.push_back(MakeSegment(tr.times[i + 1] - tr.times[i], tr.positions[i], tr.positions[i + 1],
+                              v[i], v[i + 1], quintic ? &a[i] : nullptr,
+                              quintic ? &a[i + 1] : nullptr));
+  return out;
+}
+
+}  // namespace
+
+void JointTrajectory::Sample(double t, Eigen::VectorXd* q, Eigen::VectorXd* qd,
+                             Eigen::VectorXd* qdd) const {
+  size_t i = 0;
+  if (SampleEnds(*this, t, q, qd, qdd, &i)) return;
+  const size_t n = times.size();
+  // positions only: the spline through all of them, fitted for this one call
+  if (velocities.size() != n) return TrajectorySampler(*this).Sample(t, q, qd, qdd);
+  const bool has_acc = accelerations.size() == n;
+  Evaluate(MakeSegment(times[i + 1] - times[i], positions[i], positions[i + 1], velocities[i],
+                       velocities[i + 1], has_acc ? &accelerations[i] : nullptr,
+                       has_acc ? &accelerations[i + 1] : nullptr),
+           t - times[i], q, qd, qdd);
+}
+
+TrajectorySampler::TrajectorySampler(JointTrajectory trajectory)
+    : trajectory_(std::move(trajectory)) {
+  if (trajectory_.times.empty() || trajectory_.positions.size() != trajectory_.times.size())
+    throw Error("TrajectorySampler: the trajectory has no valid waypoints");
+  segments_ = Segments(trajectory_);
+}
+
+void TrajectorySampler::Sample(double t, Eigen::VectorXd* q, Eigen::VectorXd* qd,
+                               Eigen::VectorXd* qdd) const {
+  size_t i = 0;
+  if (SampleEnds(trajectory_, t, q, qd, qdd, &i)) return;
+  Evaluate(segments_[i], t - trajectory_.times[i], q, qd, qdd);
 }
 
 JointTrajectory TimeParameterize(const std::vector<Eigen::VectorXd>& path,
@@ -218,7 +260,7 @@ JointTrajectory TimeParameterize(const std::vector<Eigen::VectorXd>& path,
       double r = 0.0;
       for (Eigen::Index k = 0; k < dof; ++k) {
         // velocity is quadratic in time: extremes at the ends or at its vertex
-        double c1 = s.c[1][k], c2 = s.c[2][k], c3 = s.c[3][k];
+        double c1 = s[1][k], c2 = s[2][k], c3 = s[3][k];
         double vmax = std::max(std::abs(c1), std::abs(c1 + 2 * c2 * h[i] + 3 * c3 * h[i] * h[i]));
         if (c3 != 0) {
           double tv = -c2 / (3 * c3);

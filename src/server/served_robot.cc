@@ -140,7 +140,7 @@ struct ServedRobot::Impl {
     const double now = scene->GetTime(), t = now - goal->start;
     const ControllerStatus& st = trajectory->GetStatus();
     Eigen::VectorXd desired, desired_v;
-    trajectory->GetTrajectory().Sample(std::min(t, goal->end - goal->start), &desired, &desired_v);
+    trajectory->GetSampler().Sample(std::min(t, goal->end - goal->start), &desired, &desired_v);
     const Eigen::VectorXd actual = trajectory->GetQpos(), err = desired - actual;
     if (goal->feedback && now + 1e-9 >= goal->next_feedback) {
       goal->next_feedback = now + 0.02;  // 50 Hz of simulated time

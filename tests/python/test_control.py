@@ -83,8 +83,19 @@ def test_trajectories():
     t.positions = [np.zeros(1), np.ones(1)]
     q, _, _ = t.sample(0.5)
     assert q[0] == pytest.approx(0.5)
+    # a sampler gives the same values, fitted once
+    t.times = [0.0, 0.4, 1.0]
+    t.positions = [np.zeros(1), np.array([0.7]), np.ones(1)]
+    sampler = partsim.TrajectorySampler(t)
+    for time in (-1.0, 0.0, 0.2, 0.4, 0.77, 1.0, 2.0):
+        for mine, theirs in zip(sampler.sample(time), t.sample(time)):
+            assert np.array_equal(mine, theirs)
+    assert sampler.trajectory.times == t.times
+    with pytest.raises(partsim.PartsimError, match="no valid waypoints"):
+        partsim.TrajectorySampler(partsim.JointTrajectory())
     with pytest.raises(partsim.PartsimError, match="waypoint"):
         t.times = [0.0, 0.0]
+        t.positions = [np.zeros(1), np.ones(1)]
         t.validate(1)
     with pytest.raises(partsim.PartsimError):
         partsim.time_parameterize([], np.ones(1), np.ones(1))

@@ -74,6 +74,58 @@ TEST(TrajectorySample, CubicWithVelocitiesAndSplineWithPositionsOnly) {
   }
 }
 
+// A TrajectorySampler gives JointTrajectory::Sample's values to the last bit, for positions
+// only (the clamped spline), with velocities (cubic) and with accelerations too (quintic): before
+// the first waypoint, at each waypoint, between them, at the end and after it.
+TEST(TrajectorySampler, GivesJointTrajectorySampleExactly) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto random = [&](int dof) {
+    Eigen::VectorXd v(dof);
+    for (int k = 0; k < dof; ++k) v[k] = u(rng);
+    return v;
+  };
+  for (int kind = 0; kind < 3; ++kind) {
+    JointTrajectory t;
+    double time = 0.3;  // the first waypoint after 0: the trajectory holds before it
+    for (int w = 0; w < 40; ++w) {
+      t.times.push_back(time);
+      time += 0.05 + 0.1 * (u(rng) + 1.0);
+      t.positions.push_back(random(3));
+      if (kind >= 1) t.velocities.push_back(random(3));
+      if (kind == 2) t.accelerations.push_back(random(3));
+    }
+    t.Validate(3);
+    const TrajectorySampler sampler(t);
+    std::vector<double> at = {-1.0, 0.0, t.times.back(), t.Duration() + 1.0};
+    for (size_t w = 0; w + 1 < t.times.size(); ++w) {
+      at.push_back(t.times[w]);
+      at.push_back(0.5 * (t.times[w] + t.times[w + 1]));
+      at.push_back(std::nextafter(t.times[w + 1], 0.0));
+    }
+    for (double x : at) {
+      Eigen::VectorXd q0, qd0, qdd0, q1, qd1, qdd1;
+      t.Sample(x, &q0, &qd0, &qdd0);
+      sampler.Sample(x, &q1, &qd1, &qdd1);
+      ASSERT_EQ(q0, q1) << "kind " << kind << ", t " << x;
+      ASSERT_EQ(qd0, qd1) << "kind " << kind << ", t " << x;
+      ASSERT_EQ(qdd0, qdd1) << "kind " << kind << ", t " << x;
+    }
+  }
+  // one waypoint, and what cannot be sampled
+  JointTrajectory one;
+  one.times = {0.0};
+  one.positions = {V({0.5})};
+  Eigen::VectorXd q;
+  TrajectorySampler(one).Sample(3.0, &q);
+  EXPECT_EQ(q, V({0.5}));
+  EXPECT_THROW(TrajectorySampler().Sample(0.0, &q), Error);
+  JointTrajectory bad = one;
+  bad.positions.clear();
+  EXPECT_THROW(TrajectorySampler{bad}, Error);
+  EXPECT_THROW(TrajectorySampler(one).Sample(std::nan(""), &q), Error);
+}
+
 TEST(TrajectoryValidate, BadInputNamesTheWaypoint) {
   JointTrajectory t;
   EXPECT_THROW(t.Validate(1), Error);

@@ -165,13 +165,15 @@ class JointTrajectoryController : public Controller {
   /// A path without times: TimeParameterize with these limits, then follow it.
   void SetPath(const std::vector<Eigen::VectorXd>& path, const Eigen::VectorXd& velocity_limits,
                const Eigen::VectorXd& acceleration_limits);
-  const JointTrajectory& GetTrajectory() const { return trajectory_; }
+  const JointTrajectory& GetTrajectory() const { return trajectory_.trajectory(); }
+  /// The trajectory as it is followed, ready to sample (in seconds since it was set).
+  const TrajectorySampler& GetSampler() const { return trajectory_; }
   void Update() override;
   /// The options, and path_tolerance > 0.
   void CheckSettings() const override;
 
  private:
-  JointTrajectory trajectory_;
+  TrajectorySampler trajectory_;
   double start_time_ = 0.0;
   bool started_ = false;
 };

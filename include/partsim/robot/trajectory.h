@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 namespace partsim {
@@ -24,6 +25,31 @@ struct JointTrajectory {
   /// given. Before times[0] it holds positions[0].
   void Sample(double t, Eigen::VectorXd* q, Eigen::VectorXd* qd = nullptr,
               Eigen::VectorXd* qdd = nullptr) const;
+};
+
+/// A JointTrajectory made ready to be sampled many times, as a controller samples it at every
+/// step: the polynomial of each segment is computed once (for a trajectory of positions only,
+/// that includes the clamped spline through all of them), so that Sample costs a binary search
+/// and one polynomial whatever the number of waypoints. JointTrajectory::Sample fits the spline
+/// again at every call. The values are exactly JointTrajectory::Sample's.
+class TrajectorySampler {
+ public:
+  /// Samples an empty trajectory: Sample throws.
+  TrajectorySampler() = default;
+  /// Throws partsim::Error when `trajectory` has no waypoints or positions for fewer or more
+  /// times (JointTrajectory::Validate checks the rest).
+  explicit TrajectorySampler(JointTrajectory trajectory);
+
+  const JointTrajectory& trajectory() const { return trajectory_; }
+  /// JointTrajectory::Sample of the trajectory.
+  void Sample(double t, Eigen::VectorXd* q, Eigen::VectorXd* qd = nullptr,
+              Eigen::VectorXd* qdd = nullptr) const;
+
+ private:
+  JointTrajectory trajectory_;
+  /// Per pair of consecutive waypoints, the coefficients of its polynomial in the time since the
+  /// first of them, ascending powers.
+  std::vector<std::array<Eigen::VectorXd, 6>> segments_;
 };
 
 /// Times a path of joint positions (no times) so that it starts and ends at rest and no joint
