@@ -25,7 +25,15 @@
 //
 // Usage: partsim_vision_dataset_bench [--objects N] [--views V] [--size S] [--reps R]
 //                                     [--seconds T] [--jobs J1,J2,...] [--tree DIR] [--keep]
-// (--tree: the objects of an existing tree, e.g. ../shared/realdata, instead of generated ones)
+//                                     [--processes P]
+// (--tree: the objects of an existing tree, e.g. ../shared/realdata, instead of generated ones;
+// --processes P: each dataset run is P processes at once, each rendering its shard i/P with
+// --jobs J workers, then a merge-only run, as a scheduler would split the work; "all" is then
+// views / (the processes' wall time + the merge's), "render" leaves out the merge-only time, and
+// CPU counts the processes')
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -179,9 +187,8 @@ struct DatasetRun {
   long views = 0;
 };
 
-DatasetRun RunDataset(const std::string& tree, const std::string& out, int views, int size,
-                      int jobs) {
-  fs::remove_all(out);
+partsim::vision::DatasetOptions Options(const std::string& tree, const std::string& out, int views,
+                                        int size, int jobs) {
   partsim::vision::DatasetOptions o;
   o.dataset_root = tree;
   o.out = out;
@@ -190,6 +197,74 @@ DatasetRun RunDataset(const std::string& tree, const std::string& out, int views
   o.seed = 1;
   o.jobs = jobs;
   o.progress = false;
+  return o;
+}
+
+double ChildrenCpu() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// The run split into `processes` processes of this program, shard i of them each
+// (--shard-worker), started at once; then a merge-only run here.
+DatasetRun RunShardedDataset(const std::string& tree, const std::string& out, int views, int size,
+                             int jobs, int processes) {
+  fs::remove_all(out);
+  const std::string self = fs::read_symlink("/proc/self/exe").string();
+  std::vector<pid_t> pids;
+  const double cpu0 = ChildrenCpu();
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < processes; ++i) {
+    const std::string shard = std::to_string(i) + "/" + std::to_string(processes);
+    const std::vector<std::string> args = {self,
+                                           "--shard-worker",
+                                           shard,
+                                           "--tree",
+                                           tree,
+                                           "--out",
+                                           out,
+                                           "--views",
+                                           std::to_string(views),
+                                           "--size",
+                                           std::to_string(size),
+                                           "--jobs",
+                                           std::to_string(jobs)};
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    if (posix_spawn(&pid, self.c_str(), nullptr, nullptr, argv.data(), environ) != 0)
+      throw partsim::Error("could not start a shard process");
+    pids.push_back(pid);
+  }
+  for (pid_t pid : pids) {
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+      throw partsim::Error("a shard process failed");
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cpu = ChildrenCpu() - cpu0;
+  partsim::vision::DatasetOptions o = Options(tree, out, views, size, jobs);
+  o.merge_only = true;
+  const partsim::vision::DatasetSummary m = partsim::vision::GenerateDataset(o);
+  fs::remove_all(out);
+  DatasetRun r;
+  r.views = static_cast<long>(m.objects) * views;
+  r.merge = m.seconds;
+  r.cpu_ms = 1000 * cpu / static_cast<double>(r.views);
+  r.all = static_cast<double>(r.views) / (wall + m.seconds);
+  r.render = static_cast<double>(r.views) / wall;
+  return r;
+}
+
+DatasetRun RunDataset(const std::string& tree, const std::string& out, int views, int size,
+                      int jobs, int processes) {
+  if (processes > 1) return RunShardedDataset(tree, out, views, size, jobs, processes);
+  fs::remove_all(out);
+  partsim::vision::DatasetOptions o = Options(tree, out, views, size, jobs);
   const double cpu0 = CpuNow();
   const partsim::vision::DatasetSummary s = partsim::vision::GenerateDataset(o);
   const double cpu1 = CpuNow();
@@ -217,7 +292,8 @@ std::string Minutes(double seconds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int objects = 12, views = 20, size = 512, reps = 3;
+  int objects = 12, views = 20, size = 512, reps = 3, processes = 1;
+  std::string shard_worker, out_dir;  // the hidden --shard-worker mode (RunShardedDataset)
   std::vector<int> jobs = {1, 2};
   double seconds = 4.0;
   bool keep = false;
@@ -255,15 +331,27 @@ int main(int argc, char** argv) {
       tree = next();
     } else if (!std::strcmp(argv[i], "--keep")) {
       keep = true;
+    } else if (!std::strcmp(argv[i], "--processes")) {
+      processes = std::atoi(next());
+    } else if (!std::strcmp(argv[i], "--shard-worker")) {
+      shard_worker = next();
+    } else if (!std::strcmp(argv[i], "--out")) {
+      out_dir = next();
     } else {
       std::fprintf(stderr,
                    "usage: %s [--objects N] [--views V] [--size S] [--reps R] [--seconds T] "
-                   "[--jobs J1,J2,...] [--tree DIR] [--keep]\n",
+                   "[--jobs J1,J2,...] [--tree DIR] [--keep] [--processes P]\n",
                    argv[0]);
       return 2;
     }
   }
-  if (objects < 1 || views < 1 || size < 16 || reps < 1) {
+  if (!shard_worker.empty()) {
+    partsim::vision::DatasetOptions o = Options(tree, out_dir, views, size, jobs.front());
+    if (std::sscanf(shard_worker.c_str(), "%d/%d", &o.shard_index, &o.shard_count) != 2) return 2;
+    const partsim::vision::DatasetSummary s = partsim::vision::GenerateDataset(o);
+    return s.failed > 0 ? 1 : 0;
+  }
+  if (objects < 1 || views < 1 || size < 16 || reps < 1 || processes < 1) {
     std::fprintf(stderr, "bad arguments\n");
     return 2;
   }
@@ -310,6 +398,9 @@ int main(int argc, char** argv) {
   const unsigned kDatasetOutputs = partsim::kColor | partsim::kPosition | partsim::kSegmentation;
   std::printf("device: %s; %zu triangles per object on average; %d x %d, %d views per object\n",
               backend->Device().c_str(), triangles / scenes.size(), size, size, views);
+  if (processes > 1)
+    std::printf("each dataset run: %d processes at once, shard i/%d each, then a merge-only run\n",
+                processes, processes);
   std::printf("%d repetitions; rasterizer rates over >= %.1f s each; hardware threads %u\n", reps,
               seconds, std::thread::hardware_concurrency());
   std::fflush(stdout);
@@ -341,7 +432,7 @@ int main(int argc, char** argv) {
         bare_cpu.push_back(rate.cpu_ms);
       } else {
         const size_t j = run - 2;
-        const DatasetRun d = RunDataset(tree, out, views, size, jobs[j]);
+        const DatasetRun d = RunDataset(tree, out, views, size, jobs[j], processes);
         j_all[j].push_back(d.all);
         j_render[j].push_back(d.render);
         j_cpu[j].push_back(d.cpu_ms);
@@ -373,7 +464,8 @@ int main(int argc, char** argv) {
     // the rendering at the measured rate, the start (scan, parse) and the split files scaled
     // by the number of objects
     const double projected = kPaperObjects * kPaperViews / render + merge * kPaperObjects / objects;
-    const std::string name = "--jobs " + std::to_string(jobs[j]);
+    const std::string name = (processes > 1 ? std::to_string(processes) + " x " : std::string()) +
+                             "--jobs " + std::to_string(jobs[j]);
     std::printf("%-9s %8.2f %8.2f %8.1f | %8.3f %8.3f %8.3f | %8.2f | %s\n", name.c_str(), all,
                 render, cpu, render / raster_m, render / bare_m, raster_cpu_m / cpu, merge,
                 Minutes(projected).c_str());

@@ -1,6 +1,8 @@
 // GenerateDataset: the detection and motion-attribute datasets (partsim/vision/dataset.h).
 #include "partsim/vision/dataset.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -163,10 +165,21 @@ void WriteText(const std::string& path, const std::string& text) {
   if (!f) throw Error("vision dataset: cannot write '" + path + "'");
 }
 
-// Writes `text` to path.partial and renames it into place: a reader never sees half a file.
+// Writes `text` to a file of its own beside `path` and renames it into place: a reader never
+// sees half a file, and writers at once (shards of one dataset in several processes, say) never
+// write into one another's file; the last rename wins.
 void WriteTextAtomic(const std::string& path, const std::string& text) {
-  WriteText(path + ".partial", text);
-  fs::rename(path + ".partial", path);
+  static std::atomic<unsigned long> count{0};
+  const std::string mine =
+      path + ".partial." + std::to_string(::getpid()) + "." + std::to_string(count.fetch_add(1));
+  try {
+    WriteText(mine, text);
+    fs::rename(mine, path);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(mine, ignored);
+    throw;
+  }
 }
 
 std::string Two(int i) {

@@ -1,5 +1,5 @@
-// The perception datasets: same bytes whatever the jobs and shards, resume, the split, the
-// COCO files read back by partsim's own COCO reader, bad options.
+// The perception datasets: same bytes whatever the jobs and shards (shards at the same time
+// too), resume, the split, the COCO files read back by partsim's own COCO reader, bad options.
 #include "partsim/vision/dataset.h"
 
 #include <gtest/gtest.h>
@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <map>
 #include <sstream>
 
@@ -125,6 +126,38 @@ TEST(DatasetTest, DetectionDatasetIsTheSameWhateverTheJobsAndShards) {
   for (const CocoAnnotation& a : train.annotations)
     perfect.push_back({a.image_id, a.category_id, a.segmentation, 1.0});
   EXPECT_NEAR(EvaluateDetection(train, perfect).map, 1.0, 1e-12);
+}
+
+// Shards of one dataset may run at the same time into one folder (a scheduler's array job):
+// each writes dataset.json and the split files through a file of its own, so none trips over
+// another's. After a merge-only run the folder is the same bytes as one run's.
+TEST(DatasetTest, ShardsRunAtTheSameTimeIntoOneFolder) {
+  const std::string one = Temp("together_one"), together = Temp("together");
+  DatasetOptions o = SmallOptions(one, DatasetKind::kDetection);
+  GenerateDataset(o);
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    fs::remove_all(together);
+    std::vector<std::future<DatasetSummary>> shards;
+    for (int i = 0; i < 4; ++i) {
+      DatasetOptions s = o;
+      s.out = together;
+      s.shard_count = 4;
+      s.shard_index = i;
+      shards.push_back(std::async(std::launch::async, [s] { return GenerateDataset(s); }));
+    }
+    int rendered = 0;
+    for (auto& f : shards) {
+      const DatasetSummary s = f.get();  // rethrows what a shard threw
+      EXPECT_EQ(s.failed, 0) << (s.errors.empty() ? "" : s.errors.front());
+      rendered += s.rendered;
+    }
+    EXPECT_EQ(rendered, 4);
+    DatasetOptions merge = o;
+    merge.out = together;
+    merge.merge_only = true;
+    GenerateDataset(merge);
+    EXPECT_EQ(Files(one), Files(together)) << "attempt " << attempt;
+  }
 }
 
 TEST(DatasetTest, SplitIsByObjectWithinEachCategory) {
