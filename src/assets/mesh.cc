@@ -20,6 +20,7 @@
 #include <unordered_map>
 
 #include "assets/obj_reader.h"
+#include "core/ascii.h"
 #include "core/file_read.h"
 #include "partsim/assets/convex_decomposition.h"
 #include "partsim/core/error.h"
@@ -39,9 +40,7 @@ Eigen::Matrix4d ToEigen(const aiMatrix4x4& m) {
 
 // Whether `path` ends in `ext` (".obj"), in any case.
 bool HasExtension(const std::string& path, const char* ext) {
-  std::string e = fs::path(path).extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
-  return e == ext;
+  return internal::AsciiLower(fs::path(path).extension().string()) == ext;
 }
 
 // Render material of an assimp material; texture paths made absolute against `dir`.

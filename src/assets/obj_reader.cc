@@ -11,6 +11,7 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "core/ascii.h"
 #include "core/file_read.h"
 #include "partsim/core/error.h"
 
@@ -37,11 +38,12 @@ std::string_view Token(std::string_view* s) {
   return t;
 }
 
-bool ToFloat(std::string_view t, float* out) {
+bool ToFloat(std::string_view t, float* out, bool* out_of_range = nullptr) {
   const char* b = t.data();
   const char* e = b + t.size();
   if (b != e && *b == '+') ++b;
   auto [p, ec] = std::from_chars(b, e, *out);
+  if (out_of_range) *out_of_range = ec == std::errc::result_out_of_range && p == e;
   return ec == std::errc() && p == e;
 }
 
@@ -137,13 +139,6 @@ std::string_view TextureName(std::string_view rest) {
   return Trim(rest);
 }
 
-std::string Lower(std::string_view s) {
-  std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return out;
-}
-
 // Reads the materials of an MTL library into `materials`, in order; `dir` resolves textures.
 void ReadMtl(const std::string& path, const fs::path& dir,
              std::vector<std::pair<std::string, RenderMaterial>>* materials) {
@@ -162,7 +157,7 @@ void ReadMtl(const std::string& path, const fs::path& dir,
   };
   while (lines.Next(&line, &number)) {
     std::string_view rest = line;
-    const std::string key = Lower(Token(&rest));
+    const std::string key = AsciiLower(Token(&rest));
     if (key == "newmtl") {
       materials->emplace_back(std::string(Trim(rest)), DefaultMaterial());
       current = &materials->back().second;
@@ -256,28 +251,30 @@ void Triangulate(const std::vector<Eigen::Vector3f>& p, std::vector<Eigen::Vecto
   };
   std::vector<int> left(n);
   for (int i = 0; i < n; ++i) left[i] = i;
-  while (left.size() > 3) {
+  // walk round the polygon cutting ears; the walk goes on from the corner after a cut, so a
+  // polygon of n corners costs O(n^2), and a whole round without a cut ends it
+  int k = 0, misses = 0;
+  while (left.size() > 3 && misses < static_cast<int>(left.size())) {
     const int m = static_cast<int>(left.size());
-    bool cut = false;
-    for (int k = 0; k < m && !cut; ++k) {
-      const int a = left[(k + m - 1) % m], b = left[k], c = left[(k + 1) % m];
-      if (cross(q[a], q[b], q[c]) <= 0.0) continue;  // reflex or flat corner
-      bool empty = true;
-      for (int j : left) {
-        if (j == a || j == b || j == c) continue;
-        if (cross(q[a], q[b], q[j]) >= 0 && cross(q[b], q[c], q[j]) >= 0 &&
-            cross(q[c], q[a], q[j]) >= 0) {
-          empty = false;
-          break;
-        }
-      }
-      if (!empty) continue;
-      out->emplace_back(a, b, c);
-      left.erase(left.begin() + k);
-      cut = true;
+    k %= m;
+    const int a = left[(k + m - 1) % m], b = left[k], c = left[(k + 1) % m];
+    bool ear = cross(q[a], q[b], q[c]) > 0.0;  // not a reflex or flat corner
+    for (size_t j = 0; ear && j < left.size(); ++j) {
+      const int x = left[j];
+      if (x == a || x == b || x == c) continue;
+      ear = !(cross(q[a], q[b], q[x]) >= 0 && cross(q[b], q[c], q[x]) >= 0 &&
+              cross(q[c], q[a], q[x]) >= 0);
     }
-    if (!cut) break;  // self-intersecting: the rest as a fan
+    if (!ear) {
+      ++k;
+      ++misses;
+      continue;
+    }
+    out->emplace_back(a, b, c);
+    left.erase(left.begin() + k);
+    misses = 0;
   }
+  // a self-intersecting rest, if any, as a fan
   for (size_t i = 1; i + 1 < left.size(); ++i) out->emplace_back(left[0], left[i], left[i + 1]);
 }
 
@@ -359,7 +356,9 @@ std::vector<FileSubMesh> ParseObj(std::string_view text, const std::string& fold
       const int need = key == "vt" ? 1 : 3;
       int n = 0;
       for (std::string_view t = Token(&rest); !t.empty() && n < 3; t = Token(&rest), ++n) {
-        if (!ToFloat(t, &x[n])) {
+        bool huge = false;
+        if (!ToFloat(t, &x[n], &huge)) {
+          if (huge) fail(number, "'" + std::string(t) + "' is beyond the range of a float");
           if (n >= need) break;  // e.g. a colour after "v x y z" is numbers too; anything else ends
           fail(number, "'" + std::string(key) + "' needs " + std::to_string(need) + " number" +
                            (need > 1 ? "s" : "") + ", got '" + std::string(t) + "'");
@@ -396,11 +395,12 @@ std::vector<FileSubMesh> ParseObj(std::string_view text, const std::string& fold
             // relative indices count back from the data read so far; positive ones are
             // checked once the whole file is read
             const long long resolved = index > 0 ? index - 1 : sizes[k] + index;
-            if (resolved < 0 || resolved > std::numeric_limits<int>::max())
-              fail(number, "face corner '" + std::string(t) + "' refers before the first " +
-                               (k == 0   ? "vertex"
-                                : k == 1 ? "texture coordinate"
-                                         : "normal"));
+            const char* what = k == 0 ? "vertex" : k == 1 ? "texture coordinate" : "normal";
+            if (resolved < 0)
+              fail(number, "face corner '" + std::string(t) + "' refers before the first " + what);
+            if (resolved > std::numeric_limits<int>::max())  // more than a file can hold
+              fail(number, "face refers to " + std::string(what) + " " + std::to_string(index) +
+                               " of " + std::to_string(sizes[k]));
             *slots[k] = static_cast<int>(resolved);
           }
           if (slash == std::string_view::npos) break;

@@ -2,7 +2,6 @@
 #include "partsim/assets/scene_file.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/ascii.h"
 #include "core/file_read.h"
 #include "core/json_parse.h"
 #include "partsim/assets/partnet_mobility.h"
@@ -29,12 +29,6 @@ constexpr double kUnitTolerance = 1e-3;  // |norm - 1| allowed for quaternions, 
 // What a path names.
 enum class PathKind { kUrdf, kPartNetFolder, kSceneFile };
 
-std::string Lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
-
 std::string Number(double x) {
   std::ostringstream s;
   s.precision(17);
@@ -53,7 +47,7 @@ PathKind Classify(const fs::path& path, const std::string& where) {
                 ": folder holds neither mobility.urdf nor mobility_v2.json (not a "
                 "PartNet-Mobility object)");
   }
-  const std::string ext = Lower(path.extension().string());
+  const std::string ext = internal::AsciiLower(path.extension().string());
   if (ext == ".urdf") return PathKind::kUrdf;
   if (ext == ".json") return PathKind::kSceneFile;
   throw Error(where + ": unknown extension '" + ext +
@@ -151,7 +145,7 @@ SceneObjectSpec ReadEntry(const json& j, const Fields& f, const fs::path& base_d
   if (raw.empty()) f.Fail("path", "is empty");
   fs::path p(raw);
   spec.path = (p.is_absolute() ? p : base_dir / p).lexically_normal().string();
-  if (Lower(p.extension().string()) == ".json")
+  if (internal::AsciiLower(p.extension().string()) == ".json")
     f.Fail("path", "'" + raw + "' is a scene file; scene files cannot be nested");
   if (j.contains("name")) {
     spec.name = f.String(j, "name");

@@ -1,27 +1,18 @@
 #include "server/web_security.h"
 
-#include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <cstring>
 #include <random>
 
+#include "core/ascii.h"
+
 namespace partsim::internal {
-
-namespace {
-
-std::string Lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char ch) { return std::tolower(ch); });
-  return s;
-}
-
-}  // namespace
 
 bool OriginAllowed(const std::string& origin, const std::vector<std::string>& allowed) {
   if (origin.empty()) return true;
-  const std::string o = Lower(origin);
+  const std::string o = AsciiLower(origin);
   for (const std::string& a : allowed)
-    if (a == "*" || Lower(a) == o) return true;
+    if (a == "*" || AsciiLower(a) == o) return true;
   if (!allowed.empty()) return false;
   for (const char* scheme : {"http://", "https://"}) {
     if (o.rfind(scheme, 0) != 0) continue;

@@ -3,6 +3,8 @@
 #include <cctype>
 #include <map>
 
+#include "core/ascii.h"
+
 namespace partsim::internal {
 
 void SplitResource(const std::string& resource, std::string* path, std::string* query) {
@@ -58,8 +60,7 @@ std::string ContentTypeOf(const std::string& path) {
       {"woff2", "font/woff2"}};
   const size_t dot = path.rfind('.');
   if (dot == std::string::npos) return "application/octet-stream";
-  std::string ext = path.substr(dot + 1);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = AsciiLower(path.substr(dot + 1));
   auto it = types.find(ext);
   return it == types.end() ? "application/octet-stream" : it->second;
 }

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -170,6 +171,36 @@ TEST(ObjReaderTest, ConcavePolygonsCoverWhatTheyBound) {
   EXPECT_NEAR(area, 5.0 + 0.7 + 4.4, 1e-5);
 }
 
+// A concave face of 2,000 corners (a star) is cut into 1,998 ears that cover exactly its area;
+// the cutting walks on from each cut, so such a face costs n^2 checks, not n^3.
+TEST(ObjReaderTest, AStarOfTwoThousandCornersIsCutIntoEars) {
+  const fs::path dir = Temp("star");
+  constexpr int kCorners = 2000;
+  std::string obj;
+  std::vector<Eigen::Vector2d> corners;
+  for (int i = 0; i < kCorners; ++i) {
+    const double angle = 2.0 * M_PI * i / kCorners, r = i % 2 ? 0.5 : 1.0;
+    corners.emplace_back(r * std::cos(angle), r * std::sin(angle));
+    obj += "v " + std::to_string(corners.back().x()) + " " + std::to_string(corners.back().y()) +
+           " 0\n";
+  }
+  obj += "f";
+  for (int i = 1; i <= kCorners; ++i) obj += " " + std::to_string(i);
+  Write(dir / "star.obj", obj + "\n");
+  const std::vector<LoadedMesh> m = LoadMeshFile((dir / "star.obj").string());
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_EQ(m[0].mesh->faces.size(), static_cast<size_t>(kCorners - 2));
+  double twice_area = 0.0;  // shoelace, of the file's rounded corners
+  for (int i = 0; i < kCorners; ++i) {
+    const Eigen::Vector3f& a = m[0].mesh->vertices[i];
+    const Eigen::Vector3f& b = m[0].mesh->vertices[(i + 1) % kCorners];
+    twice_area += static_cast<double>(a.x()) * b.y() - static_cast<double>(b.x()) * a.y();
+  }
+  const auto [area, normal] = AreaAndNormal(*m[0].mesh);
+  EXPECT_NEAR(area, twice_area, 1e-4);
+  EXPECT_NEAR(normal.z(), area, 1e-4);  // no ear folds back
+}
+
 // Where assimp refuses or guesses: CRLF line ends, a statement continued with '\', comments
 // after numbers, a vertex colour, points and lines among faces, and faces without normals next
 // to faces with them (assimp leaves those normals zero; partsim gives them their face's).
@@ -212,6 +243,15 @@ TEST(ObjReaderTest, BadStatementsAreNamedByLine) {
   };
   expect("v 0 0 0\nv 1 zero 0\n", "2", "'v' needs 3 numbers, got 'zero'");
   expect("v 0 0 0\nv 1 0\n", "2", "'v' needs 3 numbers, got 2");
+  // huge numbers: a coordinate past a float, an index past an int or a long
+  expect("v 0 0 0\nv 1e50 0 0\n", "2", "'1e50' is beyond the range of a float");
+  expect("v 0 0 0\nvt 0.5 -1e39\n", "2", "'-1e39' is beyond the range of a float");
+  expect("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", "4",
+         "indices are whole numbers from 1");
+  expect("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3000000000\n", "4",
+         "face refers to vertex 3000000000 of 3");
+  // non-ASCII bytes where a number belongs
+  expect("v 0 0 0\nv \xc3\xa9 0 0\n", "2", "'v' needs 3 numbers");
   expect("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", "4", "indices are whole numbers from 1");
   expect("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "4", "indices are whole numbers from 1");
   expect("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "4", "face refers to vertex 9 of 3");
