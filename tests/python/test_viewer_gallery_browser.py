@@ -102,7 +102,8 @@ def session(tmp_path_factory):
                       key=lambda o: len(o["movable"]))
         door = next(o for o in objects if o["category"] == "Door")
         config = {"url": url, "out": out, "category": "Faucet", "label": "door",
-                  "open": [storage["name"], door["name"]], "timeout_ms": 240000}
+                  "open": [storage["name"], door["name"]], "mesh_delay_ms": 600,
+                  "timeout_ms": 240000}
         returncode, page = run_page_check(CHECK, config, timeout=300)
         if returncode != 0:
             pytest.fail(f"the gallery check failed: {page.get('error')} (steps {page.get('steps')}; "
@@ -187,6 +188,10 @@ def test_click_opens_the_object_and_its_joints_animate(session):
         assert o["canvas_visible"]
         links = sorted(b["name"] for b in o["bodies"] if b["kind"] == "link")
         assert links == sorted(expected["links"]), (links, expected["links"])
+        # sampled once every mesh had come (they were held back 600 ms): each visual built
+        for b in o["bodies"]:
+            assert b["visuals"] == b["visuals_listed"], b
+        assert sum(b["visuals"] for b in o["bodies"]) > 0
         # no meshes left over from the previous object: one per visual of this scene
         assert o["mesh_count"] == sum(b["visuals"] for b in o["bodies"]), o["mesh_count"]
         # the panels start afresh for each object

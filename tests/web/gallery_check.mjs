@@ -3,7 +3,8 @@
 // (tests/python/test_viewer_gallery_browser.py) makes the assertions.
 // Usage: node tests/web/gallery_check.mjs CONFIG_JSON
 //   CONFIG: {"url", "out": DIR, "category": a category to filter on, "open": [name, name]
-//            (two objects to open one after the other), "timeout_ms"}
+//            (two objects to open one after the other), "mesh_delay_ms" (mesh requests held this
+//            long while the objects open), "timeout_ms"}
 // Exit code 0 with {"ok": true, ...}; 2 with {"skip": reason} when Chromium cannot start; 1 with
 // {"error": ...} otherwise.
 import path from 'node:path';
@@ -58,6 +59,15 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: 1100, heig
     note('filters');
 
     // 3. open the first object with a click on its card: the viewer shows its links, animated
+    // meshes come late (config.mesh_delay_ms): the object is sampled only once all have come
+    if (config.mesh_delay_ms) {
+      await page.setRequestInterception(true);
+      page.on('request', (r) => {
+        if (r.isInterceptResolutionHandled()) return;
+        if (r.url().includes('/api/mesh/')) setTimeout(() => r.continue(), config.mesh_delay_ms);
+        else r.continue();
+      });
+    }
     const opened = [];
     for (const [k, name] of config.open.entries()) {
       const index = result.items.find((i) => i.name === name).index;
@@ -66,7 +76,8 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: 1100, heig
       await waitFor(page, () => window.partsimViewer.galleryState().mode === 'viewer', null, 5000, 'viewer shown');
       await waitFor(page, (v) => {
         const s = window.partsimViewer.stats();
-        return s.scene_version !== v && s.bodies > 0 && !document.body.classList.contains('gallery-shown');
+        return s.scene_version !== v && s.bodies > 0 && !s.loading &&
+          !document.body.classList.contains('gallery-shown');
       }, versionBefore, 30000, `scene of ${name}`);
       await sleep(300);
       const o = { name, index };

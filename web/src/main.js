@@ -390,6 +390,8 @@ class Viewer {
       fast_shading: this.fastShading,
       antialias: this.renderer.getContextAttributes()?.antialias ?? null,
       scene_version: this.model.desc ? this.model.desc.scene_version : null,
+      // a scene.json is being loaded: its bodies may be listed while their meshes still arrive
+      loading: this.loading,
     };
   }
 
@@ -419,7 +421,8 @@ class Viewer {
         bodies: () => this.model.bodies.filter(Boolean).map((b) => ({
           id: b.desc.id, name: b.desc.name, label: b.desc.label || '', kind: b.desc.kind,
           articulation: b.desc.articulation, joint: b.joint ? b.joint.name : null,
-          visuals: b.visuals.length,
+          visuals: b.visuals.length, // built so far
+          visuals_listed: (b.desc.visuals || []).length, // in scene.json
         })),
         // each body's drawn pose [x, y, z, qw, qx, qy, qz] (what the last frame applied)
         bodyPoses: () => this.model.bodies.filter(Boolean).map((b) => {
