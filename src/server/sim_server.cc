@@ -39,8 +39,13 @@ void SimServer::Stop() {
 }
 
 void SimServer::Pause() {
-  paused_ = true;
-  pending_steps_ = 0;  // a pause stops a StepN burst too
+  {
+    // under the lock, so that the simulation thread cannot miss the change between testing
+    // its wait's condition and starting to wait
+    std::lock_guard<std::mutex> lock(mutex_);
+    paused_ = true;
+    pending_steps_ = 0;  // a pause stops a StepN burst too
+  }
   cv_.notify_all();
 }
 
@@ -57,14 +62,18 @@ void SimServer::StepN(long long n) {
   if (n < 1 || n > kMaxStepRequest)
     throw Error("step: n must be an integer from 1 to " + std::to_string(kMaxStepRequest) +
                 ", got " + std::to_string(n));
-  long long pending = pending_steps_.load();
-  while (!pending_steps_.compare_exchange_weak(pending, std::min(pending + n, kMaxStepRequest))) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);  // as in Pause()
+    pending_steps_ = std::min(pending_steps_ + n, kMaxStepRequest);
   }
   cv_.notify_all();
 }
 
 void SimServer::Reset() {
-  pending_steps_ = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_steps_ = 0;
+  }
   Post([this] { scene_->Unpack(initial_state_); });
 }
 
@@ -136,6 +145,7 @@ void SimServer::Loop() {
       cv_.wait(lock, [this] { return stop_ || !queue_.empty() || !paused_ || pending_steps_ > 0; });
       continue;
     }
+    // paused: one of the requested steps (the count and the flag change only under the lock)
     const bool single = paused_;
     if (single) --pending_steps_;
     // pace against the wall clock

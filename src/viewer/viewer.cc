@@ -677,6 +677,7 @@ struct Viewer::Impl {
       } else if (service == "/partsim/pause") {
         if (sim) {
           sim->Pause();
+          RequestSnapshot();  // the state it paused in (the last steps' snapshots may be skipped)
         } else {
           std::lock_guard<std::mutex> lock(mutex);
           paused = true;
@@ -1070,7 +1071,9 @@ void Viewer::Attach(SimServer* sim) {
   if (!m.scene) throw Error("Viewer::Attach: the viewer has no scene");
   m.sim = sim;
   sim->AddStepCallback([this](long long) {
-    if (impl_->started) impl_->Snapshot(false);
+    // the last step of a /partsim/step burst is always shown: the scene rests there
+    const bool rests = impl_->sim->IsPaused() && impl_->sim->GetPendingSteps() <= 0;
+    if (impl_->started) impl_->Snapshot(rests);
   });
 }
 

@@ -252,13 +252,20 @@ def test_view_file_serves_its_links_and_stops_on_sigterm(tmp_path, serve):
     assert {"base", "door", "drawer"} <= {b["name"] for b in scene["bodies"]}
     # served mode: a step while running pauses, then the SimServer takes the n steps
     ws = s.connect()
-    assert call(ws, "/partsim/step", {"n": 5}, "step")["result"] is True
     ws.send(json.dumps({"op": "subscribe", "topic": "/partsim/status"}))
-    status = next_message(ws, "/partsim/status")
-    assert status["paused"] is True
-    time.sleep(0.5)
-    later = next_message(ws, "/partsim/status")
-    assert later["paused"] is True and later["step"] == status["step"]
+    running = next_message(ws, "/partsim/status")
+    assert running["paused"] is False
+    assert call(ws, "/partsim/step", {"n": 5}, "step")["result"] is True
+    # the call queues the steps; the simulation thread takes them when it gets the CPU. Wait
+    # until the step count holds over half a second (it never does while running)
+    status, deadline = last_message(ws, "/partsim/status", 0.5), time.time() + 30
+    while True:
+        later = last_message(ws, "/partsim/status", 0.5)
+        if later["step"] == status["step"] or time.time() > deadline:
+            break
+        status = later
+    assert later["paused"] is True and later["step"] == status["step"], (status, later)
+    assert later["step"] >= running["step"] + 5, (running, later)
     ws.close()
     t0 = time.time()
     assert s.sigterm() == 0 and time.time() - t0 < 5

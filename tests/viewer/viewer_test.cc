@@ -533,6 +533,50 @@ TEST_F(ViewerTest, StepWhileRunningPausesThenSteps) {
   viewer_.reset();
 }
 
+TEST_F(ViewerTest, ThePageSeesTheStateTheSimulationRestsIn) {
+  // served mode: snapshots (what /partsim/status and /partsim/poses tell) are taken at most
+  // every 1/60 s while running, but the state a pause or the end of a /partsim/step burst leaves
+  // is always taken (a burst of a few steps takes less than 1/60 s: its last steps were skipped)
+  SimServerOptions so;
+  so.fast = false;
+  SimServer sim(scene_.get(), nullptr, so);
+  viewer_ = std::make_unique<Viewer>(scene_.get());
+  viewer_->Attach(&sim);
+  viewer_->Start();
+  sim.Start();
+  ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() > 20; }));
+  TestClient c(viewer_->GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Auth(viewer_->GetToken());
+  c.Send(json{{"op", "subscribe"}, {"topic", "/partsim/status"}});
+  auto status_at = [&](long long step) {
+    return c.WaitMessage([&](const json& m) {
+      return m.value("topic", "") == "/partsim/status" && m["msg"]["paused"] == true &&
+             m["msg"]["step"] == step;
+    });
+  };
+  c.Send(Call("/partsim/pause", json::object(), "p"));
+  ASSERT_FALSE(c.WaitReply("p").is_null());
+  // the thread may finish the step it is in
+  ASSERT_TRUE(WaitFor([&] {
+    const long long s = sim.GetClockSteps();
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    return sim.GetClockSteps() == s;
+  }));
+  const long long paused_at = sim.GetClockSteps();
+  EXPECT_FALSE(status_at(paused_at).is_null()) << "the status shows the step it paused at";
+  for (int burst = 1; burst <= 5; ++burst) {
+    const long long before = sim.GetClockSteps();
+    const std::string id = "s" + std::to_string(burst);
+    c.Send(Call("/partsim/step", {{"n", 3}}, id));
+    ASSERT_FALSE(c.WaitReply(id).is_null());
+    ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() == before + 3; }));
+    EXPECT_FALSE(status_at(before + 3).is_null()) << "burst " << burst;
+  }
+  sim.Stop();
+  viewer_.reset();
+}
+
 TEST_F(ViewerTest, CameraServiceAnswersAPngThatDecodes) {
   Camera cam = scene_->AddCamera("front", 64, 48, 1.0, 0.05, 20.0);
   cam.SetLocalPose(CameraLookAt(Eigen::Vector3d(2, -2, 1.5), Eigen::Vector3d(0, 0, 0.4)));
