@@ -90,9 +90,10 @@ export function isGalleryProbe(url) {
  * viewer's scene drawn), 'gallery' (the gallery's grid built, or known absent) or 'none';
  * `viewport`: {width, height} of the page before it loads (default: the browser's).
  */
-export async function openViewer(browser, url, { timeoutMs = 60000, waitFor = 'ready', viewport = null } = {}) {
+export async function openViewer(browser, url, { timeoutMs = 60000, waitFor = 'ready', viewport = null, beforeLoad = null } = {}) {
   const page = await browser.newPage();
   if (viewport) await page.setViewport({ deviceScaleFactor: 1, ...viewport });
+  if (beforeLoad) await beforeLoad(page);
   const errors = [];
   const warnings = [];
   const probes = [];
@@ -135,6 +136,13 @@ export async function waitFor(page, fn, arg, timeoutMs, what) {
 }
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+/** Waits until the page has drawn `n` more frames (a slow machine may take longer than a sleep). */
+export async function framesDrawn(page, n, timeoutMs = 30000) {
+  const start = await page.evaluate(() => window.partsimViewer.stats().frames);
+  await waitFor(page, (want) => window.partsimViewer.stats().frames >= want, start + n, timeoutMs,
+    `${n} frames drawn`);
+}
 
 /**
  * Runs one browser check and ends the process with its result as one JSON line: launches

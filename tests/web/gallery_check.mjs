@@ -15,7 +15,21 @@ const shownNames = (items) => items.filter((i) => i.shown).map((i) => i.name);
 
 runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: 1100, height: 700 } },
   async (browser, result, note) => {
-    const { page, errors, warnings, probes } = await openViewer(browser, config.url, { waitFor: 'gallery' });
+    // the thumbnails are held back until the placeholders have been counted; meshes, by
+    // config.mesh_delay_ms once the objects open
+    let releaseThumbnails;
+    const thumbnailsHeld = new Promise((resolve) => { releaseThumbnails = resolve; });
+    let meshDelayMs = 0;
+    const beforeLoad = async (p) => {
+      await p.setRequestInterception(true);
+      p.on('request', (r) => {
+        const go = () => r.continue().catch(() => {}); // the page may have closed meanwhile
+        if (r.url().includes('/api/thumbnail/')) thumbnailsHeld.then(go);
+        else if (meshDelayMs && r.url().includes('/api/mesh/')) setTimeout(go, meshDelayMs);
+        else go();
+      });
+    };
+    const { page, errors, warnings, probes } = await openViewer(browser, config.url, { waitFor: 'gallery', beforeLoad });
     result.errors = errors;
     result.warnings = warnings;
     result.probes = probes;
@@ -29,6 +43,7 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: 1100, heig
     result.grid_visible = await ev(() => !document.getElementById('gallery').hidden);
     result.items_at_load = await items();
     result.placeholders_at_load = await ev(() => document.querySelectorAll('.gallery-item .thumb.loading').length);
+    releaseThumbnails();
     result.category_options = await ev(() => [...document.querySelectorAll('#gallery-category option')]
       .map((o) => ({ value: o.value, text: o.textContent })));
     note('gallery');
@@ -60,14 +75,7 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: 1100, heig
 
     // 3. open the first object with a click on its card: the viewer shows its links, animated
     // meshes come late (config.mesh_delay_ms): the object is sampled only once all have come
-    if (config.mesh_delay_ms) {
-      await page.setRequestInterception(true);
-      page.on('request', (r) => {
-        if (r.isInterceptResolutionHandled()) return;
-        if (r.url().includes('/api/mesh/')) setTimeout(() => r.continue(), config.mesh_delay_ms);
-        else r.continue();
-      });
-    }
+    meshDelayMs = config.mesh_delay_ms || 0;
     const opened = [];
     for (const [k, name] of config.open.entries()) {
       const index = result.items.find((i) => i.name === name).index;

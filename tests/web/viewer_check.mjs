@@ -6,7 +6,7 @@
 // Exit code 0 with {"ok": true, ...}; 2 with {"skip": reason} when Chromium cannot start; 1 with
 // {"error": ...} otherwise.
 import path from 'node:path';
-import { openViewer, runCheck, sleep, waitFor } from './browser.mjs';
+import { framesDrawn, openViewer, runCheck, sleep, waitFor } from './browser.mjs';
 
 const config = JSON.parse(process.argv[2]);
 runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: config.camera.width, height: config.camera.height } },
@@ -41,7 +41,8 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: config.cam
       v.toggle('segmentation', true);
       v.setCamera(c.position, c.target, c.fovy_deg);
     }, cam);
-    await sleep(500); // a few frames
+    await sleep(300);
+    await framesDrawn(page, 3); // drawn from the new camera
     result.background = await viewer(() => window.partsimViewer.background());
     result.silhouette = path.join(config.out, 'page_silhouette.png');
     await page.screenshot({ path: result.silhouette });
@@ -106,7 +107,8 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: config.cam
       const t = c.target;
       window.partsimViewer.setCamera([t[0] + 1.55, t[1] + 1.15, t[2] + 0.75], t, 45);
     }, cam);
-    await sleep(800);
+    await sleep(500);
+    await framesDrawn(page, 3);
     result.screenshot = path.join(config.out, 'viewer.png');
     await page.screenshot({ path: result.screenshot });
     note('screenshot');
