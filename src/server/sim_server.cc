@@ -136,12 +136,22 @@ void SimServer::RunCommands(std::unique_lock<std::mutex>& lock) {
 void SimServer::Loop() {
   Clock::time_point anchor_wall;
   long long anchor_steps = 0;
+  bool stepped = false;  // since the thread last came to rest
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     RunCommands(lock);
     if (stop_) break;
     // paused with nothing to step: wait for a command, a step request or resume
     if (paused_ && pending_steps_ == 0) {
+      if (stepped) {
+        // come to rest: the rest callbacks see the state the scene stays in
+        stepped = false;
+        lock.unlock();
+        for (const StepCallback& callback : rest_callbacks_)
+          Guarded("rest callback", [&] { callback(clock_steps_); });
+        lock.lock();
+        continue;
+      }
       cv_.wait(lock, [this] { return stop_ || !queue_.empty() || !paused_ || pending_steps_ > 0; });
       continue;
     }
@@ -178,6 +188,7 @@ void SimServer::Loop() {
         scene_->Step(1);
     });
     const long long now_steps = ++clock_steps_;
+    stepped = true;
     for (const StepCallback& callback : callbacks_)
       Guarded("step callback", [&] { callback(now_steps); });
     lock.lock();

@@ -677,7 +677,6 @@ struct Viewer::Impl {
       } else if (service == "/partsim/pause") {
         if (sim) {
           sim->Pause();
-          RequestSnapshot();  // the state it paused in (the last steps' snapshots may be skipped)
         } else {
           std::lock_guard<std::mutex> lock(mutex);
           paused = true;
@@ -1071,9 +1070,12 @@ void Viewer::Attach(SimServer* sim) {
   if (!m.scene) throw Error("Viewer::Attach: the viewer has no scene");
   m.sim = sim;
   sim->AddStepCallback([this](long long) {
-    // the last step of a /partsim/step burst is always shown: the scene rests there
-    const bool rests = impl_->sim->IsPaused() && impl_->sim->GetPendingSteps() <= 0;
-    if (impl_->started) impl_->Snapshot(rests);
+    if (impl_->started) impl_->Snapshot(false);
+  });
+  // the state a pause or the end of a step burst leaves is always shown, whoever asked for it
+  // (the page, a ROS client, the program), though the last steps came within 1 / max_rate s
+  sim->AddRestCallback([this](long long) {
+    if (impl_->started) impl_->Snapshot(true);
   });
 }
 

@@ -5,8 +5,10 @@
 
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "partsim/core/error.h"
 #include "partsim/robot/robots.h"
@@ -60,6 +62,36 @@ TEST_F(SimServerTest, PausedServerStepsExactlyWhatIsAsked) {
   const long long n = sim.GetClockSteps();
   std::this_thread::sleep_for(30ms);
   EXPECT_EQ(sim.GetClockSteps(), n);
+}
+
+TEST_F(SimServerTest, RestCallbacksSeeTheStateAPauseOrAStepBurstLeaves) {
+  SimServer sim(&scene_, nullptr);
+  std::mutex mutex;
+  std::vector<long long> rests;  // the clock at each rest
+  sim.AddRestCallback([&](long long steps) {
+    EXPECT_EQ(steps, sim.GetClockSteps());
+    std::lock_guard<std::mutex> lock(mutex);
+    rests.push_back(steps);
+  });
+  auto rested = [&] {
+    std::lock_guard<std::mutex> lock(mutex);
+    return rests;
+  };
+  sim.Start(/*paused=*/true);
+  std::this_thread::sleep_for(30ms);
+  EXPECT_TRUE(rested().empty()) << "no steps yet, no rest";
+  sim.StepN(3);
+  ASSERT_TRUE(WaitFor([&] { return rested().size() == 1; }));
+  EXPECT_EQ(rested(), std::vector<long long>({3})) << "once, at the burst's last step";
+  sim.Post([] {});  // a command while resting is no new rest
+  sim.Resume();
+  ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() > 20; }));
+  sim.Pause();
+  ASSERT_TRUE(WaitFor([&] { return rested().size() == 2; }));
+  std::this_thread::sleep_for(30ms);
+  ASSERT_EQ(rested().size(), 2u);
+  EXPECT_EQ(rested()[1], sim.GetClockSteps()) << "the step it paused at";
+  sim.Stop();
 }
 
 TEST_F(SimServerTest, PausesAndStepRequestsFromAnotherThreadNeverLoseOrRunAwaySteps) {

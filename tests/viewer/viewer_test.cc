@@ -536,7 +536,8 @@ TEST_F(ViewerTest, StepWhileRunningPausesThenSteps) {
 TEST_F(ViewerTest, ThePageSeesTheStateTheSimulationRestsIn) {
   // served mode: snapshots (what /partsim/status and /partsim/poses tell) are taken at most
   // every 1/60 s while running, but the state a pause or the end of a /partsim/step burst leaves
-  // is always taken (a burst of a few steps takes less than 1/60 s: its last steps were skipped)
+  // is always taken (SimServer's rest callback; a burst of a few steps takes less than 1/60 s,
+  // and its last steps were skipped before)
   SimServerOptions so;
   so.fast = false;
   SimServer sim(scene_.get(), nullptr, so);
@@ -573,6 +574,16 @@ TEST_F(ViewerTest, ThePageSeesTheStateTheSimulationRestsIn) {
     ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() == before + 3; }));
     EXPECT_FALSE(status_at(before + 3).is_null()) << "burst " << burst;
   }
+  // a pause from outside the page (a ROS client, the program) is shown too
+  sim.Resume();
+  ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() > paused_at + 40; }));
+  sim.Pause();
+  ASSERT_TRUE(WaitFor([&] {
+    const long long s = sim.GetClockSteps();
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    return sim.GetClockSteps() == s;
+  }));
+  EXPECT_FALSE(status_at(sim.GetClockSteps()).is_null()) << "paused by the program";
   sim.Stop();
   viewer_.reset();
 }

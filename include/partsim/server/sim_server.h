@@ -64,6 +64,10 @@ class SimServer {
   void Post(Command command);
   /// Adds a callback run after every step, in the order added (before Start).
   void AddStepCallback(StepCallback callback) { callbacks_.push_back(std::move(callback)); }
+  /// Adds a callback run once each time the thread comes to rest after stepping: paused with
+  /// no steps waiting (after a pause, or the last step of a StepN), in the order added (before
+  /// Start). The state it sees is the one the scene stays in.
+  void AddRestCallback(StepCallback callback) { rest_callbacks_.push_back(std::move(callback)); }
   void SetOptions(const SimServerOptions& options);
 
   /// Monotonic clock: steps taken since Start (Reset does not rewind it), and in seconds.
@@ -91,6 +95,7 @@ class SimServer {
   double dt_;
   std::vector<char> initial_state_;
   std::vector<StepCallback> callbacks_;
+  std::vector<StepCallback> rest_callbacks_;
   std::thread thread_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
