@@ -1,13 +1,17 @@
-// Capacity: N primitive actors added one by one to a partsim scene, then the first step (which
-// compiles them) and 100 more, against raw MuJoCo loading the same bodies from one MJCF string
-// and stepping as often. Median of the repetitions; prints one line per N and the ratio.
+// Capacity: scenes of many bodies built through partsim's API and stepped, against raw MuJoCo
+// (the same version, linked the same way) loading the same bodies from one MJCF string and
+// stepping as often. Median of the repetitions (partsim and raw taking turns); one line per
+// size with the build time, the time per step, the warnings the scene gave and the ratios.
 //
-// Usage: partsim_capacity_bench [--reps N] [--sizes 100,300,1000] [--integrator euler|implicit]
-// The boxes lie on a grid in zero gravity, 0.3 m apart (no contacts): the cost measured is the
-// scene's size, not the contact solver's.
+// Usage: partsim_capacity_bench [--scenario ground|grid|chain] [--sizes 300,1000] [--reps N]
+//                               [--steps S] [--integrator implicitfast|implicit|euler|rk4]
+//   ground  N free 4 cm boxes resting on the ground under gravity (4 contacts each), in
+//           rows 6 cm apart (the default)
+//   grid    N free 10 cm boxes 0.3 m apart in zero gravity (no contacts: the scene's size alone)
+//   chain   one fixed-root chain of N capsule links on revolute joints, in zero gravity
+// The default integrator is partsim's default (implicitfast).
 #include <mujoco/mujoco.h>
 #include <sys/resource.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -27,68 +31,140 @@ double Seconds(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-Eigen::Vector3d At(int i) {
+struct Options {
+  std::string scenario = "ground";
+  partsim::Integrator integrator = partsim::SceneConfig().integrator;
+  int steps = 200;
+};
+
+const char* MjIntegrator(partsim::Integrator i) {
+  switch (i) {
+    case partsim::Integrator::kEuler:
+      return "Euler";
+    case partsim::Integrator::kRK4:
+      return "RK4";
+    case partsim::Integrator::kImplicit:
+      return "implicit";
+    case partsim::Integrator::kImplicitFast:
+      return "implicitfast";
+  }
+  return "implicitfast";
+}
+
+Eigen::Vector3d At(const std::string& scenario, int i) {
+  if (scenario == "ground") {
+    const int side = 40;
+    return Eigen::Vector3d(0.06 * (i % side), 0.06 * (i / side), 0.02);
+  }
   return Eigen::Vector3d(0.3 * (i % 10), 0.3 * (i / 10 % 10), 0.3 * (i / 100));
 }
 
-// partsim: add one by one, then step; returns (add seconds, first step, 100 steps)
-std::vector<double> RunPartsim(int n, bool implicit) {
+double Half(const std::string& scenario) { return scenario == "ground" ? 0.02 : 0.05; }
+
+struct Result {
+  double build = 0;     ///< s: adding the bodies and the first step (which compiles)
+  double per_step = 0;  ///< s per step over the steps after the first
+  size_t warnings = 0;
+};
+
+Result RunPartsim(int n, const Options& o) {
   partsim::SceneConfig cfg;
-  cfg.gravity = Eigen::Vector3d::Zero();
-  cfg.integrator = implicit ? partsim::Integrator::kImplicit : partsim::Integrator::kEuler;
-  partsim::Scene scene(cfg);
+  cfg.integrator = o.integrator;
+  if (o.scenario != "ground") cfg.gravity = Eigen::Vector3d::Zero();
   auto t0 = Clock::now();
-  for (int i = 0; i < n; ++i) {
-    partsim::ActorDesc d;
-    d.name = "b" + std::to_string(i);
-    d.pose = partsim::Pose(At(i));
-    partsim::CollisionShape s;
-    s.type = partsim::ShapeType::kBox;
-    s.half_size = Eigen::Vector3d::Constant(0.05);
-    d.collisions.push_back(s);
-    scene.AddActor(d);
+  partsim::Scene scene(cfg);
+  if (o.scenario == "chain") {
+    partsim::ArticulationDesc chain;
+    chain.name = "chain";
+    chain.fix_root = true;
+    for (int i = 0; i < n; ++i) {
+      partsim::LinkDesc l;
+      l.name = "l" + std::to_string(i);
+      l.parent = i - 1;
+      partsim::CollisionShape s;
+      s.type = partsim::ShapeType::kCapsule;
+      s.radius = 0.01;
+      s.half_length = 0.04;
+      l.collisions.push_back(s);
+      if (i > 0) {
+        l.joint.name = "j" + std::to_string(i);
+        l.joint.type = partsim::JointType::kRevolute;
+        l.joint.lower = -0.5;
+        l.joint.upper = 0.5;
+        l.joint.pose_in_parent = partsim::Pose(Eigen::Vector3d(0.1, 0, 0));
+      }
+      chain.links.push_back(l);
+    }
+    scene.AddArticulation(chain);
+  } else {
+    if (o.scenario == "ground") scene.AddGround(0.0);
+    for (int i = 0; i < n; ++i) {
+      partsim::ActorDesc d;
+      d.name = "b" + std::to_string(i);
+      d.pose = partsim::Pose(At(o.scenario, i));
+      partsim::CollisionShape s;
+      s.type = partsim::ShapeType::kBox;
+      s.half_size = Eigen::Vector3d::Constant(Half(o.scenario));
+      d.collisions.push_back(s);
+      scene.AddActor(d);
+    }
   }
-  const double add = Seconds(t0);
-  t0 = Clock::now();
   scene.Step(1);
-  const double first = Seconds(t0);
+  Result r;
+  r.build = Seconds(t0);
   t0 = Clock::now();
-  scene.Step(100);
-  return {add, first, Seconds(t0)};
+  scene.Step(o.steps);
+  r.per_step = Seconds(t0) / o.steps;
+  r.warnings = scene.GetWarnings().size();
+  return r;
 }
 
-// raw MuJoCo: the same bodies in one MJCF string, loaded once
-std::vector<double> RunRaw(int n, bool implicit) {
+// raw MuJoCo: the same bodies in one MJCF string, parsed, compiled and stepped
+Result RunRaw(int n, const Options& o) {
   auto t0 = Clock::now();
   std::ostringstream xml;
-  xml << "<mujoco><option gravity=\"0 0 0\" integrator=\"" << (implicit ? "implicit" : "Euler")
-      << "\"/><worldbody>";
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d p = At(i);
-    xml << "<body pos=\"" << p.x() << " " << p.y() << " " << p.z()
-        << "\"><freejoint/><geom type=\"box\" size=\"0.05 0.05 0.05\"/></body>";
+  xml << "<mujoco><option timestep=\"0.002\" integrator=\"" << MjIntegrator(o.integrator) << "\""
+      << (o.scenario == "ground" ? "" : " gravity=\"0 0 0\"") << "/><worldbody>";
+  if (o.scenario == "chain") {
+    for (int i = 0; i < n; ++i) {
+      xml << "<body pos=\"" << (i == 0 ? 0.0 : 0.1) << " 0 0\">";
+      if (i > 0)
+        xml << "<joint type=\"hinge\" axis=\"1 0 0\" limited=\"true\" range=\"-0.5 0.5\"/>";
+      xml << "<geom type=\"capsule\" size=\"0.01 0.04\" euler=\"0 1.5708 0\"/>";
+    }
+    for (int i = 0; i < n; ++i) xml << "</body>";
+  } else {
+    if (o.scenario == "ground") xml << "<geom type=\"plane\" size=\"0 0 1\"/>";
+    const double h = Half(o.scenario);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3d p = At(o.scenario, i);
+      xml << "<body pos=\"" << p.x() << " " << p.y() << " " << p.z()
+          << "\"><freejoint/><geom type=\"box\" size=\"" << h << " " << h << " " << h
+          << "\"/></body>";
+    }
   }
   xml << "</worldbody></mujoco>";
-  const std::string path = "/tmp/partsim_capacity_bench_" + std::to_string(getpid()) + ".xml";
-  FILE* f = std::fopen(path.c_str(), "w");
-  std::fputs(xml.str().c_str(), f);
-  std::fclose(f);
   char err[1000] = "";
-  mjModel* m = mj_loadXML(path.c_str(), nullptr, err, sizeof(err));
-  std::remove(path.c_str());
+  mjSpec* spec = mj_parseXMLString(xml.str().c_str(), nullptr, err, sizeof(err));
+  mjModel* m = spec ? mj_compile(spec, nullptr) : nullptr;
   if (!m) {
-    std::fprintf(stderr, "raw MuJoCo could not load %d bodies: %s\n", n, err);
-    return {-1, -1, -1};
+    std::fprintf(stderr, "raw MuJoCo could not load %d bodies: %s\n", n,
+                 spec ? mjs_getError(spec) : err);
+    if (spec) mj_deleteSpec(spec);
+    return {-1, -1, 0};
   }
+  mj_deleteSpec(spec);
   mjData* d = mj_makeData(m);
   mj_step(m, d);
-  const double first = Seconds(t0);  // building and loading, and one step
+  Result r;
+  r.build = Seconds(t0);
   t0 = Clock::now();
-  for (int i = 0; i < 100; ++i) mj_step(m, d);
-  const double steps = Seconds(t0);
+  for (int i = 0; i < o.steps; ++i) mj_step(m, d);
+  r.per_step = Seconds(t0) / o.steps;
+  for (int k = 0; k < mjNWARNING; ++k) r.warnings += d->warning[k].number > 0 ? 1 : 0;
   mj_deleteData(d);
   mj_deleteModel(m);
-  return {0.0, first, steps};
+  return r;
 }
 
 double Median(std::vector<double> v) {
@@ -100,43 +176,57 @@ double Median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   int reps = 3;
-  std::vector<int> sizes = {100, 300, 1000};
-  bool implicit = false;
+  std::vector<int> sizes;
+  Options o;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--reps" && i + 1 < argc) {
       reps = std::max(1, std::atoi(argv[++i]));
+    } else if (a == "--steps" && i + 1 < argc) {
+      o.steps = std::max(1, std::atoi(argv[++i]));
     } else if (a == "--sizes" && i + 1 < argc) {
-      sizes.clear();
       std::stringstream in(argv[++i]);
       std::string t;
       while (std::getline(in, t, ',')) sizes.push_back(std::atoi(t.c_str()));
+    } else if (a == "--scenario" && i + 1 < argc) {
+      o.scenario = argv[++i];
     } else if (a == "--integrator" && i + 1 < argc) {
-      implicit = std::string(argv[++i]) == "implicit";
+      const std::string v = argv[++i];
+      o.integrator = v == "euler"      ? partsim::Integrator::kEuler
+                     : v == "rk4"      ? partsim::Integrator::kRK4
+                     : v == "implicit" ? partsim::Integrator::kImplicit
+                                       : partsim::Integrator::kImplicitFast;
     } else {
       std::fprintf(stderr,
-                   "usage: partsim_capacity_bench [--reps N] [--sizes A,B] "
-                   "[--integrator euler|implicit]\n");
+                   "usage: partsim_capacity_bench [--scenario ground|grid|chain] [--sizes A,B] "
+                   "[--reps N] [--steps S] [--integrator implicitfast|implicit|euler|rk4]\n");
       return 2;
     }
   }
-  std::printf("integrator %s, %d repetitions, medians\n", implicit ? "implicit" : "euler", reps);
-  std::printf("%6s %10s %12s %12s %12s %12s %10s %10s\n", "N", "add (s)", "+1st step", "raw load",
-              "100 steps", "raw 100", "load x", "step x");
+  if (o.scenario != "ground" && o.scenario != "grid" && o.scenario != "chain") {
+    std::fprintf(stderr, "unknown scenario '%s'\n", o.scenario.c_str());
+    return 2;
+  }
+  if (sizes.empty())
+    sizes = o.scenario == "chain" ? std::vector<int>{100, 500} : std::vector<int>{300, 1000};
+  std::printf("MuJoCo %s, scenario %s, integrator %s, %d steps, %d repetitions, medians\n",
+              mj_versionString(), o.scenario.c_str(), MjIntegrator(o.integrator), o.steps, reps);
+  std::printf("%6s %10s %10s %10s %10s %9s %9s %8s %8s\n", "N", "build (s)", "raw build", "ms/step",
+              "raw ms", "steps/s", "warnings", "build x", "step x");
   for (int n : sizes) {
-    std::vector<double> add, first, steps, raw_first, raw_steps;
-    for (int r = 0; r < reps; ++r) {  // interleaved
-      std::vector<double> p = RunPartsim(n, implicit), q = RunRaw(n, implicit);
-      add.push_back(p[0]);
-      first.push_back(p[0] + p[1]);
-      steps.push_back(p[2]);
-      raw_first.push_back(q[1]);
-      raw_steps.push_back(q[2]);
+    std::vector<double> build, step, raw_build, raw_step;
+    size_t warnings = 0;
+    for (int r = 0; r < reps; ++r) {  // taking turns
+      const Result p = RunPartsim(n, o), q = RunRaw(n, o);
+      build.push_back(p.build);
+      step.push_back(p.per_step);
+      raw_build.push_back(q.build);
+      raw_step.push_back(q.per_step);
+      warnings = std::max(warnings, p.warnings);
     }
-    const double a = Median(add), f = Median(first), s = Median(steps), rf = Median(raw_first),
-                 rs = Median(raw_steps);
-    std::printf("%6d %10.3f %12.3f %12.3f %12.3f %12.3f %10.2f %10.2f\n", n, a, f, rf, s, rs,
-                f / rf, s / rs);
+    const double b = Median(build), s = Median(step), rb = Median(raw_build), rs = Median(raw_step);
+    std::printf("%6d %10.3f %10.3f %10.3f %10.3f %9.0f %9zu %8.2f %8.2f\n", n, b, rb, 1e3 * s,
+                1e3 * rs, 1.0 / s, warnings, b / rb, s / rs);
     std::fflush(stdout);
   }
   rusage u{};

@@ -107,10 +107,10 @@ double VelocityGain(const DriveGains& g) { return g.kd + g.kp * kTimestep; }
 const char* kRawMjcf = R"(
 <mujoco model="drawer_raw">
   <compiler angle="radian" inertiafromgeom="auto" boundmass="1e-6" boundinertia="1e-9"/>
-  <option timestep="0.002" gravity="0 0 -9.81" iterations="50" integrator="implicit"/>
-  <size nconmax="256" njmax="1138" nstack="1024272"/>
+  <option timestep="0.002" gravity="0 0 -9.81" iterations="50" integrator="implicitfast"/>
   <default>
-    <geom friction="0.5 0.005 0.0001" solref="0.02 1" density="600" conaffinity="-1"/>
+    <geom friction="0.5 0.005 0.0001" solref="0.02 1" density="600" conaffinity="-1"
+          margin="5e-8" solimp="0.999 0.999 0.001 0.5 2"/>
   </default>
   <worldbody>
     <body name="cabinet">
@@ -196,20 +196,16 @@ const char* kRawMjcf = R"(
 </mujoco>
 )";
 
-// Loads MJCF text through MuJoCo's virtual file system; exits on error.
+// Parses and compiles MJCF text; exits on error.
 mjModel* LoadFromString(const std::string& xml) {
-  mjVFS vfs;
-  mj_defaultVFS(&vfs);
-  const char* name = "drawer_raw.xml";
-  mj_makeEmptyFileVFS(&vfs, name, static_cast<int>(xml.size()));
-  std::memcpy(vfs.filedata[mj_findFileVFS(&vfs, name)], xml.data(), xml.size());
   char error[1024] = "";
-  mjModel* m = mj_loadXML(name, &vfs, error, sizeof(error));
-  mj_deleteVFS(&vfs);
+  mjSpec* spec = mj_parseXMLString(xml.c_str(), nullptr, error, sizeof(error));
+  mjModel* m = spec ? mj_compile(spec, nullptr) : nullptr;
   if (!m) {
-    std::fprintf(stderr, "raw MJCF failed to load: %s\n", error);
+    std::fprintf(stderr, "raw MJCF failed to load: %s\n", spec ? mjs_getError(spec) : error);
     std::exit(1);
   }
+  mj_deleteSpec(spec);
   return m;
 }
 
@@ -413,11 +409,14 @@ int CompareModels(const mjModel* a, const mjModel* b) {
   ModelDiff diff;
   if (a->nbody != b->nbody || a->ngeom != b->ngeom || a->njnt != b->njnt || a->nv != b->nv ||
       a->nu < b->nu) {
-    std::fprintf(stderr,
-                 "model mismatch: sizes (nbody, ngeom, njnt, nv, nu): partsim (%d %d %d %d %d), "
-                 "raw (%d %d %d %d %d)\n",
-                 a->nbody, a->ngeom, a->njnt, a->nv, a->nu, b->nbody, b->ngeom, b->njnt, b->nv,
-                 b->nu);
+    std::fprintf(
+        stderr,
+        "model mismatch: sizes (nbody, ngeom, njnt, nv, nu): partsim (%ld %ld %ld %ld %ld), "
+        "raw (%ld %ld %ld %ld %ld)\n",
+        static_cast<long>(a->nbody), static_cast<long>(a->ngeom), static_cast<long>(a->njnt),
+        static_cast<long>(a->nv), static_cast<long>(a->nu), static_cast<long>(b->nbody),
+        static_cast<long>(b->ngeom), static_cast<long>(b->njnt), static_cast<long>(b->nv),
+        static_cast<long>(b->nu));
     return 1;
   }
   // options
@@ -431,9 +430,7 @@ int CompareModels(const mjModel* a, const mjModel* b) {
   diff.Compare("disableflags", 0, a->opt.disableflags, b->opt.disableflags);
   diff.Compare("enableflags", 0, a->opt.enableflags, b->opt.enableflags);
   for (int k = 0; k < 3; ++k) diff.Compare("gravity", k, a->opt.gravity[k], b->opt.gravity[k]);
-  diff.Compare("nconmax", 0, a->nconmax, b->nconmax);
-  diff.Compare("njmax", 0, a->njmax, b->njmax);
-  diff.Compare("nstack", 0, a->nstack, b->nstack);
+  diff.Compare("narena", 0, a->narena, b->narena);
   // excluded body pairs (signature: body1 << 16 + body2)
   if (a->nexclude != b->nexclude) {
     diff.Compare("nexclude", 0, a->nexclude, b->nexclude);

@@ -54,10 +54,21 @@ write_basic_package_version_file(${CMAKE_BINARY_DIR}/partsimConfigVersion.cmake
 install(FILES ${CMAKE_BINARY_DIR}/partsimConfig.cmake ${CMAKE_BINARY_DIR}/partsimConfigVersion.cmake
         DESTINATION ${PARTSIM_CMAKE_DIR} COMPONENT partsim)
 
+# MuJoCo's library (from the venv's mujoco-core wheel, cmake/mujoco.cmake) goes beside
+# libpartsim.so, and everything installed finds it there through its RUNPATH: an installed partsim
+# runs without the venv
+install(FILES ${PARTSIM_MUJOCO_LIBRARY} DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT partsim)
+set_target_properties(partsim PROPERTIES INSTALL_RPATH "$ORIGIN")
 if(TARGET partsim_cli)
+  file(RELATIVE_PATH _bin_to_lib ${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}
+       ${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR})
+  set_target_properties(partsim_cli PROPERTIES INSTALL_RPATH "$ORIGIN/${_bin_to_lib}")
   install(TARGETS partsim_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT partsim)
 endif()
 if(TARGET partsim_py)
+  file(RELATIVE_PATH _py_to_lib ${CMAKE_INSTALL_PREFIX}/${PARTSIM_PYTHON_INSTALL_DIR}/partsim
+       ${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_LIBDIR})
+  set_target_properties(partsim_py PROPERTIES INSTALL_RPATH "$ORIGIN/${_py_to_lib}")
   install(TARGETS partsim_py LIBRARY DESTINATION ${PARTSIM_PYTHON_INSTALL_DIR}/partsim
           COMPONENT partsim)
   install(DIRECTORY ${CMAKE_SOURCE_DIR}/python/partsim/

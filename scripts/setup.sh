@@ -6,8 +6,8 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(
   build-essential cmake git pkg-config
-  libmujoco-dev libqhull-dev libeigen3-dev libassimp-dev libtinyxml2-dev nlohmann-json3-dev
-  pybind11-dev python3-dev python3-numpy python3-pytest
+  libqhull-dev libeigen3-dev libassimp-dev libtinyxml2-dev nlohmann-json3-dev
+  pybind11-dev python3-dev python3-venv python3-numpy python3-pytest
   # the SAPIEN-style examples save pictures and build rotations as SAPIEN's tutorials do
   python3-pil python3-transforms3d
   # PyTorch (CPU) for partsim.vision's torch datasets and learning on the tasks; matplotlib for
@@ -54,11 +54,18 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
+# The project's Python environment: a venv made from Debian's /usr/bin/python3 that also sees
+# Debian's packages (numpy, pytest, torch, rospy), with requirements.lock's packages from PyPI:
+# MuJoCo among them, whose library and headers the build takes (cmake/mujoco.cmake). The lock is
+# installed again whenever it changed.
+bash scripts/setup_venv.sh
+
 # Configure once: afterwards `cmake --build` configures again by itself when a CMakeLists.txt,
 # a globbed folder or a ROS 1 message definition changes, so a build that is current costs a
-# second. /usr/bin/python3 is Debian's interpreter: the one that sees python3-numpy and pybind11.
-if [ ! -f build/CMakeCache.txt ] || [ ! -f build/Makefile ]; then
-  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE=/usr/bin/python3
+# second. A build folder configured before the venv (Debian's MuJoCo) is configured again.
+if [ ! -f build/CMakeCache.txt ] || [ ! -f build/Makefile ] ||
+    ! grep -q "^PARTSIM_MUJOCO_DIR:" build/CMakeCache.txt; then
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPYTHON_EXECUTABLE="$PWD/.venv/bin/python"
 fi
 cmake --build build -j"${PARTSIM_JOBS:-2}"
 

@@ -40,7 +40,7 @@ echo "== C++ tests (ctest)"
 ctest --test-dir build --output-on-failure -j2
 
 echo "== Python tests (pytest)"
-PARTSIM_PYTHON_DIR="$PWD/build/python" /usr/bin/python3 -m pytest tests/python -q
+PARTSIM_PYTHON_DIR="$PWD/build/python" .venv/bin/python -m pytest tests/python -q
 
 echo "== install: cmake --install into a temporary prefix, then the Debian package; each checked from outside the tree"
 prefix="$(mktemp -d)"

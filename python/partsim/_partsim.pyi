@@ -1298,10 +1298,13 @@ class Integrator:
       IMPLICIT
 
       RK4
+
+      IMPLICITFAST
     """
     EULER: typing.ClassVar[Integrator]
     IMPLICIT: typing.ClassVar[Integrator]
     RK4: typing.ClassVar[Integrator]
+    IMPLICITFAST: typing.ClassVar[Integrator]
     def __eq__(self, other: object) -> bool: ...
     def __getstate__(self) -> int: ...
     def __hash__(self) -> int: ...
@@ -2049,6 +2052,73 @@ class MeshData:
     def vertices(self, value: numpy.ndarray) -> None: ...
 
 
+class MjcfModel:
+    """An MJCF model loaded into a scene (Scene.load_mjcf): its bodies, joints, tendons, equality constraints, actuators and sensors as MuJoCo defines them, with partsim's handles on its bodies."""
+    def get_actors(self) -> list:
+        """The actors made of its free, static and mocap bodies (and its worldbody's geoms)."""
+        ...
+    def get_actuator_names(self) -> typing.List[str]:
+        """Its actuators' names, without the prefix, in MuJoCo's order."""
+        ...
+    def get_articulations(self) -> list:
+        """The articulations made of its kinematic trees."""
+        ...
+    def get_bodies_without_handle(self) -> typing.List[str]:
+        """Bodies MuJoCo simulates that have no partsim handle (trees with a ball joint)."""
+        ...
+    def get_ctrl(self) -> numpy.ndarray:
+        """Its actuators' controls (MuJoCo's ctrl), (nu,)."""
+        ...
+    def get_joint_names(self) -> typing.List[str]:
+        """Its joints' names, without the prefix, in MuJoCo's order."""
+        ...
+    def get_qpos(self) -> numpy.ndarray:
+        """Its slice of MuJoCo's qpos, joint by joint."""
+        ...
+    def get_qvel(self) -> numpy.ndarray:
+        """Its slice of MuJoCo's qvel, joint by joint."""
+        ...
+    def get_tendon_lengths(self) -> numpy.ndarray:
+        """Its tendons' lengths now (m), in the order of get_tendon_names()."""
+        ...
+    def get_tendon_names(self) -> typing.List[str]:
+        """Its tendons' names, without the prefix, in MuJoCo's order."""
+        ...
+    @property
+    def id(self) -> int:
+        """The model's id in its scene."""
+        ...
+    def mj_id(self, mj_object_type: int, name: str) -> int:
+        """The id of one of its elements in the scene's MuJoCo model (mujoco.mjtObj value), -1 when it has none of that name."""
+        ...
+    @property
+    def name(self) -> str:
+        """The model's name (<mujoco model=...>, else the file's stem)."""
+        ...
+    @property
+    def path(self) -> str:
+        """The file it was loaded from."""
+        ...
+    @property
+    def prefix(self) -> str:
+        """What its element names start with in the scene's MuJoCo model."""
+        ...
+    @typing.overload
+    def set_ctrl(self, ctrl: numpy.ndarray) -> None:
+        """Sets every actuator's control; kept until set again."""
+        ...
+    @typing.overload
+    def set_ctrl(self, actuator: str, value: float) -> None:
+        """Sets one actuator's control by name."""
+        ...
+    def set_qpos(self, qpos: numpy.ndarray) -> None:
+        """Sets its slice of MuJoCo's qpos (free joints: position and w, x, y, z quaternion)."""
+        ...
+    def set_qvel(self, qvel: numpy.ndarray) -> None:
+        """Sets its slice of MuJoCo's qvel."""
+        ...
+
+
 class MotionPlanner:
     """Collision-free joint paths for some joints of an articulation in the current scene (OMPL; collisions checked on a private copy)."""
     def __init__(self, arm: Articulation, joints: typing.List[str] = ..., velocity_limits: numpy.ndarray = ..., acceleration_limits: numpy.ndarray = ...) -> None:
@@ -2770,6 +2840,9 @@ class Scene:
     def get_mjcf(self) -> str:
         """The MJCF text the last compile used (debugging)."""
         ...
+    def get_mjcf_models(self) -> list:
+        """The MJCF models loaded into the scene."""
+        ...
     def get_render_backend(self) -> RenderBackend:
         """The backend (created on first use: the rasterizer unless another was set)."""
         ...
@@ -2794,6 +2867,9 @@ class Scene:
         ...
     @gravity.setter
     def gravity(self, value: numpy.ndarray) -> None: ...
+    def load_mjcf(self, path: str, pose: Pose = ...) -> MjcfModel:
+        """Loads an MJCF file (MuJoCo's format) into the scene at `pose`; returns its MjcfModel. <include>, <replicate>, <attach> and relative asset paths work; the scene's options are kept. Raises PartsimError with MuJoCo's message (file and line) and leaves the scene as it was."""
+        ...
     def pack(self) -> bytes:
         """Whole dynamic state as bytes, bit-exact."""
         ...
@@ -2842,6 +2918,18 @@ class SceneConfig:
     """Scene-wide settings: timestep, gravity, default material, solver iterations and integrator."""
     def __init__(self) -> None: ...
     @property
+    def contact_impedance(self) -> float:
+        """In (0, 0.9999]: the share of the force a contact needs that it gives at the moment of touching (MuJoCo's solimp dmin; default 0.999: nearly hard, as PhysX's are; MuJoCo's own is 0.9)."""
+        ...
+    @contact_impedance.setter
+    def contact_impedance(self, value: float) -> None: ...
+    @property
+    def contact_offset(self) -> float:
+        """m, >= rest_offset: each shape's distance within which contacts are found (SAPIEN's contact offset; a pair adds up its two shapes'); contacts beyond the rest offset are reported with zero force (default 0)."""
+        ...
+    @contact_offset.setter
+    def contact_offset(self, value: float) -> None: ...
+    @property
     def default_material(self) -> PhysicalMaterial:
         """PhysicalMaterial of the collision shapes that name none."""
         ...
@@ -2855,10 +2943,16 @@ class SceneConfig:
     def gravity(self, value: numpy.ndarray) -> None: ...
     @property
     def integrator(self) -> Integrator:
-        """Integrator (default IMPLICIT, which handles stiff PD damping)."""
+        """Integrator (default IMPLICITFAST; the implicit ones handle stiff PD damping)."""
         ...
     @integrator.setter
     def integrator(self, value: Integrator) -> None: ...
+    @property
+    def rest_offset(self) -> float:
+        """m, >= 0: each shape's distance at which bodies rest on it (SAPIEN's rest offset; a pair adds up its two shapes'; default 0)."""
+        ...
+    @rest_offset.setter
+    def rest_offset(self, value: float) -> None: ...
     @property
     def solver_iterations(self) -> int:
         """Constraint solver iterations per step, >= 1 (default 50)."""
@@ -3451,6 +3545,10 @@ def inverse_kinematics(model: KinematicModel, link: int, target: Pose, q_init: n
     """Joint positions that put options.offset on `link` at world pose `target`, by damped least squares within the joint limits; success False (and the closest q) when out of reach. Raises PartsimError for a bad link, a q_init of the wrong size or a non-finite target."""
     ...
 
+def is_mjcf_file(path: str) -> bool:
+    """Whether a file is MJCF (a .xml whose root element is <mujoco>)."""
+    ...
+
 def load_convex_pieces(path: str, scale: numpy.ndarray = ...) -> typing.List[MeshData]:
     """Collision pieces of a file: one per sub-mesh and connected component."""
     ...
@@ -3480,11 +3578,15 @@ def parse_task_type(name: str) -> TaskType:
     ...
 
 def place_on_ground(articulation: Articulation, altitude: float = ...) -> None:
-    """Moves the articulation's root so that its lowest point touches z = altitude."""
+    """Moves the articulation's root so that it stands on z = altitude (its lowest point 10 micrometres clear of it)."""
     ...
 
 def pose_error(current: Pose, target: Pose) -> numpy.ndarray:
     """(p_target - p; axis-angle of R_target R^T), a (6,) array in m and rad."""
+    ...
+
+def scene_config_from_mjcf(path: str) -> SceneConfig:
+    """The options of an MJCF file (timestep, gravity, integrator, iterations) as a SceneConfig."""
     ...
 
 def set_log_level(level: str) -> None:
@@ -3508,7 +3610,7 @@ def split_connected_components(mesh: MeshData) -> typing.List[MeshData]:
     ...
 
 def standing_root_pose(articulation: Articulation, altitude: float = ...) -> Pose:
-    """Root pose that makes the articulation stand on z = altitude at its current joint positions (orientation and x, y kept)."""
+    """Root pose that makes the articulation stand on z = altitude at its current joint positions (orientation and x, y kept), its lowest point 10 micrometres clear of it."""
     ...
 
 def step_tasks(tasks: typing.List[ArticulationTask], actions: numpy.ndarray) -> None:

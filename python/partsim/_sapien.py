@@ -249,8 +249,7 @@ _p.SceneConfig.default_dynamic_friction = _material_property("dynamic_friction")
 _p.SceneConfig.default_restitution = _material_property("restitution")
 
 # PhysX settings SAPIEN's SceneConfig has and MuJoCo has no counterpart for: kept, not used
-_PHYSX_ONLY = {"bounce_threshold": 2.0, "sleep_threshold": 0.005, "contact_offset": 0.01,
-               "solver_velocity_iterations": 1, "enable_pcm": True, "enable_tgs": True,
+_PHYSX_ONLY = {"bounce_threshold": 2.0, "sleep_threshold": 0.005, "solver_velocity_iterations": 1, "enable_pcm": True, "enable_tgs": True,
                "enable_ccd": False, "enable_enhanced_determinism": False,
                "enable_friction_every_iteration": True, "enable_adaptive_force": False,
                "disable_collision_visual": False}
@@ -266,9 +265,10 @@ _scene_config_init = _p.SceneConfig.__init__
 @_add(_p.SceneConfig, "__init__")
 def _scene_config_init_sapien(self, **kwargs):
     """Scene settings with SAPIEN's names too: gravity, default_static_friction,
-    default_dynamic_friction, default_restitution, solver_iterations; the defaults given to
-    sapien.physx.set_scene_config / set_default_material / set_body_config first. PhysX-only
-    fields (bounce_threshold, sleep_threshold, contact_offset, solver_velocity_iterations,
+    default_dynamic_friction, default_restitution, solver_iterations, contact_offset,
+    rest_offset; the defaults given to sapien.physx.set_scene_config / set_default_material /
+    set_body_config / set_shape_config first. PhysX-only fields (bounce_threshold,
+    sleep_threshold, solver_velocity_iterations,
     enable_pcm, enable_tgs, enable_ccd, enable_enhanced_determinism,
     enable_friction_every_iteration, enable_adaptive_force) are kept and have no effect: MuJoCo
     has no such settings."""
@@ -1062,7 +1062,14 @@ physx.set_default_material = _set_default_material
 physx.get_default_material = lambda: _physx_defaults.get("default_material",
                                                           _p.SceneConfig().default_material)
 physx.set_body_config = _set_body_config
-physx.set_shape_config = lambda contact_offset=0.01, rest_offset=0.0: None
+def _set_shape_config(contact_offset=0.01, rest_offset=0.0):
+    """Contact and rest offsets of the shapes of scenes created afterwards (SceneConfig's
+    contact_offset and rest_offset: MuJoCo's margin and gap)."""
+    _physx_defaults["contact_offset"] = float(contact_offset)
+    _physx_defaults["rest_offset"] = float(rest_offset)
+
+
+physx.set_shape_config = _set_shape_config
 physx.PhysxMaterial = _physical_material
 physx.PhysxSceneConfig = SceneConfig
 for _n in ("PhysxRigidBaseComponent", "PhysxRigidBodyComponent", "PhysxRigidDynamicComponent",

@@ -38,6 +38,12 @@ double LowestZ(const Shape& s, const Pose& X_WS) {
   return kInf;
 }
 
+// How far above the plane the lowest point stands. MuJoCo's contacts are soft and take rounding
+// (a few nm) below the plane for a penetration to push out: a drawer of a fixed cabinet that
+// touched the ground exactly could not push it out (its slide holds it up), and the contact's
+// friction held the drawer shut.
+constexpr double kStandClearance = 1e-5;
+
 }  // namespace
 
 Pose StandingRootPose(const Articulation& articulation, double altitude) {
@@ -61,7 +67,7 @@ Pose StandingRootPose(const Articulation& articulation, double altitude) {
     throw Error("StandingRootPose: articulation '" + articulation.GetName() +
                 "' has no geometry to stand on");
   }
-  root.p.z() += altitude - lowest;
+  root.p.z() += altitude + kStandClearance - lowest;
   return root;
 }
 

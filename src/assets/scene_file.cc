@@ -17,6 +17,7 @@
 #include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/physics/description.h"
+#include "partsim/physics/mjcf.h"
 
 namespace partsim {
 namespace {
@@ -27,7 +28,7 @@ using nlohmann::json;
 constexpr double kUnitTolerance = 1e-3;  // |norm - 1| allowed for quaternions, as Pose::IsValid
 
 // What a path names.
-enum class PathKind { kUrdf, kPartNetFolder, kSceneFile };
+enum class PathKind { kUrdf, kPartNetFolder, kSceneFile, kMjcf };
 
 std::string Number(double x) {
   std::ostringstream s;
@@ -50,8 +51,10 @@ PathKind Classify(const fs::path& path, const std::string& where) {
   const std::string ext = internal::AsciiLower(path.extension().string());
   if (ext == ".urdf") return PathKind::kUrdf;
   if (ext == ".json") return PathKind::kSceneFile;
+  if (IsMjcfFile(path.string())) return PathKind::kMjcf;
   throw Error(where + ": unknown extension '" + ext +
-              "' (expected a .urdf file, a PartNet-Mobility folder or a .json scene file)");
+              "' (expected a .urdf file, a PartNet-Mobility folder, an MJCF .xml file or a .json "
+              "scene file)");
 }
 
 // Reads the fields of one JSON object; errors name the scene file and the field's JSON path
@@ -175,6 +178,10 @@ Prepared Prepare(const std::string& path, const Pose& pose, bool fix_root, doubl
   const PathKind kind = Classify(path, where);
   if (kind == PathKind::kSceneFile)
     throw Error(where + ": is a scene file; scene files cannot be nested");
+  if (kind == PathKind::kMjcf)
+    throw Error(where +
+                ": is an MJCF file; scene files list URDF files and PartNet-Mobility "
+                "folders (load an MJCF file on its own)");
   try {
     if (kind == PathKind::kUrdf) {
       UrdfLoader loader;
@@ -249,6 +256,10 @@ std::vector<Articulation> AddSceneObjects(Scene* scene, const std::string& path,
                                           const Pose& default_pose, bool fix_root) {
   if (scene == nullptr) throw Error("AddSceneObjects(" + path + "): scene is null");
   CheckPose("AddSceneObjects(" + path + "): default_pose", default_pose);
+
+  // an MJCF model: loaded whole (LoadMjcf leaves the scene as it was on an error)
+  if (Classify(path, path) == PathKind::kMjcf)
+    return LoadMjcf(*scene, path, default_pose).GetArticulations();
 
   // read every object before touching the scene
   std::vector<Prepared> prepared;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <map>
 #include <regex>
@@ -21,147 +22,181 @@ namespace {
 // MuJoCo capsules and cylinders lie along z; partsim's along x: rotate z onto x.
 const Eigen::Quaterniond kZToX(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()));
 
-std::string Quat(const Eigen::Quaterniond& q) {
-  Eigen::Quaterniond n = q.normalized();
-  return Num(n.w()) + " " + Num(n.x()) + " " + Num(n.y()) + " " + Num(n.z());
+void SetQuat(double out[4], const Eigen::Quaterniond& q) {
+  const Eigen::Quaterniond n = q.normalized();
+  out[0] = n.w();
+  out[1] = n.x();
+  out[2] = n.y();
+  out[3] = n.z();
 }
 
-std::string PoseAttrs(const Pose& pose) {
-  return " pos=\"" + Vec(pose.p) + "\" quat=\"" + Quat(pose.q) + "\"";
+void SetVec(double out[3], const Eigen::Vector3d& v) {
+  for (int k = 0; k < 3; ++k) out[k] = v[k];
 }
 
-// Writes the MJCF of a scene. Kept as a class so that the emitters share the output stream and
-// the mesh asset table.
-class MjcfWriter {
+void SetPose(double pos[3], double quat[4], const Pose& pose) {
+  SetVec(pos, pose.p);
+  SetQuat(quat, pose.q);
+}
+
+void SetName(mjsElement* element, const std::string& name) { mjs_setName(element, name.c_str()); }
+
+// Builds the model specification (mjSpec) of a scene through MuJoCo's model-editing API: the
+// compiler, option and size settings are parsed from a few lines of MJCF, the bodies, meshes,
+// constraints and actuators are added by calls, so that no limit of the XML parser (its nesting
+// depth: MuJoCo reads bodies nested in XML) applies to partsim's scenes. Kept as a class so that
+// the emitters share the specification and the mesh table.
+class SpecWriter {
  public:
-  explicit MjcfWriter(const SceneImpl& scene) : scene_(scene) {}
+  explicit SpecWriter(const SceneImpl& scene) : scene_(scene) {}
 
-  /// After Write(): the first geom that uses each mesh asset.
+  /// After Build(): the first geom that uses each mesh asset.
   const std::map<std::string, std::string>& MeshUsers() const { return mesh_users_; }
 
-  std::string Write() {
+  /// The specification, or null with *error set (MuJoCo's message).
+  MjSpecPtr Build(std::string* error) {
     const SceneConfig& c = scene_.config;
-    const char* integrator = c.integrator == Integrator::kEuler ? "Euler"
-                             : c.integrator == Integrator::kRK4 ? "RK4"
-                                                                : "implicit";
-    // bodies first: they collect mesh assets and equality constraints
-    for (const auto& a : scene_.actors) WriteActor(a.id, a.desc);
-    for (const auto& a : scene_.articulations) WriteArticulation(a.id, a.desc);
-    WriteIgnoreGroupExcludes();
-
-    std::ostringstream out;
-    out << "<mujoco model=\"partsim\">\n"
-        << "  <compiler angle=\"radian\" inertiafromgeom=\"auto\" boundmass=\"1e-6\" "
-           "boundinertia=\"1e-9\"/>\n"
-        << "  <option timestep=\"" << Num(c.timestep) << "\" gravity=\"" << Vec(c.gravity)
-        << "\" iterations=\"" << c.solver_iterations << "\" integrator=\"" << integrator
-        << "\"/>\n";
-    // Contact and constraint buffers. MuJoCo 2.2.2 allocates them in mj_makeData, with dense
-    // njmax x njmax and njmax x nv matrices, so they are sized from the contacts the scene has
-    // needed (SceneImpl::Step doubles them when a step fills them), not from its size: memory
-    // grows with the contacts, not with the square of the bodies. The rows always cover every
-    // contact (4 rows each: condim 3, pyramidal cone), so contacts overflow before rows do.
-    // A scene without collision shapes has no contacts (a rendered dataset object, a
-    // kinematic model): its buffers start small instead of at about 20 MB, which mj_makeData
-    // zeroes, and grow like the others if a step needs more.
-    const bool contacts = num_collision_geoms_ > 0;
-    const int nconmax = std::max(scene_.contact_capacity, contacts ? kBaseContacts : 4);
-    const int njmax =
-        4 * nconmax + 4 * num_limits_ + 6 * num_equalities_ + 2 * num_friction_dofs_ + 100;
-    // MuJoCo's scratch stack: its own default scales with njmax and came out too small with
-    // the buffers above ("Stack overflow" at compile). MuJoCo 2.2.2's implicit integrator works
-    // on dense nv x nv matrices: 300 free boxes (nv 1,800) need 33-36 M numbers, about 11 nv^2;
-    // the explicit integrators need under nv^2 / 36 (1,000 boxes: 0.5-1 M). Without contacts,
-    // the constraint projection's njmax x nv block bounds the rest
-    const long long nv = num_dofs_;
-    const long long dense = c.integrator == Integrator::kImplicit ? 12 * nv * nv : nv * nv / 32;
-    const long long floor = contacts ? 1000000 : 50000 + nv * njmax;
-    const long long nstack =
-        std::max(floor + 60 * nv + 20ll * njmax + dense, scene_.stack_capacity);
-    out << "  <size nconmax=\"" << nconmax << "\" njmax=\"" << njmax << "\" nstack=\"" << nstack
-        << "\"/>\n";
-    if (!assets_.str().empty()) out << "  <asset>\n" << assets_.str() << "  </asset>\n";
-    out << "  <worldbody>\n" << bodies_.str() << "  </worldbody>\n";
-    if (!excludes_.empty()) {
-      out << "  <contact>\n";
-      for (const auto& [a, b] : excludes_)
-        out << "    <exclude body1=\"" << a << "\" body2=\"" << b << "\"/>\n";
-      out << "  </contact>\n";
+    const char* integrator = c.integrator == Integrator::kEuler      ? "Euler"
+                             : c.integrator == Integrator::kRK4      ? "RK4"
+                             : c.integrator == Integrator::kImplicit ? "implicit"
+                                                                     : "implicitfast";
+    std::ostringstream header;
+    header << "<mujoco model=\"partsim\">\n"
+           << "  <compiler angle=\"radian\" inertiafromgeom=\"auto\" boundmass=\"1e-6\" "
+              "boundinertia=\"1e-9\" autolimits=\"false\"/>\n"
+           << "  <option timestep=\"" << Num(c.timestep) << "\" gravity=\"" << Vec(c.gravity)
+           << "\" iterations=\"" << c.solver_iterations << "\" integrator=\"" << integrator
+           << "\"/>\n"
+           << "</mujoco>\n";
+    char err[1024] = "";
+    spec_.reset(mj_parseXMLString(header.str().c_str(), nullptr, err, sizeof(err)));
+    if (!spec_) {
+      *error = err;
+      return nullptr;
     }
-    if (!equality_.str().empty()) out << "  <equality>\n" << equality_.str() << "  </equality>\n";
-    if (!actuators_.str().empty()) out << "  <actuator>\n" << actuators_.str() << "  </actuator>\n";
-    out << "</mujoco>\n";
-    return out.str();
+    world_ = mjs_findBody(spec_.get(), "world");
+    for (const auto& a : scene_.actors)
+      if (a.mjcf < 0) AddActor(a.id, a.desc);
+    for (const auto& a : scene_.articulations)
+      if (a.mjcf < 0) AddArticulation(a.id, a.desc);
+    // MJCF models: each attached (copied) at its pose with its prefix, then the drives partsim
+    // gives the joints of the articulations made of them
+    mjs_setDeepCopy(spec_.get(), 1);
+    for (const auto& model : scene_.mjcf_models) {
+      mjsFrame* frame = mjs_addFrame(world_, nullptr);
+      SetPose(frame->pos, frame->quat, model.pose);
+      if (!mjs_attach(frame->element, model.spec->element, model.prefix.c_str(), "")) {
+        *error =
+            "MJCF model '" + model.path + "' could not be attached: " + mjs_getError(spec_.get());
+        return nullptr;
+      }
+    }
+    for (const auto& a : scene_.articulations)
+      if (a.mjcf >= 0) AddMjcfDrives(a);
+    AddIgnoreGroupExcludes();
+    for (const auto& [a, b] : excludes_) {
+      mjsExclude* e = mjs_addExclude(spec_.get());
+      mjs_setString(e->bodyname1, a.c_str());
+      mjs_setString(e->bodyname2, b.c_str());
+    }
+    // MuJoCo's arena: contacts, constraint rows and the scratch stack share it, and MuJoCo
+    // takes what each step needs from it. Its own estimate sizes it (about 14 MB for a few
+    // bodies, growing with the square of the geoms), unless a step has needed more
+    // (SceneImpl::arena_capacity, doubled by Step when a step runs out). A scene without
+    // collision shapes has no contacts (a rendered dataset object, a kinematic model): it
+    // starts with what its dofs need, and grows like the others if a step needs more.
+    const long long nv = num_dofs_;
+    long long memory = scene_.arena_capacity;
+    if (memory == 0 && num_collision_geoms_ == 0)
+      memory = (1ll << 19) + 8 * (64 * nv + 4 * nv * nv);
+    if (memory > 0) spec_->memory = memory;
+    return std::move(spec_);
   }
 
  private:
-  void Indent(int depth) { bodies_ << std::string(2 * depth + 4, ' '); }
-
-  void WriteInertial(const std::optional<Inertial>& inertial, bool has_collision, int depth) {
+  void AddInertial(mjsBody* body, const std::optional<Inertial>& inertial, bool has_collision) {
     if (inertial) {
-      Indent(depth);
-      bodies_ << "<inertial" << PoseAttrs(inertial->cmass_local_pose) << " mass=\""
-              << Num(inertial->mass) << "\" diaginertia=\"" << Vec(inertial->inertia) << "\"/>\n";
+      body->mass = inertial->mass;
+      SetPose(body->ipos, body->iquat, inertial->cmass_local_pose);
+      SetVec(body->inertia, inertial->inertia);
+      body->explicitinertial = 1;
     } else if (!has_collision) {
       // a body with nothing to derive mass from gets a small one, so it can move
-      Indent(depth);
-      bodies_ << "<inertial pos=\"0 0 0\" mass=\"0.001\" diaginertia=\"1e-6 1e-6 1e-6\"/>\n";
+      body->mass = 0.001;
+      SetVec(body->ipos, Eigen::Vector3d::Zero());
+      SetQuat(body->iquat, Eigen::Quaterniond::Identity());
+      SetVec(body->inertia, Eigen::Vector3d::Constant(1e-6));
+      body->explicitinertial = 1;
     }
   }
 
-  void WriteShapes(const std::vector<CollisionShape>& shapes, const std::string& prefix,
-                   int depth) {
+  void AddShapes(mjsBody* body, const std::vector<CollisionShape>& shapes,
+                 const std::string& prefix) {
+    const SceneConfig& config = scene_.config;
+    // SAPIEN's rest offset is the surface's inflation (MuJoCo's margin: force within it) and its
+    // contact offset the distance at which contacts are found (MuJoCo's margin + gap); MuJoCo
+    // adds up the two shapes' values of a pair, as PhysX does. The skin makes bodies placed
+    // exactly touching (distance 0) push from the first step: MuJoCo applies force below the
+    // margin only.
+    const double margin = config.rest_offset + 0.5 * kTouchSkin;
+    const double gap = std::max(0.0, config.contact_offset - config.rest_offset);
+    const double dmin = config.contact_impedance, dmax = std::max(dmin, 0.95);
     for (size_t i = 0; i < shapes.size(); ++i) {
       const CollisionShape& s = shapes[i];
-      const PhysicalMaterial& mat = s.material ? *s.material : scene_.config.default_material;
+      const PhysicalMaterial& mat = s.material ? *s.material : config.default_material;
+      const std::string name = prefix + "_g" + std::to_string(i);
+      mjsGeom* g = mjs_addGeom(body, nullptr);
+      SetName(g->element, name);
       Pose pose = s.pose;
-      std::string type, size;
       switch (s.type) {
         case ShapeType::kBox:
-          type = "box";
-          size = Vec(s.half_size);
+          g->type = mjGEOM_BOX;
+          SetVec(g->size, s.half_size);
           break;
         case ShapeType::kSphere:
-          type = "sphere";
-          size = Num(s.radius);
+          g->type = mjGEOM_SPHERE;
+          g->size[0] = s.radius;
           break;
         case ShapeType::kCapsule:
         case ShapeType::kCylinder:
-          type = s.type == ShapeType::kCapsule ? "capsule" : "cylinder";
-          size = Num(s.radius) + " " + Num(s.half_length);
+          g->type = s.type == ShapeType::kCapsule ? mjGEOM_CAPSULE : mjGEOM_CYLINDER;
+          g->size[0] = s.radius;
+          g->size[1] = s.half_length;
           pose.q = pose.q * kZToX;
           break;
         case ShapeType::kPlane:
-          type = "plane";
-          size = "0 0 1";
+          g->type = mjGEOM_PLANE;
+          g->size[0] = 0;
+          g->size[1] = 0;
+          g->size[2] = 1;
           break;
-        case ShapeType::kConvexMesh: {
-          type = "mesh";
-          size = "";
+        case ShapeType::kConvexMesh:
+          g->type = mjGEOM_MESH;
+          mjs_setString(g->meshname, MeshAsset(*s.mesh, name).c_str());
           break;
-        }
       }
-      Indent(depth);
-      bodies_ << "<geom name=\"" << prefix << "_g" << i << "\" type=\"" << type << "\"";
-      if (!size.empty()) bodies_ << " size=\"" << size << "\"";
-      if (s.type == ShapeType::kConvexMesh)
-        bodies_ << " mesh=\"" << MeshAsset(*s.mesh, prefix + "_g" + std::to_string(i)) << "\"";
-      bodies_ << PoseAttrs(pose) << " density=\"" << Num(s.density) << "\" friction=\""
-              << Num(mat.static_friction) << " 0.005 0.0001\" solref=\"0.02 "
-              << Num(RestitutionToDampingRatio(mat.restitution)) << "\"";
+      SetPose(g->pos, g->quat, pose);
+      g->density = s.density;
+      g->friction[0] = mat.static_friction;
+      g->friction[1] = 0.005;
+      g->friction[2] = 0.0001;
+      g->solref[0] = 0.02;
+      g->solref[1] = RestitutionToDampingRatio(mat.restitution);
+      g->solimp[0] = dmin;
+      g->solimp[1] = dmax;
+      g->margin = margin;
+      g->gap = gap;
       // SAPIEN's g0 / g1 follow MuJoCo's contype / conaffinity rule; MuJoCo stores them as
-      // signed 32-bit integers (MuJoCo's default is 1)
-      const std::array<uint32_t, 4>& g = s.collision_groups;
-      if (g[0] != 1u) bodies_ << " contype=\"" << static_cast<int32_t>(g[0]) << "\"";
-      if (g[1] != 1u) bodies_ << " conaffinity=\"" << static_cast<int32_t>(g[1]) << "\"";
-      bodies_ << "/>\n";
+      // signed 32-bit integers
+      g->contype = static_cast<int32_t>(s.collision_groups[0]);
+      g->conaffinity = static_cast<int32_t>(s.collision_groups[1]);
       ++num_collision_geoms_;
     }
     NoteIgnoreGroups(prefix, shapes);
   }
 
   // A body can only be ignored as a whole by another when each of its shapes has g2 != 0 and
-  // they share one g3; such bodies are kept, by g3, for WriteIgnoreGroupExcludes.
+  // they share one g3; such bodies are kept, by g3, for AddIgnoreGroupExcludes.
   void NoteIgnoreGroups(const std::string& body, const std::vector<CollisionShape>& shapes) {
     if (shapes.empty()) return;
     uint32_t g3 = shapes[0].collision_groups[3];
@@ -175,7 +210,7 @@ class MjcfWriter {
   // their shapes is ignored. Limitation: where only some shape pairs of two bodies are ignored,
   // all of them keep colliding. Only the candidates noted above are compared, pairwise within
   // each g3, so scenes that leave g2 at 0 cost nothing.
-  void WriteIgnoreGroupExcludes() {
+  void AddIgnoreGroupExcludes() {
     for (const auto& [g3, bodies] : ignore_candidates_) {
       for (size_t i = 0; i < bodies.size(); ++i) {
         for (size_t j = i + 1; j < bodies.size(); ++j) {
@@ -199,7 +234,7 @@ class MjcfWriter {
   // root would still touch their children. Excluded here, for every moving joint: each link
   // rigidly attached (through fixed joints) to its parent against each link rigidly attached to
   // its child; and every pair joined by a fixed joint. Then the pairs the description disables.
-  void WriteCollisionExcludes(int id, const ArticulationDesc& art) {
+  void AddCollisionExcludes(int id, const ArticulationDesc& art) {
     size_t n = art.links.size();
     // rigid group of a link: the topmost link reached through fixed joints (parents come first)
     std::vector<int> group(n);
@@ -239,48 +274,44 @@ class MjcfWriter {
     std::string name = "mesh" + std::to_string(mesh_names_.size());
     mesh_names_[&mesh] = name;
     mesh_users_[name] = geom;
-    assets_ << "    <mesh name=\"" << name << "\" vertex=\"";
-    char buf[64];
-    for (const auto& v : mesh.vertices) {
-      std::snprintf(buf, sizeof(buf), "%.9g %.9g %.9g ", v.x(), v.y(), v.z());
-      assets_ << buf;
-    }
-    assets_ << "\"/>\n";
+    mjsMesh* m = mjs_addMesh(spec_.get(), nullptr);
+    SetName(m->element, name);
+    // the vertices alone: MuJoCo collides with their convex hull
+    mjs_setFloat(m->uservert, mesh.vertices.empty() ? nullptr : mesh.vertices[0].data(),
+                 static_cast<int>(3 * mesh.vertices.size()));
     return name;
   }
 
-  void WriteActor(int id, const ActorDesc& a) {
+  void AddActor(int id, const ActorDesc& a) {
     std::string name = ActorBodyName(id);
-    Indent(0);
-    bodies_ << "<body name=\"" << name << "\"" << PoseAttrs(a.pose);
-    if (a.type == ActorType::kKinematic) bodies_ << " mocap=\"true\"";
-    bodies_ << ">\n";
+    mjsBody* body = mjs_addBody(world_, nullptr);
+    SetName(body->element, name);
+    SetPose(body->pos, body->quat, a.pose);
+    if (a.type == ActorType::kKinematic) body->mocap = 1;
     if (a.type == ActorType::kDynamic) {
-      Indent(1);
-      bodies_ << "<freejoint name=\"" << name << "_free\"/>\n";
+      mjsJoint* free = mjs_addFreeJoint(body);
+      SetName(free->element, name + "_free");
       num_dofs_ += 6;
+      AddInertial(body, a.inertial, !a.collisions.empty());
     }
-    if (a.type == ActorType::kDynamic) WriteInertial(a.inertial, !a.collisions.empty(), 1);
-    WriteShapes(a.collisions, name, 1);
-    Indent(0);
-    bodies_ << "</body>\n";
+    AddShapes(body, a.collisions, name);
   }
 
-  void WriteArticulation(int id, const ArticulationDesc& art) {
-    WriteCollisionExcludes(id, art);
+  void AddArticulation(int id, const ArticulationDesc& art) {
+    AddCollisionExcludes(id, art);
     if (art.kinematic) {
       // every link is a mocap body placed by forward kinematics
       for (size_t i = 0; i < art.links.size(); ++i) {
         std::string name = LinkBodyName(id, static_cast<int>(i));
-        Indent(0);
-        bodies_ << "<body name=\"" << name << "\" mocap=\"true\"" << PoseAttrs(art.root_pose)
-                << ">\n";
-        WriteShapes(art.links[i].collisions, name, 1);
-        Indent(0);
-        bodies_ << "</body>\n";
+        mjsBody* body = mjs_addBody(world_, nullptr);
+        SetName(body->element, name);
+        SetPose(body->pos, body->quat, art.root_pose);
+        body->mocap = 1;
+        AddShapes(body, art.links[i].collisions, name);
       }
       return;
     }
+    // links in the order of a depth-first walk from the root, each under its parent's body
     std::vector<std::vector<int>> children(art.links.size());
     int root = -1;
     for (size_t i = 0; i < art.links.size(); ++i) {
@@ -289,13 +320,17 @@ class MjcfWriter {
       else
         children[art.links[i].parent].push_back(static_cast<int>(i));
     }
-    WriteLink(id, art, root, children, 0);
+    std::vector<std::pair<int, mjsBody*>> stack = {{root, world_}};
+    while (!stack.empty()) {
+      const auto [index, parent] = stack.back();
+      stack.pop_back();
+      mjsBody* body = AddLink(id, art, index, parent);
+      for (auto c = children[index].rbegin(); c != children[index].rend(); ++c)
+        stack.push_back({*c, body});
+    }
     for (const JointCoupling& c : art.couplings) {
       int joint = FindJoint(art, c.joint), source = FindJoint(art, c.source);
-      equality_ << "    <joint joint1=\"" << JointMjName(id, joint) << "\" joint2=\""
-                << JointMjName(id, source) << "\" polycoef=\"" << Num(c.offset) << " "
-                << Num(c.multiplier) << " 0 0 0\"" << EqualitySolver() << "/>\n";
-      ++num_equalities_;
+      AddJointEquality(JointMjName(id, joint), JointMjName(id, source), c.offset, c.multiplier);
     }
   }
 
@@ -305,89 +340,135 @@ class MjcfWriter {
     return -1;  // Validate() has already rejected unknown names
   }
 
-  // Couplings must hold tightly even against stiff, implicitly damped drives: the shortest time
-  // constant MuJoCo accepts and the highest impedance.
-  std::string EqualitySolver() const {
-    return " solref=\"" + Num(2.0 * scene_.config.timestep) +
-           " 1\" solimp=\"0.9999 0.9999 0.001 0.5 2\"";
+  // joint1 = offset + multiplier joint2. Couplings must hold tightly even against stiff,
+  // implicitly damped drives: the shortest time constant MuJoCo accepts and the highest
+  // impedance.
+  void AddJointEquality(const std::string& joint1, const std::string& joint2, double offset,
+                        double multiplier) {
+    mjsEquality* e = mjs_addEquality(spec_.get(), nullptr);
+    e->type = mjEQ_JOINT;
+    e->objtype = mjOBJ_JOINT;
+    e->active = 1;
+    mjs_setString(e->name1, joint1.c_str());
+    mjs_setString(e->name2, joint2.c_str());
+    std::fill(e->data, e->data + mjNEQDATA, 0.0);
+    e->data[0] = offset;
+    e->data[1] = multiplier;
+    e->solref[0] = 2.0 * scene_.config.timestep;
+    e->solref[1] = 1.0;
+    const double solimp[5] = {0.9999, 0.9999, 0.001, 0.5, 2};
+    std::copy(solimp, solimp + 5, e->solimp);
   }
 
-  void WriteLink(int id, const ArticulationDesc& art, int index,
-                 const std::vector<std::vector<int>>& children, int depth) {
+  mjsBody* AddLink(int id, const ArticulationDesc& art, int index, mjsBody* parent) {
     const LinkDesc& link = art.links[index];
     std::string name = LinkBodyName(id, index);
     Pose X_PC = link.parent < 0 ? art.root_pose
                                 : link.joint.pose_in_parent * link.joint.pose_in_child.Inverse();
-    Indent(depth);
-    bodies_ << "<body name=\"" << name << "\"" << PoseAttrs(X_PC) << ">\n";
+    mjsBody* body = mjs_addBody(parent, nullptr);
+    SetName(body->element, name);
+    SetPose(body->pos, body->quat, X_PC);
     if (link.parent < 0 && !art.fix_root) {
-      Indent(depth + 1);
-      bodies_ << "<freejoint name=\"" << JointMjName(id, index) << "\"/>\n";
+      mjsJoint* free = mjs_addFreeJoint(body);
+      SetName(free->element, JointMjName(id, index));
+      num_dofs_ += 6;
     } else if (link.parent >= 0 && link.joint.type != JointType::kFixed) {
-      WriteJoint(id, index, link.joint, depth + 1);
+      AddJoint(body, id, index, link.joint);
     }
     bool moves = !(art.fix_root && link.parent < 0);
     if (moves)
-      WriteInertial(link.inertial, !link.collisions.empty(), depth + 1);
+      AddInertial(body, link.inertial, !link.collisions.empty());
     else if (link.inertial)
-      WriteInertial(link.inertial, true, depth + 1);
-    WriteShapes(link.collisions, name, depth + 1);
-    for (int c : children[index]) WriteLink(id, art, c, children, depth + 1);
-    Indent(depth);
-    bodies_ << "</body>\n";
+      AddInertial(body, link.inertial, true);
+    AddShapes(body, link.collisions, name);
+    return body;
   }
 
-  void WriteJoint(int id, int index, const JointDesc& j, int depth) {
+  // The drives of an articulation made of an MJCF model's tree: an actuator on each joint, and
+  // the inertia of its backward-Euler step on the joint's armature.
+  void AddMjcfDrives(const SceneImpl::ArticulationEntry& a) {
+    const double drive_dt = DriveStep(scene_.config);
+    for (size_t i = 0; i < a.desc.links.size(); ++i) {
+      const std::string& name = a.mj_link_joint[i];
+      if (name.empty()) continue;
+      const JointDesc& j = a.desc.links[i].joint;
+      mjsJoint* joint = mjs_asJoint(mjs_findElement(spec_.get(), mjOBJ_JOINT, name.c_str()));
+      if (!joint) continue;  // the model changed under it: BuildTables will say
+      joint->armature = j.armature + DriveArmature(j.drive, drive_dt);
+      AddDrive(a.id, static_cast<int>(i), name, j.drive, drive_dt);
+    }
+  }
+
+  void AddJoint(mjsBody* body, int id, int index, const JointDesc& j) {
     Eigen::Vector3d axis = j.pose_in_child.q * Eigen::Vector3d::UnitX();
     // rotating x leaves rounding (2e-16) where an axis has zeros: exact zeros let MuJoCo's
     // sparse products skip them (0.8% of a step's time in the drawer bench)
     for (int k = 0; k < 3; ++k)
       if (std::abs(axis[k]) < 1e-12) axis[k] = 0.0;
     num_dofs_ += j.type == JointType::kScrew ? 2 : 1;
-    if (j.friction > 0) num_friction_dofs_ += j.type == JointType::kScrew ? 2 : 1;
-    std::string where = " pos=\"" + Vec(j.pose_in_child.p) + "\" axis=\"" + Vec(axis) + "\"";
-    // the implicit integrator steps drives by backward Euler: their inertia joins the armature
+    mjsJoint* joint = mjs_addJoint(body, nullptr);
+    SetName(joint->element, JointMjName(id, index));
+    joint->type = j.type == JointType::kPrismatic ? mjJNT_SLIDE : mjJNT_HINGE;
+    SetVec(joint->pos, j.pose_in_child.p);
+    SetVec(joint->axis, axis);
+    // the implicit integrators step drives by backward Euler: their inertia joins the armature
     const double drive_dt = DriveStep(scene_.config);
-    std::string dyn = " damping=\"" + Num(j.damping) + "\" frictionloss=\"" + Num(j.friction) +
-                      "\" armature=\"" + Num(j.armature + DriveArmature(j.drive, drive_dt)) + "\"";
-    bool limited =
+    joint->damping[0] = j.damping;
+    joint->frictionloss = j.friction;
+    joint->armature = j.armature + DriveArmature(j.drive, drive_dt);
+    const bool limited =
         std::isfinite(j.lower) && std::isfinite(j.upper) && j.type != JointType::kContinuous;
-    // limits hold hard: the shortest time constant MuJoCo accepts, high impedance
-    std::string limits = limited
-                             ? " limited=\"true\" range=\"" + Num(j.lower) + " " + Num(j.upper) +
-                                   "\" solreflimit=\"" + Num(2.0 * scene_.config.timestep) +
-                                   " 1\" solimplimit=\"0.99 0.999 0.001 0.5 2\""
-                             : " limited=\"false\"";
-    if (limited) ++num_limits_;
-    const char* type = j.type == JointType::kPrismatic ? "slide" : "hinge";
-    Indent(depth);
-    bodies_ << "<joint name=\"" << JointMjName(id, index) << "\" type=\"" << type << "\"" << where
-            << dyn << limits << "/>\n";
+    joint->limited = limited ? mjLIMITED_TRUE : mjLIMITED_FALSE;
+    if (limited) {
+      // limits hold hard: the shortest time constant MuJoCo accepts, high impedance
+      joint->range[0] = j.lower;
+      joint->range[1] = j.upper;
+      joint->solref_limit[0] = 2.0 * scene_.config.timestep;
+      joint->solref_limit[1] = 1.0;
+      const double solimp[5] = {0.99, 0.999, 0.001, 0.5, 2};
+      std::copy(solimp, solimp + 5, joint->solimp_limit);
+    }
     if (j.type == JointType::kScrew) {
       // the translation follows the rotation through an equality constraint
-      Indent(depth);
-      bodies_ << "<joint name=\"" << ScrewSlideMjName(id, index) << "\" type=\"slide\"" << where
-              << " limited=\"false\"/>\n";
-      equality_ << "    <joint joint1=\"" << ScrewSlideMjName(id, index) << "\" joint2=\""
-                << JointMjName(id, index) << "\" polycoef=\"0 " << Num(j.pitch) << " 0 0 0\""
-                << EqualitySolver() << "/>\n";
-      ++num_equalities_;
+      mjsJoint* slide = mjs_addJoint(body, nullptr);
+      SetName(slide->element, ScrewSlideMjName(id, index));
+      slide->type = mjJNT_SLIDE;
+      SetVec(slide->pos, j.pose_in_child.p);
+      SetVec(slide->axis, axis);
+      slide->limited = mjLIMITED_FALSE;
+      AddJointEquality(ScrewSlideMjName(id, index), JointMjName(id, index), 0.0, j.pitch);
     }
-    // every joint with a dof gets a PD drive actuator; gains are set at run time (SyncDrive).
-    // Backward-Euler drives take their velocity gain in ctrl (SceneImpl::ApplyDrives): a velocity
-    // gain here would be integrated implicitly a second time.
-    actuators_ << "    <general name=\"" << ActuatorMjName(id, index) << "\" joint=\""
-               << JointMjName(id, index) << "\" gaintype=\"fixed\" gainprm=\"1\" "
-               << "biastype=\"affine\" biasprm=\"0 " << Num(-j.drive.stiffness) << " "
-               << Num(drive_dt > 0 ? 0.0 : -j.drive.damping) << "\" ctrllimited=\"false\"";
-    if (std::isfinite(j.drive.force_limit))
-      actuators_ << " forcelimited=\"true\" forcerange=\"" << Num(-j.drive.force_limit) << " "
-                 << Num(j.drive.force_limit) << "\"";
-    actuators_ << "/>\n";
+    AddDrive(id, index, JointMjName(id, index), j.drive, drive_dt);
+  }
+
+  // Every joint with a dof gets a PD drive actuator; gains are set at run time (SyncDrive).
+  // Backward-Euler drives take their velocity gain in ctrl (SceneImpl::ApplyDrives): a velocity
+  // gain here would be integrated implicitly a second time.
+  void AddDrive(int id, int index, const std::string& joint, const DriveDesc& d, double drive_dt) {
+    mjsActuator* drive = mjs_addActuator(spec_.get(), nullptr);
+    SetName(drive->element, ActuatorMjName(id, index));
+    drive->trntype = mjTRN_JOINT;
+    mjs_setString(drive->target, joint.c_str());
+    drive->gaintype = mjGAIN_FIXED;
+    std::fill(drive->gainprm, drive->gainprm + mjNGAIN, 0.0);
+    drive->gainprm[0] = 1.0;
+    drive->biastype = mjBIAS_AFFINE;
+    std::fill(drive->biasprm, drive->biasprm + mjNBIAS, 0.0);
+    drive->biasprm[1] = -d.stiffness;
+    drive->biasprm[2] = drive_dt > 0 ? 0.0 : -d.damping;
+    drive->ctrllimited = mjLIMITED_FALSE;
+    if (std::isfinite(d.force_limit)) {
+      drive->forcelimited = mjLIMITED_TRUE;
+      drive->forcerange[0] = -d.force_limit;
+      drive->forcerange[1] = d.force_limit;
+    } else {
+      drive->forcelimited = mjLIMITED_FALSE;
+    }
   }
 
   const SceneImpl& scene_;
-  std::ostringstream bodies_, assets_, equality_, actuators_;
+  MjSpecPtr spec_;
+  mjsBody* world_ = nullptr;
   std::map<const MeshData*, std::string> mesh_names_;
   std::map<std::string, std::string> mesh_users_;  ///< mesh asset -> first geom that uses it
   std::set<std::pair<std::string, std::string>> excludes_;  ///< body pairs, first < second
@@ -395,10 +476,7 @@ class MjcfWriter {
   std::map<uint32_t, std::vector<std::pair<std::string, const std::vector<CollisionShape>*>>>
       ignore_candidates_;
   int num_collision_geoms_ = 0;
-  int num_dofs_ = 0;           ///< dofs (MuJoCo's stack)
-  int num_friction_dofs_ = 0;  ///< dofs with dry friction (a friction-loss row each)
-  int num_limits_ = 0;
-  int num_equalities_ = 0;
+  int num_dofs_ = 0;  ///< dofs (MuJoCo's arena)
 };
 
 int Id(const mjModel* m, mjtObj type, const std::string& name) {
@@ -429,12 +507,30 @@ double RestitutionToDampingRatio(double e) {
   return -l / std::sqrt(M_PI * M_PI + l * l);
 }
 
-std::string GenerateMjcf(const SceneImpl& scene) { return MjcfWriter(scene).Write(); }
+MjSpecPtr BuildSpec(const SceneImpl& scene, std::string* error,
+                    std::map<std::string, std::string>* mesh_users) {
+  SpecWriter writer(scene);
+  MjSpecPtr spec = writer.Build(error);
+  if (mesh_users) *mesh_users = writer.MeshUsers();
+  return spec;
+}
 
-std::string DescribeMjNames(const SceneImpl& scene, const std::string& text) {
-  MjcfWriter writer(scene);
-  writer.Write();
-  const std::map<std::string, std::string>& mesh_users = writer.MeshUsers();
+std::string SaveMjcf(mjSpec* spec) {
+  if (!spec) return "";
+  char err[1024] = "";
+  std::string xml(1 << 16, '\0');
+  int need = mj_saveXMLString(spec, xml.data(), static_cast<int>(xml.size()), err, sizeof(err));
+  if (need > 0) {
+    xml.assign(need + 1, '\0');
+    need = mj_saveXMLString(spec, xml.data(), static_cast<int>(xml.size()), err, sizeof(err));
+  }
+  if (need < 0) return std::string("<!-- MuJoCo could not write the model: ") + err + " -->";
+  xml.resize(std::strlen(xml.c_str()));
+  return xml;
+}
+
+std::string DescribeMjNames(const SceneImpl& scene, const std::string& text,
+                            const std::map<std::string, std::string>& mesh_users) {
   auto quoted = [](const std::string& kind, const std::string& name, int id) {
     return name.empty() ? kind + " " + std::to_string(id) : kind + " '" + name + "'";
   };
@@ -515,9 +611,11 @@ std::string DescribeMjNames(const SceneImpl& scene, const std::string& text) {
     last = m.position(0) + m.length(0);
   }
   out += message.substr(last);
-  // MuJoCo's positions point into the generated MJCF, which the user never wrote
+  // MuJoCo's element ids are its own; a line (of an MJCF model's file) stays
   static const std::regex kWhere(",? ?\\(?id = -?\\d+(?:, line = -?\\d+, column = -?\\d+)?\\)?");
   out = std::regex_replace(out, kWhere, "");
+  static const std::regex kId(",? id -?\\d+");
+  out = std::regex_replace(out, kId, "");
   static const std::regex kObject("\\s*\\n\\s*(?:Object|Element) name\\s*=?\\s*");
   out = std::regex_replace(out, kObject, " in ");
   static const std::regex kError("^Error: ");
@@ -572,21 +670,40 @@ void BuildTables(const SceneImpl& s, Model& model) {
     }
   };
 
+  // an MJCF entity's geoms, by their names in the model
+  auto own_named_geoms = [&](const std::vector<std::string>& names, GeomOwner owner) {
+    for (size_t i = 0; i < names.size(); ++i) {
+      int g = Id(m, mjOBJ_GEOM, names[i]);
+      owner.shape_index = static_cast<int>(i);
+      if (g >= 0) model.geom_owner[g] = owner;
+    }
+  };
   for (const auto& a : s.actors) {
     CompiledActor c;
-    std::string name = ActorBodyName(a.id);
+    const bool mjcf = a.mjcf >= 0;
+    std::string name = mjcf ? a.mj_body : ActorBodyName(a.id);
     c.body = Id(m, mjOBJ_BODY, name);
+    if (c.body < 0)
+      throw Error("the MJCF body '" + name + "' of actor '" + a.desc.name +
+                  "' is no longer in the model");
     c.mocap = m->body_mocapid[c.body];
-    int j = Id(m, mjOBJ_JOINT, name + "_free");
+    int j = mjcf ? (c.body > 0 && m->body_jntnum[c.body] == 1 &&
+                            m->jnt_type[m->body_jntadr[c.body]] == mjJNT_FREE
+                        ? m->body_jntadr[c.body]
+                        : -1)
+                 : Id(m, mjOBJ_JOINT, name + "_free");
     if (j >= 0) {
       c.qposadr = m->jnt_qposadr[j];
       c.dofadr = m->jnt_dofadr[j];
     }
     model.actors[a.id] = c;
-    SyncActorDamping(model, a.desc, c);
+    if (!mjcf) SyncActorDamping(model, a.desc, c);
     GeomOwner owner;
     owner.actor_id = a.id;
-    own_geoms(name, a.desc.collisions.size(), owner);
+    if (mjcf)
+      own_named_geoms(a.mj_geoms, owner);
+    else
+      own_geoms(name, a.desc.collisions.size(), owner);
   }
 
   for (const auto& a : s.articulations) {
@@ -598,21 +715,29 @@ void BuildTables(const SceneImpl& s, Model& model) {
     c.link_mocap.assign(n, -1);
     c.joints.resize(n);
     std::map<std::string, int> link_of_joint;
+    const bool mjcf = a.mjcf >= 0;
     for (size_t i = 0; i < n; ++i) {
-      std::string name = LinkBodyName(a.id, static_cast<int>(i));
+      std::string name = mjcf ? a.mj_link_body[i] : LinkBodyName(a.id, static_cast<int>(i));
       c.link_body[i] = Id(m, mjOBJ_BODY, name);
+      if (c.link_body[i] < 0)
+        throw Error("the MJCF body '" + name + "' of articulation '" + desc.name +
+                    "' is no longer in the model");
       c.link_mocap[i] = m->body_mocapid[c.link_body[i]];
       GeomOwner owner;
       owner.articulation_id = a.id;
       owner.link_index = static_cast<int>(i);
-      own_geoms(name, desc.links[i].collisions.size(), owner);
+      if (mjcf)
+        own_named_geoms(a.mj_link_geoms[i], owner);
+      else
+        own_geoms(name, desc.links[i].collisions.size(), owner);
       if (desc.links[i].parent >= 0) link_of_joint[desc.links[i].joint.name] = static_cast<int>(i);
     }
     // free root
     if (!desc.kinematic && !desc.fix_root) {
       for (size_t i = 0; i < n; ++i) {
         if (desc.links[i].parent >= 0) continue;
-        int j = Id(m, mjOBJ_JOINT, JointMjName(a.id, static_cast<int>(i)));
+        int j = mjcf ? m->body_jntadr[c.link_body[i]]
+                     : Id(m, mjOBJ_JOINT, JointMjName(a.id, static_cast<int>(i)));
         c.root_qposadr = m->jnt_qposadr[j];
         c.root_dofadr = m->jnt_dofadr[j];
       }
@@ -625,7 +750,8 @@ void BuildTables(const SceneImpl& s, Model& model) {
       const LinkDesc& link = desc.links[i];
       CompiledJoint& cj = c.joints[i];
       if (!desc.kinematic) {
-        cj.mj_joint = Id(m, mjOBJ_JOINT, JointMjName(a.id, static_cast<int>(i)));
+        cj.mj_joint =
+            Id(m, mjOBJ_JOINT, mjcf ? a.mj_link_joint[i] : JointMjName(a.id, static_cast<int>(i)));
         cj.qposadr = m->jnt_qposadr[cj.mj_joint];
         cj.dofadr = m->jnt_dofadr[cj.mj_joint];
         if (link.joint.type == JointType::kScrew) {

@@ -18,7 +18,7 @@ Eigen::MatrixXd MjMassMatrix(const Model& model, const Data& data, const Compile
   const mjModel* m = model.mj.get();
   const int nv = m->nv;
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> full(nv, nv);
-  mj_fullM(m, full.data(), data.mj->qM);
+  mj_fullM(m, data.mj.get(), full.data());
   for (int k = 0; k < c.Dof(); ++k) {
     const CompiledJoint& j = c.DofJoint(k);
     full(j.dofadr, j.dofadr) -= j.drive.armature;
@@ -178,7 +178,7 @@ Model Model::Copy() const {
   Model out;
   out.mj.reset(mj_copyModel(nullptr, mj.get()));
   if (!out.mj) throw Error("MuJoCo could not allocate a copy of the scene's model: out of memory");
-  out.mjcf = mjcf;
+  out.spec = spec;
   out.actors = actors;
   out.articulations = articulations;
   out.geom_owner = geom_owner;

@@ -1,5 +1,5 @@
 // ProximityQuery: MuJoCo's collision detection (mj_kinematics + mj_collision) on a copy of the
-// scene, with the queried links' shapes inflated by the margin.
+// scene, with the queried links' shapes given the margin as MuJoCo's detection gap.
 #include "partsim/physics/proximity.h"
 
 #include <cmath>
@@ -15,8 +15,8 @@ struct ProximityQuery::Impl {
   Articulation source;
   std::unique_ptr<Scene> world;
   Articulation arm;
-  std::vector<int> geom_link;   ///< per MuJoCo geom of the copy: link of the articulation, or -1
-  std::vector<double> margins;  ///< per MuJoCo geom: the margin it has now
+  std::vector<int> geom_link;  ///< per MuJoCo geom of the copy: link of the articulation, or -1
+  std::vector<double> gaps;    ///< per MuJoCo geom: the detection gap it has now
 };
 
 ProximityQuery::ProximityQuery(const Articulation& articulation) : impl_(std::make_unique<Impl>()) {
@@ -39,7 +39,7 @@ void ProximityQuery::Refresh() {
   for (int g = 0; g < ngeom; ++g)
     if (s.model.geom_owner[g].articulation_id == p.source.GetId())
       p.geom_link[g] = s.model.geom_owner[g].link_index;
-  p.margins.assign(s.m()->geom_margin, s.m()->geom_margin + ngeom);
+  p.gaps.assign(s.m()->geom_gap, s.m()->geom_gap + ngeom);
 }
 
 Articulation& ProximityQuery::GetArticulation() { return impl_->arm; }
@@ -58,9 +58,10 @@ std::vector<ShapeProximity> ProximityQuery::Query(double margin, const std::vect
   s.EnsureCompiled();
   mjModel* m = s.m();
   mjData* d = s.d();
-  // contacts appear within a pair's largest geom margin: inflate the queried links' shapes
-  for (int g = 0; g < m->ngeom; ++g)
-    m->geom_margin[g] = queried(p.geom_link[g]) ? margin : p.margins[g];
+  // MuJoCo finds contacts closer than the sum of a pair's margins (the shapes' inflation) and
+  // gaps (detection beyond it): the queried links' shapes get the margin as their gap, and the
+  // pairs found are kept when they are closer than the margin
+  for (int g = 0; g < m->ngeom; ++g) m->geom_gap[g] = queried(p.geom_link[g]) ? margin : p.gaps[g];
   mj_kinematics(m, d);
   mj_collision(m, d);
   s.Invalidate();
@@ -71,7 +72,8 @@ std::vector<ShapeProximity> ProximityQuery::Query(double margin, const std::vect
   };
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& c = d->contact[i];
-    if (c.exclude != 0) continue;
+    // 0: a contact with force, 1: within the gap (no force)
+    if (c.exclude > 1 || c.dist >= margin) continue;
     const int l1 = p.geom_link[c.geom1], l2 = p.geom_link[c.geom2];
     if (!queried(l1) && !queried(l2)) continue;
     const bool swap = !queried(l1);

@@ -71,14 +71,21 @@ struct InstallWarningHook {
   }
 } install_warning_hook;
 
+// Empties MuJoCo's scratch stack, which an error thrown out of a step leaves marked.
+void ReleaseStack(mjData* d) {
+  d->pstack = 0;
+  d->pbase = 0;
+}
+
 // Marks a scene as stepping on this thread (its warnings go to it) until destroyed; on the way
 // out of a failed step it releases what MuJoCo held on its stack.
 struct SteppingScope {
   SceneImpl* scene;
-  explicit SteppingScope(SceneImpl* s) : scene(s) { stepping_scene = s; }
+  SceneImpl* outer;  ///< a scope around this one (a compile within a step), put back after
+  explicit SteppingScope(SceneImpl* s) : scene(s), outer(stepping_scene) { stepping_scene = s; }
   ~SteppingScope() {
-    stepping_scene = nullptr;
-    if (scene->d()) scene->d()->pstack = 0;
+    stepping_scene = outer;
+    if (scene->d()) ReleaseStack(scene->d());
   }
 };
 
@@ -86,7 +93,8 @@ struct SteppingScope {
 struct NamedState {
   double time = 0;
   std::map<std::string, std::vector<double>> joint_qpos, joint_qvel, joint_warm, joint_qfrc;
-  std::map<std::string, std::vector<double>> mocap;  // pos + quat
+  std::map<std::string, std::vector<double>> mocap;     // pos + quat
+  std::map<std::string, std::vector<double>> actuator;  // ctrl, then its activations
 };
 
 NamedState SaveNamed(const mjModel* m, const mjData* d) {
@@ -110,6 +118,15 @@ NamedState SaveNamed(const mjModel* m, const mjData* d) {
     std::vector<double> v(d->mocap_pos + 3 * id, d->mocap_pos + 3 * id + 3);
     v.insert(v.end(), d->mocap_quat + 4 * id, d->mocap_quat + 4 * id + 4);
     s.mocap[mj_id2name(m, mjOBJ_BODY, b)] = v;
+  }
+  for (int a = 0; a < m->nu; ++a) {
+    const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
+    if (!name) continue;
+    std::vector<double> v = {d->ctrl[a]};
+    if (m->actuator_actadr[a] >= 0)
+      v.insert(v.end(), d->act + m->actuator_actadr[a],
+               d->act + m->actuator_actadr[a] + m->actuator_actnum[a]);
+    s.actuator[name] = v;
   }
   return s;
 }
@@ -141,23 +158,34 @@ void RestoreNamed(const NamedState& s, const mjModel* m, mjData* d) {
     std::copy(it->second.begin(), it->second.begin() + 3, d->mocap_pos + 3 * id);
     std::copy(it->second.begin() + 3, it->second.end(), d->mocap_quat + 4 * id);
   }
+  for (int a = 0; a < m->nu; ++a) {
+    const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
+    if (!name) continue;
+    auto it = s.actuator.find(name);
+    const int nact = m->actuator_actadr[a] >= 0 ? static_cast<int>(m->actuator_actnum[a]) : 0;
+    if (it == s.actuator.end() || it->second.size() != static_cast<size_t>(1 + nact)) continue;
+    d->ctrl[a] = it->second[0];
+    if (nact > 0)
+      std::copy(it->second.begin() + 1, it->second.end(), d->act + m->actuator_actadr[a]);
+  }
 }
 
-// Loads MJCF text through a virtual file system.
-mjModel* LoadMjcf(const std::string& xml, std::string* error) {
-  auto vfs = std::make_unique<mjVFS>();
-  mj_defaultVFS(vfs.get());
-  const char* name = "partsim_scene.xml";
-  if (mj_makeEmptyFileVFS(vfs.get(), name, static_cast<int>(xml.size())) != 0) {
-    *error = "cannot allocate the virtual MJCF file";
-    return nullptr;
+// MuJoCo's words for a scratch stack or arena too small for the model.
+bool IsOutOfArena(const std::string& error) {
+  return error.find("stack overflow") != std::string::npos ||
+         error.find("Stack overflow") != std::string::npos ||
+         error.find("arena") != std::string::npos;
+}
+
+// Compiles a model specification, or returns null with *error set (MuJoCo's message).
+mjModel* Compile(mjSpec* spec, std::string* error) {
+  mjModel* m = nullptr;
+  try {
+    m = mj_compile(spec, nullptr);
+  } catch (const Error& e) {  // OnMujocoError
+    *error = e.what();
   }
-  int idx = mj_findFileVFS(vfs.get(), name);
-  std::memcpy(vfs->filedata[idx], xml.data(), xml.size());
-  char err[1024] = "";
-  mjModel* m = mj_loadXML(name, vfs.get(), err, sizeof(err));
-  mj_deleteVFS(vfs.get());
-  if (!m) *error = err;
+  if (!m && error->empty()) *error = mjs_getError(spec);
   return m;
 }
 
@@ -169,25 +197,33 @@ void SceneImpl::EnsureCompiled() {
   // (Invalidate, after every setter) are refused while another thread holds the scene; reading
   // the description and the compiled tables (names, counts, dof indices) is not
   CheckUser();
-  std::string xml = GenerateMjcf(*this);
   std::string error;
-  mjModel* new_m = LoadMjcf(xml, &error);
-  // the compiler's own use of MuJoCo's stack outgrew partsim's estimate: twice as much, again
-  for (int tries = 0; !new_m && tries < 6 && error.find("Stack overflow") != std::string::npos;
-       ++tries) {
-    const size_t at = xml.find("nstack=\"");
-    if (at == std::string::npos) break;
-    stack_capacity = 2 * std::atoll(xml.c_str() + at + 8);
-    xml = GenerateMjcf(*this);
-    new_m = LoadMjcf(xml, &error);
+  std::map<std::string, std::string> mesh_users;
+  MjSpecPtr spec;
+  mjModel* new_m = nullptr;
+  {
+    // MuJoCo's warnings while compiling join the scene's, but for the scene's options winning
+    // over an MJCF model's (by design: the scene's settings hold for all it holds)
+    const size_t warnings_before = warnings.size();
+    SteppingScope scope(this);
+    spec = BuildSpec(*this, &error, &mesh_users);
+    new_m = spec ? Compile(spec.get(), &error) : nullptr;
+    // the compiler's own use of MuJoCo's arena outgrew partsim's estimate: twice as much, again
+    for (int tries = 0; spec && !new_m && tries < 6 && IsOutOfArena(error); ++tries) {
+      arena_capacity = 2 * std::max<long long>(arena_capacity, 1 << 20);
+      error.clear();
+      spec = BuildSpec(*this, &error, &mesh_users);
+      new_m = spec ? Compile(spec.get(), &error) : nullptr;
+    }
+    warnings.erase(
+        std::remove_if(warnings.begin() + static_cast<long>(warnings_before), warnings.end(),
+                       [](const Warning& w) {
+                         return w.message.find("Attach conflict") != std::string::npos;
+                       }),
+        warnings.end());
   }
   if (!new_m) {
-    std::string why = DescribeMjNames(*this, error);
-    if (why.find("Element nesting is too deep") != std::string::npos)
-      why =
-          "bodies are nested deeper than MuJoCo 2.2.2's XML parser takes (100 levels: an "
-          "articulation's chain of links can be about 95 deep from its root): " +
-          why;
+    std::string why = DescribeMjNames(*this, error, mesh_users);
     if (!uncompiled_actors.empty()) {
       // some actor added since the last compile breaks it: they are taken back out and put in
       // again one by one, and those that MuJoCo refuses stay out; the error names them
@@ -225,16 +261,15 @@ void SceneImpl::EnsureCompiled() {
   new_model.mj.reset(new_m);
   MjDataPtr new_d(mj_makeData(new_m));
   if (!new_d)
-    throw Error("MuJoCo could not allocate the data of the scene (" +
-                std::to_string(new_m->nconmax) + " contacts, " + std::to_string(new_m->njmax) +
-                " constraint rows): out of memory");
+    throw Error("MuJoCo could not allocate the data of the scene (an arena of " +
+                std::to_string(new_m->narena) + " bytes): out of memory");
   // carry the state of everything that existed before: MuJoCo's by element name, partsim's by
   // articulation id (a new articulation's drives start at its description's targets)
   if (model.mj && data.mj)
     RestoreNamed(SaveNamed(model.mj.get(), data.mj.get()), new_m, new_d.get());
   else
     new_d->time = 0;
-  new_model.mjcf = std::move(xml);
+  new_model.spec = std::move(spec);
   BuildTables(*this, new_model);
   std::map<int, ArticulationData> states;
   for (const ArticulationEntry& a : articulations) {
@@ -306,30 +341,24 @@ void SceneImpl::UpdateKinematicArticulation(ArticulationEntry& a) {
   Invalidate();
 }
 
-void SceneImpl::GrowBuffers(int contacts, long long stack, const std::string& why) {
-  const int old_contacts = contact_capacity;
-  const long long old_stack = stack_capacity;
-  const int nv = m()->nv;
-  contact_capacity = contacts;
-  stack_capacity = stack;
+void SceneImpl::GrowArena(const std::string& why) {
+  const long long old_arena = arena_capacity;
+  const long long now = m()->narena;
+  arena_capacity = 2 * now;
   dirty = true;
   try {
     EnsureCompiled();  // the state is carried over
   } catch (const Error& e) {
-    // MuJoCo 2.2.2 sizes its data with dense constraint matrices (rows x rows, rows x dofs):
-    // past about 2 GB it cannot allocate them. The scene stays as it was.
-    contact_capacity = old_contacts;
-    stack_capacity = old_stack;
+    // past what the machine can allocate: the scene stays as it was
+    arena_capacity = old_arena;
     dirty = true;
     EnsureCompiled();
-    throw Error("step: " + why + ", and MuJoCo cannot allocate more for this scene (" +
-                std::to_string(nv) + " dofs; its constraint buffers grow with the square of " +
-                "the contacts): " + e.what() +
-                ". Fewer bodies in contact at once, or fewer "
-                "dofs, fit");
+    throw Error("step: " + why + ", and MuJoCo cannot allocate an arena of " +
+                std::to_string(2 * now) + " bytes for this scene (" + std::to_string(m()->nv) +
+                " dofs): " + e.what() + ". Fewer bodies in contact at once, or fewer dofs, fit");
   }
-  warnings.push_back({d()->time, why + ": grown to " + std::to_string(contact_capacity) +
-                                     " contacts and a stack of " + std::to_string(m()->nstack)});
+  warnings.push_back(
+      {d()->time, why + ": its arena grown to " + std::to_string(m()->narena) + " bytes"});
 }
 
 void SceneImpl::Step(int n) {
@@ -337,23 +366,23 @@ void SceneImpl::Step(int n) {
   EnsureCompiled();
   SteppingScope scope(this);
   for (int i = 0; i < n; ++i) {
-    // the model and data move when a step grows MuJoCo's buffers (GrowBuffers recompiles)
+    // the model and data move when a step grows MuJoCo's arena (GrowArena recompiles)
     const mjModel* m = model.mj.get();
     mjData* d = data.mj.get();
     ApplyDrives(model, data);
     int bad_before = d->warning[mjWARN_BADQACC].number + d->warning[mjWARN_BADQPOS].number +
                      d->warning[mjWARN_BADQVEL].number;
-    const int full_before = d->warning[mjWARN_CONTACTFULL].number;
+    const int full_before =
+        d->warning[mjWARN_CONTACTFULL].number + d->warning[mjWARN_CNSTRFULL].number;
     try {
       mj_step(m, d);
     } catch (const Error& e) {
       // MuJoCo's scratch stack ran out (contacts and dofs need more than the estimate): twice
-      // as much, recompiled with the state as it was, and the step again; a scene whose data
+      // the arena, recompiled with the state as it was, and the step again; a scene whose data
       // MuJoCo cannot allocate fails in EnsureCompiled, saying so
-      if (std::string(e.what()).find("Stack overflow") == std::string::npos) throw;
-      d->pstack = 0;
-      GrowBuffers(std::max(contact_capacity, m->nconmax), 2 * static_cast<long long>(m->nstack),
-                  "MuJoCo's stack of " + std::to_string(m->nstack) + " numbers ran out");
+      if (!IsOutOfArena(e.what())) throw;
+      ReleaseStack(d);
+      GrowArena("MuJoCo's arena of " + std::to_string(m->narena) + " bytes ran out");
       --i;
       continue;
     }
@@ -369,10 +398,9 @@ void SceneImpl::Step(int n) {
       data.xfrc_dirty = false;
     }
     // last: growing recompiles, and the model and data above are gone
-    if (d->warning[mjWARN_CONTACTFULL].number != full_before)
-      GrowBuffers(2 * m->nconmax, stack_capacity,
-                  "contacts filled MuJoCo's buffer of " + std::to_string(m->nconmax) +
-                      " (the excess was dropped for one step)");
+    if (d->warning[mjWARN_CONTACTFULL].number + d->warning[mjWARN_CNSTRFULL].number != full_before)
+      GrowArena("contacts filled MuJoCo's arena of " + std::to_string(m->narena) +
+                " bytes (the excess was dropped for one step)");
   }
   Invalidate();
 }
@@ -393,6 +421,15 @@ Scene::Scene(const SceneConfig& config) : impl_(std::make_unique<Impl>()) {
   if (config.solver_iterations < 1)
     throw Error("SceneConfig.solver_iterations must be >= 1, got " +
                 std::to_string(config.solver_iterations));
+  if (!(config.rest_offset >= 0) || !std::isfinite(config.rest_offset))
+    throw Error("SceneConfig.rest_offset must be finite and >= 0, got " +
+                FormatNumber(config.rest_offset));
+  if (!(config.contact_offset >= config.rest_offset) || !std::isfinite(config.contact_offset))
+    throw Error("SceneConfig.contact_offset must be finite and >= rest_offset (" +
+                FormatNumber(config.rest_offset) + "), got " + FormatNumber(config.contact_offset));
+  if (!(config.contact_impedance > 0 && config.contact_impedance <= 0.9999))
+    throw Error("SceneConfig.contact_impedance must be in (0, 0.9999], got " +
+                FormatNumber(config.contact_impedance));
   impl_->config = config;
   impl_->EnsureCompiled();
 }
@@ -409,8 +446,9 @@ std::unique_ptr<Scene> Scene::Clone() const {
   c.articulations = s.articulations;
   c.next_id = s.next_id;
   c.next_visual_id = s.next_visual_id;
-  c.contact_capacity = s.contact_capacity;
-  c.stack_capacity = s.stack_capacity;
+  c.arena_capacity = s.arena_capacity;
+  c.mjcf_models = s.mjcf_models;
+  c.next_mjcf_id = s.next_mjcf_id;
   c.description_version = s.description_version;
   c.model = s.model.Copy();
   c.data = s.data.CopyFor(c.model);
@@ -508,7 +546,12 @@ Actor Scene::AddActor(const ActorDesc& given) {
   s.CheckUser();  // added without compiling: the check EnsureCompiled would make
   // an actor's id is its entity id in segmentation pictures too (as SAPIEN's)
   int id = s.next_id;
-  s.actors.push_back({id, desc, static_cast<uint32_t>(id), s.next_visual_id});
+  internal::SceneImpl::ActorEntry entry;
+  entry.id = id;
+  entry.desc = desc;
+  entry.render_id = static_cast<uint32_t>(id);
+  entry.visual_id_base = s.next_visual_id;
+  s.actors.push_back(std::move(entry));
   // compiled with the next use of the model (EnsureCompiled): adding many actors one by one
   // compiles once
   s.uncompiled_actors.push_back(id);
@@ -526,7 +569,10 @@ Articulation Scene::AddArticulation(const ArticulationDesc& given) {
   s.EnsureCompiled();
   // its links take the ids (segmentation entity ids) after the articulation's own
   int id = s.next_id;
-  internal::SceneImpl::ArticulationEntry entry{id, desc, static_cast<uint32_t>(id + 1), {}};
+  internal::SceneImpl::ArticulationEntry entry;
+  entry.id = id;
+  entry.desc = desc;
+  entry.render_id_base = static_cast<uint32_t>(id + 1);
   uint32_t visual_id = s.next_visual_id;
   for (const LinkDesc& l : desc.links) {
     entry.visual_id_base.push_back(visual_id);
@@ -654,7 +700,7 @@ mjData_* Scene::GetMjData() const {
 
 std::string Scene::GetMjcf() const {
   impl().EnsureCompiled();
-  return impl().model.mjcf;
+  return internal::SaveMjcf(impl().model.spec.get());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -690,7 +736,8 @@ std::vector<Contact> Scene::GetContacts() const {
   std::vector<Contact> out;
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& c = d->contact[i];
-    if (c.exclude != 0) continue;
+    // 0: a contact with force, 1: within the detection gap, touching soon (no force yet)
+    if (c.exclude > 1) continue;
     const bool swap = is_static(c.geom1) && !is_static(c.geom2);
     const int g0 = swap ? c.geom2 : c.geom1, g1 = swap ? c.geom1 : c.geom2;
     auto key = std::make_pair(g0, g1);
@@ -702,8 +749,8 @@ std::vector<Contact> Scene::GetContacts() const {
       it = index.emplace(key, out.size()).first;
       out.push_back(contact);
     }
-    mjtNum f[6];
-    mj_contactForce(m, d, i, f);
+    mjtNum f[6] = {0, 0, 0, 0, 0, 0};
+    if (c.efc_address >= 0) mj_contactForce(m, d, i, f);
     Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> frame(c.frame);
     ContactPoint p;
     p.position = Eigen::Vector3d(c.pos[0], c.pos[1], c.pos[2]);
@@ -810,7 +857,9 @@ void Scene::Unpack(const std::vector<char>& state) {
   Reader r(state);
   if (r.Get<uint32_t>() != kPackMagic) throw Error("unpack: not a partsim state (bad header)");
   const char* names[] = {"nq", "nv", "nu", "na", "nbody", "nmocap"};
-  int expect[] = {m->nq, m->nv, m->nu, m->na, m->nbody, m->nmocap};
+  const int expect[] = {static_cast<int>(m->nq),    static_cast<int>(m->nv),
+                        static_cast<int>(m->nu),    static_cast<int>(m->na),
+                        static_cast<int>(m->nbody), static_cast<int>(m->nmocap)};
   for (int k = 0; k < 6; ++k) {
     int got = r.Get<int>();
     if (got != expect[k])

@@ -32,7 +32,11 @@ struct MjModelDeleter {
 struct MjDataDeleter {
   void operator()(mjData* d) const { mj_deleteData(d); }
 };
+struct MjSpecDeleter {
+  void operator()(mjSpec* s) const { mj_deleteSpec(s); }
+};
 using MjModelPtr = std::unique_ptr<mjModel, MjModelDeleter>;
+using MjSpecPtr = std::unique_ptr<mjSpec, MjSpecDeleter>;
 using MjDataPtr = std::unique_ptr<mjData, MjDataDeleter>;
 
 /// Where a MuJoCo geom came from.
@@ -107,7 +111,8 @@ struct CompiledArticulation {
 /// The compiled model: MuJoCo's model and partsim's tables over it.
 struct Model {
   MjModelPtr mj;
-  std::string mjcf;                                   ///< what MuJoCo compiled
+  /// the specification MuJoCo compiled: never changed after, shared by copies
+  std::shared_ptr<mjSpec> spec;
   std::map<int, CompiledActor> actors;                ///< by actor id
   std::map<int, CompiledArticulation> articulations;  ///< by articulation id
   std::vector<GeomOwner> geom_owner;                  ///< per MuJoCo geom

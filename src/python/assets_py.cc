@@ -235,12 +235,13 @@ void BindAssets(py::module_& m) {
       "naming an option out of range.");
   m.def("standing_root_pose", &StandingRootPose, py::arg("articulation"), py::arg("altitude") = 0.0,
         "Root pose that makes the articulation stand on z = altitude at its current joint "
-        "positions (orientation and x, y kept).");
+        "positions (orientation and x, y kept), its lowest point 10 micrometres clear of it.");
   m.def(
       "place_on_ground",
       [](Articulation articulation, double altitude) { PlaceOnGround(articulation, altitude); },
       py::arg("articulation"), py::arg("altitude") = 0.0,
-      "Moves the articulation's root so that its lowest point touches z = altitude.");
+      "Moves the articulation's root so that it stands on z = altitude (its lowest point 10 "
+      "micrometres clear of it).");
   py::class_<PartNetBatchEntry>(m, "PartNetBatchEntry",
                                 "One folder of parse_partnet_mobility_batch: its object, or the "
                                 "error that stopped it.")

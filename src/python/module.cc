@@ -5,7 +5,7 @@
 #include "partsim/core/version.h"
 
 PYBIND11_MODULE(_partsim, m) {
-  m.doc() = "partsim: simulation of robots interacting with articulated objects (MuJoCo 2.2.2).";
+  m.doc() = "partsim: simulation of robots interacting with articulated objects (on MuJoCo).";
   // core first: the other subsystems use Pose and the exception types in their signatures
   partsim::python::BindCore(m);
   partsim::python::BindPhysics(m);

@@ -14,6 +14,7 @@
 #include "bindings.h"
 #include "partsim/core/check.h"
 #include "partsim/physics/description.h"
+#include "partsim/physics/mjcf.h"
 #include "partsim/physics/scene.h"
 
 namespace partsim::python {
@@ -807,7 +808,8 @@ void BindScene(py::module_& m) {
   py::enum_<Integrator>(m, "Integrator", "Numerical integrator of the scene.")
       .value("EULER", Integrator::kEuler)
       .value("IMPLICIT", Integrator::kImplicit)
-      .value("RK4", Integrator::kRK4);
+      .value("RK4", Integrator::kRK4)
+      .value("IMPLICITFAST", Integrator::kImplicitFast);
 
   py::class_<SceneConfig>(m, "SceneConfig",
                           "Scene-wide settings: timestep, gravity, default material, solver "
@@ -820,8 +822,20 @@ void BindScene(py::module_& m) {
                      "PhysicalMaterial of the collision shapes that name none.")
       .def_readwrite("solver_iterations", &SceneConfig::solver_iterations,
                      "Constraint solver iterations per step, >= 1 (default 50).")
-      .def_readwrite("integrator", &SceneConfig::integrator,
-                     "Integrator (default IMPLICIT, which handles stiff PD damping).");
+      .def_readwrite(
+          "integrator", &SceneConfig::integrator,
+          "Integrator (default IMPLICITFAST; the implicit ones handle stiff PD damping).")
+      .def_readwrite("contact_offset", &SceneConfig::contact_offset,
+                     "m, >= rest_offset: each shape's distance within which contacts are found "
+                     "(SAPIEN's contact offset; a pair adds up its two shapes'); contacts beyond "
+                     "the rest offset are reported with zero force (default 0).")
+      .def_readwrite("rest_offset", &SceneConfig::rest_offset,
+                     "m, >= 0: each shape's distance at which bodies rest on it (SAPIEN's rest "
+                     "offset; a pair adds up its two shapes'; default 0).")
+      .def_readwrite("contact_impedance", &SceneConfig::contact_impedance,
+                     "In (0, 0.9999]: the share of the force a contact needs that it gives at the "
+                     "moment of touching (MuJoCo's solimp dmin; default 0.999: nearly hard, as "
+                     "PhysX's are; MuJoCo's own is 0.9).");
 
   py::class_<Scene, std::shared_ptr<Scene>>(
       m, "Scene", "A simulated world. Handles and builders taken from it keep it alive.")
@@ -925,6 +939,79 @@ void BindScene(py::module_& m) {
 
 }  // namespace
 
+void BindMjcf(py::module_& m) {
+  const auto ka = py::keep_alive<0, 1>();
+  py::class_<MjcfModel>(
+      m, "MjcfModel",
+      "An MJCF model loaded into a scene (Scene.load_mjcf): its bodies, joints, tendons, "
+      "equality constraints, actuators and sensors as MuJoCo defines them, with partsim's "
+      "handles on its bodies.")
+      .def_property_readonly("id", &MjcfModel::GetId, "The model's id in its scene.")
+      .def_property_readonly("name", &MjcfModel::GetName,
+                             "The model's name (<mujoco model=...>, else the file's stem).")
+      .def_property_readonly("path", &MjcfModel::GetPath, "The file it was loaded from.")
+      .def_property_readonly("prefix", &MjcfModel::GetPrefix,
+                             "What its element names start with in the scene's MuJoCo model.")
+      .def(
+          "get_articulations",
+          [](py::object self) {
+            return HandleList(self.cast<const MjcfModel&>().GetArticulations(), self);
+          },
+          "The articulations made of its kinematic trees.")
+      .def(
+          "get_actors",
+          [](py::object self) {
+            return HandleList(self.cast<const MjcfModel&>().GetActors(), self);
+          },
+          "The actors made of its free, static and mocap bodies (and its worldbody's geoms).")
+      .def("get_bodies_without_handle", &MjcfModel::GetBodiesWithoutHandle,
+           "Bodies MuJoCo simulates that have no partsim handle (trees with a ball joint).")
+      .def("get_actuator_names", &MjcfModel::GetActuatorNames,
+           "Its actuators' names, without the prefix, in MuJoCo's order.")
+      .def("get_ctrl", &MjcfModel::GetCtrl, "Its actuators' controls (MuJoCo's ctrl), (nu,).")
+      .def("set_ctrl", py::overload_cast<const Eigen::VectorXd&>(&MjcfModel::SetCtrl),
+           py::arg("ctrl"), "Sets every actuator's control; kept until set again.")
+      .def("set_ctrl", py::overload_cast<const std::string&, double>(&MjcfModel::SetCtrl),
+           py::arg("actuator"), py::arg("value"), "Sets one actuator's control by name.")
+      .def("get_joint_names", &MjcfModel::GetJointNames,
+           "Its joints' names, without the prefix, in MuJoCo's order.")
+      .def("get_qpos", &MjcfModel::GetQpos, "Its slice of MuJoCo's qpos, joint by joint.")
+      .def("set_qpos", &MjcfModel::SetQpos, py::arg("qpos"),
+           "Sets its slice of MuJoCo's qpos (free joints: position and w, x, y, z quaternion).")
+      .def("get_qvel", &MjcfModel::GetQvel, "Its slice of MuJoCo's qvel, joint by joint.")
+      .def("set_qvel", &MjcfModel::SetQvel, py::arg("qvel"), "Sets its slice of MuJoCo's qvel.")
+      .def("get_tendon_names", &MjcfModel::GetTendonNames,
+           "Its tendons' names, without the prefix, in MuJoCo's order.")
+      .def("get_tendon_lengths", &MjcfModel::GetTendonLengths,
+           "Its tendons' lengths now (m), in the order of get_tendon_names().")
+      .def("mj_id", &MjcfModel::MjId, py::arg("mj_object_type"), py::arg("name"),
+           "The id of one of its elements in the scene's MuJoCo model (mujoco.mjtObj value), "
+           "-1 when it has none of that name.");
+
+  py::class_<Scene, std::shared_ptr<Scene>>(m.attr("Scene"))
+      .def(
+          "load_mjcf",
+          [](Scene& scene, const std::string& path, const Pose& pose) {
+            return LoadMjcf(scene, path, pose);
+          },
+          py::arg("path"), py::arg("pose") = Pose(), ka,
+          "Loads an MJCF file (MuJoCo's format) into the scene at `pose`; returns its "
+          "MjcfModel. <include>, <replicate>, <attach> and relative asset paths work; the "
+          "scene's options are kept. Raises PartsimError with MuJoCo's message (file and line) "
+          "and leaves the scene as it was.")
+      .def(
+          "get_mjcf_models",
+          [](py::object self) {
+            return HandleList(GetMjcfModels(self.cast<const Scene&>()), self);
+          },
+          "The MJCF models loaded into the scene.");
+  m.def("scene_config_from_mjcf", &SceneConfigFromMjcf, py::arg("path"),
+        "The options of an MJCF file (timestep, gravity, integrator, iterations) as a "
+        "SceneConfig.");
+  m.def("is_mjcf_file", &IsMjcfFile, py::arg("path"),
+        "Whether a file is MJCF (a .xml whose root element is <mujoco>).");
+}
+
 void BindPhysics(py::module_& m) {
   // classes are registered before the signatures that mention them, so docstrings (and the
   // stubs made from them) name Python types
@@ -933,6 +1020,7 @@ void BindPhysics(py::module_& m) {
   BindHandles(m);
   BindBuilders(m);
   BindScene(m);
+  BindMjcf(m);
 }
 
 }  // namespace partsim::python

@@ -87,6 +87,18 @@ LoadedObject LoadObject(const ObjectArgs& args, const SceneConfig& config) {
   if (!probe) {
     throw std::runtime_error("cannot open '" + args.file + "': " + std::strerror(errno));
   }
+  // MuJoCo's own format: a scene with the file's options, the model with partsim's handles
+  if (IsMjcfFile(args.file)) {
+    const SceneConfig file_config = SceneConfigFromMjcf(args.file);
+    std::cerr << "partsim: " << args.file << " is an MJCF model: its options are used (timestep "
+              << file_config.timestep << " s)\n";
+    out.scene = std::make_unique<Scene>(file_config);
+    out.mjcf = LoadMjcf(*out.scene, args.file);
+    for (const Articulation& a : out.mjcf->GetArticulations())
+      if (!out.art.GetScene() || a.Dof() > out.art.Dof()) out.art = a;
+    out.source = args.file;
+    return out;
+  }
   out.art = loader.Load(args.file);
   out.source = args.file;
   return out;

@@ -87,9 +87,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (command == "--version") {
-    int v = mj_version();
-    std::printf("partsim %s (MuJoCo %d.%d.%d)\n", partsim::Version(), v / 100, (v / 10) % 10,
-                v % 10);
+    std::printf("partsim %s (MuJoCo %s)\n", partsim::Version(), mj_versionString());
     return 0;
   }
   if (command == "assets") return partsim::tools::RunAssetsCommand(argc - 2, argv + 2);

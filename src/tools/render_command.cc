@@ -141,12 +141,23 @@ int Render(const RenderArgs& args) {
   RenderBackend& backend = scene.GetRenderBackend();
 
   // the object's extent, from its visuals (else from its link origins)
+  // (an MJCF model's: all its articulations and actors but the floor of its worldbody)
   std::vector<uint32_t> ids;
+  std::vector<int> articulations = {l.art.GetScene() ? l.art.GetId() : -1}, actors;
+  if (l.mjcf) {
+    for (const Articulation& a : l.mjcf->GetArticulations()) articulations.push_back(a.GetId());
+    for (const Actor& a : l.mjcf->GetActors())
+      if (a.GetType() != ActorType::kStatic) actors.push_back(a.GetId());
+  }
+  auto has = [](const std::vector<int>& v, int id) {
+    return id >= 0 && std::find(v.begin(), v.end(), id) != v.end();
+  };
   for (const RenderEntityInfo& e : scene.GetRenderEntities())
-    if (e.articulation_id == l.art.GetId()) ids.push_back(e.id);
+    if (has(articulations, e.articulation_id) || has(actors, e.actor_id)) ids.push_back(e.id);
   scene.UpdateRender();
   Eigen::Vector3d lo, hi;
   if (!VisualBounds(scene.GetRenderWorld(), ids, &lo, &hi)) {
+    if (!l.art.GetScene()) throw std::runtime_error(l.source + ": nothing to draw");
     std::cerr << "partsim render: the object has no visuals; framing its link origins\n";
     lo = hi = l.art.GetLink(0).GetPose().p;
     for (const Link& link : l.art.GetLinks()) {

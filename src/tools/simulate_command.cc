@@ -112,6 +112,10 @@ int Simulate(const SimulateArgs& args) {
   config.timestep = args.dt;
   config.gravity = args.gravity;
   LoadedObject l = LoadObject(args.object, config);
+  if (!l.art.GetScene())
+    throw std::runtime_error(l.source + ": the MJCF model has no kinematic tree to record (" +
+                             std::to_string(l.mjcf->GetActors().size()) +
+                             " actors); partsim view shows it");
   Articulation& art = l.art;
   const bool demo = args.object.file.empty();
   const long steps = args.steps.value_or(1000);

@@ -245,14 +245,15 @@ TEST_F(PartNetMobilityTest, MultipleCollisionsGiveOnePiecePerFile) {
   EXPECT_EQ(obj.articulation.links[obj.LinkIndex(0)].collisions.size(), 2u);
 }
 
-TEST_F(PartNetMobilityTest, PlaceOnGroundPutsTheLowestPointOnThePlane) {
+TEST_F(PartNetMobilityTest, PlaceOnGroundPutsTheLowestPoint10MicrometresAboveThePlane) {
   Folder f("ground");
   Scene scene;
   PartNetMobilityLoader loader(&scene);
   Articulation art = loader.Load(f.Path());
   PlaceOnGround(art, 0.25);
-  // the body's back panel spans mesh y in [-0.4, 0.4]: world z in [0.25, 1.05]
-  EXPECT_NEAR(art.GetRootPose().p.z(), 0.25 + 0.4, 1e-6);
+  // the body's back panel spans mesh y in [-0.4, 0.4]: world z in [0.25, 1.05], raised by the
+  // clearance
+  EXPECT_NEAR(art.GetRootPose().p.z(), 0.25 + 0.4 + 1e-5, 1e-7);
   EXPECT_NEAR(StandingRootPose(art, 0.25).p.z(), art.GetRootPose().p.z(), 1e-12);
 }
 

@@ -1,6 +1,6 @@
 """The SAPIEN-style example scripts (examples/sapien/) run to the end with partsim standing in for
 SAPIEN, and print what they check: the box rests and the contact force equals its weight with
-SAPIEN's sign, the car drives straight on the ground at dt = 0.01 s, the PID arm reaches its
+SAPIEN's sign, a box set down on a box is held by its contacts from the first step, the car drives straight on the ground at dt = 0.01 s, the PID arm reaches its
 target, the camera's point cloud lies on the objects."""
 
 import os
@@ -37,6 +37,17 @@ def test_hello_world_box_rests_and_contact_force_is_its_weight(tmp_path):
     force, weight = value_after(out, "contact force ="), value_after(out, "weight =")
     assert force > 0 and force == pytest.approx(weight, rel=0.01)
     assert "actor0 = box, actor1 = ground" in out
+
+
+def test_contact_a_box_set_down_on_a_box_is_held_from_the_first_step(tmp_path):
+    # SAPIEN 2's contact example: a 0.5 m cube placed exactly on a kinematic cube at dt = 0.01 s;
+    # after one step the contact impulses add up to m g dt within 1e-3, and the box stays
+    out = run_example("contact.py", cwd=tmp_path)
+    assert "contact: ok" in out
+    impulse, expected = value_after(out, "contact impulse ="), value_after(out, "m g dt =")
+    assert impulse == pytest.approx(expected, rel=1e-3)
+    assert value_after(out, "box moved") < 1e-5
+    assert "contact box-base" in out or "contact base-box" in out
 
 
 def test_hello_world_v3_renders_the_red_box(tmp_path):

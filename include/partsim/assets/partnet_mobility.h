@@ -101,7 +101,9 @@ class PartNetMobilityLoader {
 
 /// The pose of an articulation's root that makes its geometry stand on the plane z = `altitude`
 /// at the current joint positions: the root's orientation and x, y stay; z moves so that the
-/// lowest point of its collision shapes (visuals when it has none) touches the plane.
+/// lowest point of its collision shapes (visuals when it has none) is 10 micrometres above the
+/// plane: clear of it, so that a part that cannot move down (a drawer of a fixed cabinet) is not
+/// in a contact it cannot push out of, whose friction would hold it.
 Pose StandingRootPose(const Articulation& articulation, double altitude = 0.0);
 /// Moves the articulation's root to StandingRootPose.
 void PlaceOnGround(Articulation& articulation, double altitude = 0.0);

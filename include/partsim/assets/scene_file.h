@@ -51,7 +51,9 @@ SceneFileSpec ReadSceneFile(const std::string& path);
 ///   loaded z-up by PartNetMobilityLoader): one articulation at `default_pose` (X_WO), its root
 ///   fixed when `fix_root`;
 /// - a `.json` scene file: each entry (itself a URDF or a PartNet-Mobility folder) at its pose,
-///   `fix_root` being the default of entries without "fix_root".
+///   `fix_root` being the default of entries without "fix_root";
+/// - an MJCF `.xml` file (root element <mujoco>): the whole model at `default_pose` (LoadMjcf,
+///   partsim/physics/mjcf.h), returning the articulations made of its trees.
 /// The pose places the object's frame: a URDF whose root hangs from a "world" link keeps that
 /// offset (root pose = pose * offset), and such a URDF's own joint decides whether its root is
 /// fixed. Articulations get the entry's "name" when given (it must not be taken in the scene yet),

@@ -33,16 +33,33 @@ class ActorBuilder;
 class ArticulationBuilder;
 class UrdfLoader;
 
-/// Numerical integrator of the scene.
-enum class Integrator { kEuler, kImplicit, kRK4 };
+/// Numerical integrator of the scene (MuJoCo's). kImplicitFast, the default, integrates joint
+/// damping and the drives' velocity terms implicitly, as kImplicit does, and leaves out the
+/// Coriolis and centripetal derivatives that make kImplicit's matrix dense and unsymmetric: what
+/// MuJoCo recommends for new models.
+enum class Integrator { kEuler, kImplicit, kRK4, kImplicitFast };
 
 /// Scene-wide settings.
 struct SceneConfig {
   double timestep = 1.0 / 500.0;                           ///< seconds, > 0
   Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.81);  ///< m/s^2, world frame
   PhysicalMaterial default_material;
-  int solver_iterations = 50;                     ///< constraint solver iterations, >= 1
-  Integrator integrator = Integrator::kImplicit;  ///< implicit handles stiff PD damping
+  int solver_iterations = 50;  ///< constraint solver iterations, >= 1
+  /// the implicit ones handle stiff PD damping
+  Integrator integrator = Integrator::kImplicitFast;
+  /// m, >= rest_offset: each shape's distance within which contacts are found (SAPIEN's and
+  /// PhysX's contact offset; a pair adds up its two shapes'). Contacts found farther than the
+  /// rest offset are reported with zero force. MuJoCo's margin + gap.
+  double contact_offset = 0.0;
+  /// m, >= 0: each shape's distance at which bodies rest on it (SAPIEN's rest offset; a pair
+  /// adds up its two shapes'). MuJoCo's margin.
+  double rest_offset = 0.0;
+  /// in (0, 0.9999]: the share of the force a contact needs that it gives at the moment of
+  /// touching (MuJoCo's solimp dmin; dmax is max(0.95, this)). MuJoCo's own 0.9 lets a body
+  /// sink about 0.1 mm into what it rests on and gives 97% of the support at first touch; at
+  /// partsim's 0.999 contacts are nearly hard, as PhysX's are (a body set down on another is
+  /// held within 1e-3 of its weight from the first step).
+  double contact_impedance = 0.999;
 };
 
 /// Handle to an actor. Cheap to copy; valid until the actor is removed.
