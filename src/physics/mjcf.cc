@@ -495,14 +495,30 @@ SceneImpl::MjcfEntry& Entry(Scene* scene, int id) {
   return scene->impl().GetMjcf(id);
 }
 
-// The ids of a model's elements of one type, in MuJoCo's order.
-std::vector<int> Elements(SceneImpl& s, const std::string& prefix, mjtObj type, int count) {
+// The ids of a model's elements of one type (bodies, joints, actuators, tendons), in MuJoCo's
+// order.
+std::vector<int> Elements(SceneImpl& s, const std::string& prefix, mjtObj type) {
   s.EnsureCompiled();
+  const mjModel* m = s.m();
+  const long long count = type == mjOBJ_BODY       ? m->nbody
+                          : type == mjOBJ_JOINT    ? m->njnt
+                          : type == mjOBJ_ACTUATOR ? m->nu
+                          : type == mjOBJ_TENDON   ? m->ntendon
+                                                   : 0;
   std::vector<int> out;
   for (int i = 0; i < count; ++i) {
-    const char* n = mj_id2name(s.m(), type, i);
+    const char* n = mj_id2name(m, type, i);
     if (n && std::strncmp(n, prefix.c_str(), prefix.size()) == 0) out.push_back(i);
   }
+  return out;
+}
+
+// The names (without the prefix) of a model's elements of one type, in MuJoCo's order.
+std::vector<std::string> ElementNames(Scene* scene, int id, mjtObj type) {
+  SceneImpl& s = scene->impl();
+  const std::string& prefix = Entry(scene, id).prefix;
+  std::vector<std::string> out;
+  for (int e : Elements(s, prefix, type)) out.push_back(Strip(Name(s.m(), type, e), prefix));
   return out;
 }
 
@@ -529,18 +545,12 @@ std::vector<std::string> MjcfModel::GetBodiesWithoutHandle() const {
 }
 
 std::vector<std::string> MjcfModel::GetActuatorNames() const {
-  SceneImpl& s = scene_->impl();
-  const std::string& prefix = Entry(scene_, id_).prefix;
-  std::vector<std::string> out;
-  for (int a : Elements(s, prefix, mjOBJ_ACTUATOR, static_cast<int>(s.m()->nu)))
-    out.push_back(Strip(Name(s.m(), mjOBJ_ACTUATOR, a), prefix));
-  return out;
+  return ElementNames(scene_, id_, mjOBJ_ACTUATOR);
 }
 
 Eigen::VectorXd MjcfModel::GetCtrl() const {
   SceneImpl& s = scene_->impl();
-  const std::vector<int> ids =
-      Elements(s, Entry(scene_, id_).prefix, mjOBJ_ACTUATOR, static_cast<int>(s.m()->nu));
+  const std::vector<int> ids = Elements(s, Entry(scene_, id_).prefix, mjOBJ_ACTUATOR);
   Eigen::VectorXd out(ids.size());
   for (size_t i = 0; i < ids.size(); ++i) out[static_cast<Eigen::Index>(i)] = s.d()->ctrl[ids[i]];
   return out;
@@ -548,8 +558,7 @@ Eigen::VectorXd MjcfModel::GetCtrl() const {
 
 void MjcfModel::SetCtrl(const Eigen::VectorXd& ctrl) {
   SceneImpl& s = scene_->impl();
-  const std::vector<int> ids =
-      Elements(s, Entry(scene_, id_).prefix, mjOBJ_ACTUATOR, static_cast<int>(s.m()->nu));
+  const std::vector<int> ids = Elements(s, Entry(scene_, id_).prefix, mjOBJ_ACTUATOR);
   if (ctrl.size() != static_cast<Eigen::Index>(ids.size()))
     throw Error("set_ctrl: the model '" + GetName() + "' has " + std::to_string(ids.size()) +
                 " actuators, got " + std::to_string(ctrl.size()) + " controls");
@@ -571,12 +580,7 @@ void MjcfModel::SetCtrl(const std::string& actuator, double value) {
 }
 
 std::vector<std::string> MjcfModel::GetJointNames() const {
-  SceneImpl& s = scene_->impl();
-  const std::string& prefix = Entry(scene_, id_).prefix;
-  std::vector<std::string> out;
-  for (int j : Elements(s, prefix, mjOBJ_JOINT, static_cast<int>(s.m()->njnt)))
-    out.push_back(Strip(Name(s.m(), mjOBJ_JOINT, j), prefix));
-  return out;
+  return ElementNames(scene_, id_, mjOBJ_JOINT);
 }
 
 namespace {
@@ -585,7 +589,7 @@ namespace {
 std::vector<std::pair<int, int>> Slices(SceneImpl& s, const std::string& prefix, bool positions) {
   std::vector<std::pair<int, int>> out;  // (address, size)
   const mjModel* m = s.m();
-  for (int j : Elements(s, prefix, mjOBJ_JOINT, static_cast<int>(m->njnt))) {
+  for (int j : Elements(s, prefix, mjOBJ_JOINT)) {
     const int type = m->jnt_type[j];
     const int nq = type == mjJNT_FREE ? 7 : type == mjJNT_BALL ? 4 : 1;
     const int nv = type == mjJNT_FREE ? 6 : type == mjJNT_BALL ? 3 : 1;
@@ -645,18 +649,12 @@ void MjcfModel::SetQvel(const Eigen::VectorXd& qvel) {
 }
 
 std::vector<std::string> MjcfModel::GetTendonNames() const {
-  SceneImpl& s = scene_->impl();
-  const std::string& prefix = Entry(scene_, id_).prefix;
-  std::vector<std::string> out;
-  for (int t : Elements(s, prefix, mjOBJ_TENDON, static_cast<int>(s.m()->ntendon)))
-    out.push_back(Strip(Name(s.m(), mjOBJ_TENDON, t), prefix));
-  return out;
+  return ElementNames(scene_, id_, mjOBJ_TENDON);
 }
 
 Eigen::VectorXd MjcfModel::GetTendonLengths() const {
   SceneImpl& s = scene_->impl();
-  const std::vector<int> ids =
-      Elements(s, Entry(scene_, id_).prefix, mjOBJ_TENDON, static_cast<int>(s.m()->ntendon));
+  const std::vector<int> ids = Elements(s, Entry(scene_, id_).prefix, mjOBJ_TENDON);
   s.EnsureForward();
   Eigen::VectorXd out(ids.size());
   for (size_t i = 0; i < ids.size(); ++i)
