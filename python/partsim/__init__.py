@@ -1,4 +1,4 @@
-"""partsim: simulation of robots interacting with articulated objects, on MuJoCo 2.2.2.
+"""partsim: simulation of robots interacting with articulated objects, on MuJoCo.
 
 The compiled extension `partsim._partsim` holds the bindings; everything public in it is
 re-exported here, so `import partsim; partsim.Scene()` works. SAPIEN's names are added beside
