@@ -117,6 +117,7 @@ int Simulate(const SimulateArgs& args) {
                              std::to_string(l.mjcf->GetActors().size()) +
                              " actors); partsim view shows it");
   Articulation& art = l.art;
+  const double dt = l.scene->GetTimestep();  // an MJCF file's own
   const bool demo = args.object.file.empty();
   const long steps = args.steps.value_or(1000);
   std::vector<Joint> active = art.GetActiveJoints();
@@ -170,7 +171,7 @@ int Simulate(const SimulateArgs& args) {
     }
     std::ostream& out = to_stdout ? std::cout : file;
     if (format == "json")
-      WriteJson(out, tr, args.dt);
+      WriteJson(out, tr, dt);
     else
       WriteCsv(out, tr);
     if (!to_stdout && !file) throw std::runtime_error("error while writing '" + args.out + "'");
@@ -178,8 +179,8 @@ int Simulate(const SimulateArgs& args) {
 
   // summary (on stderr when the trajectory went to stdout)
   FILE* s = to_stdout ? stderr : stdout;
-  std::fprintf(s, "simulated %ld steps of %g s (%.4g s) in %.3f s: %.0f steps/s\n", steps, args.dt,
-               steps * args.dt, wall, wall > 0 ? steps / wall : 0.0);
+  std::fprintf(s, "simulated %ld steps of %g s (%.4g s) in %.3f s: %.0f steps/s\n", steps, dt,
+               steps * dt, wall, wall > 0 ? steps / wall : 0.0);
   if (record && !to_stdout) {
     std::fprintf(s, "trajectory: %zu rows written to %s\n", tr.time.size(), args.out.c_str());
   }

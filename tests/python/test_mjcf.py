@@ -93,3 +93,17 @@ def test_render_draws_an_mjcf_model(tmp_path):
     color = np.asarray(Image.open(tmp_path / "color_0.png").convert("RGB")).astype(float)
     # the mug fills part of the view: not a blank picture
     assert color.std() > 10
+
+
+def test_simulate_records_an_mjcf_model_at_its_own_timestep(tmp_path):
+    # newton's cradle has no tree; the slider-crank has two, each a hinge on the world
+    out = tmp_path / "trajectory.json"
+    p = subprocess.run([CLI, "simulate", realdata("replicate", "newton_cradle.xml"), "--steps",
+                        "10"], capture_output=True, text=True, timeout=120)
+    assert p.returncode != 0 and "no kinematic tree" in p.stderr
+    p = subprocess.run([CLI, "simulate", realdata("slider_crank", "slider_crank.xml"), "--steps",
+                        "100", "--out", str(out)], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    trajectory = json.loads(out.read_text())
+    assert trajectory["dt"] == pytest.approx(0.002)
+    assert len(trajectory["qpos"]) == 101 and len(trajectory["qpos"][0]) == 2

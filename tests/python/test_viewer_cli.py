@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import CABINET_URDF, PYTHON_DIR
+from conftest import CABINET_URDF, PYTHON_DIR, REPO
 
 websocket = pytest.importorskip("websocket")  # Debian's python3-websocket (scripts/setup.sh)
 
@@ -269,6 +269,17 @@ def test_view_file_serves_its_links_and_stops_on_sigterm(tmp_path, serve):
     ws.close()
     t0 = time.time()
     assert s.sigterm() == 0 and time.time() - t0 < 5
+
+
+def test_view_serves_an_mjcf_model(serve):
+    car = os.path.join(REPO, "..", "shared", "realdata", "mjcf", "car", "car.xml")
+    if not os.path.exists(car):
+        pytest.skip(f"{car} is absent (../shared)")
+    s = serve(["view", car, "--port", "0"])
+    bodies = {b["name"] for b in s.json("/api/scene.json")["bodies"]}
+    # the car's chassis and wheels (one articulation) and its floor (the worldbody's geoms)
+    assert {"car", "left wheel", "right wheel", "car/world"} <= bodies, bodies
+    assert s.sigterm() == 0
 
 
 def test_serve_viewer_prints_the_url_and_stops_on_sigterm(tmp_path, serve):
