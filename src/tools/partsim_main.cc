@@ -32,7 +32,9 @@ usage:
 
 OBJECT is a URDF file or a PartNet-Mobility folder (mobility.urdf with mobility_v2.json,
 semantics.txt, meta.json, as `partsim assets generate` writes them); a folder's mobility.urdf
-given alone loads as its folder does, with the part labels of semantics.txt.
+given alone loads as its folder does, with the part labels of semantics.txt. An MJCF file
+(a .xml whose root is <mujoco>) loads whole, with its own options: info describes it,
+simulate records its tree of most dof, render draws all its bodies.
 
 info       prints the links (name, parent, mass), the joints (name, type, parent -> child,
            limits in rad or m), the total mass and the number of degrees of freedom.
