@@ -25,14 +25,14 @@ namespace partsim::tools {
 namespace {
 
 constexpr char kViewUsage[] = R"(usage:
-  partsim view [FILE.urdf | FOLDER | SCENE.json] [--port P] [--address A] [--paused]
+  partsim view [FILE.urdf | FOLDER | FILE.xml | SCENE.json] [--port P] [--address A] [--paused]
                [--rate R] [--token T] [--allow-origin O]... [--duration S]
   partsim view --dataset ROOT [--category C] [--port P] [--address A] [--rate R] [--token T]
                [--allow-origin O]... [--duration S]
 
 Simulates the asset in real time (a URDF file or a PartNet-Mobility folder at the origin with its
-root fixed, a JSON scene file's objects at their poses, or with nothing given the built-in
-cabinet) on a ground under lights, with a camera "front" looking at it, and serves the browser
+root fixed, an MJCF model whole, a JSON scene file's objects at their poses, or with nothing
+given the built-in cabinet) on a ground under lights, with a camera "front" looking at it, and serves the browser
 viewer (docs/viewer.md): open the printed URL. The page orbits the camera, moves joints with
 sliders, pauses, steps and resets the simulation, and shows the camera's pictures. For a remote
 machine: ssh -L 8000:127.0.0.1:8000 HOST, then open the URL on your own.
