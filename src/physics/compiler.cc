@@ -19,9 +19,6 @@ namespace partsim {
 namespace internal {
 namespace {
 
-// MuJoCo capsules and cylinders lie along z; partsim's along x: rotate z onto x.
-const Eigen::Quaterniond kZToX(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()));
-
 void SetQuat(double out[4], const Eigen::Quaterniond& q) {
   const Eigen::Quaterniond n = q.normalized();
   out[0] = n.w();

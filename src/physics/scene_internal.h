@@ -4,8 +4,10 @@
 
 #include <mujoco/mujoco.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <optional>
@@ -159,6 +161,9 @@ inline double DriveStep(const SceneConfig& config) {
              : 0.0;
 }
 
+/// MuJoCo's capsules and cylinders lie along z, partsim's along x: a MuJoCo geom's frame is the
+/// partsim shape's frame times this rotation (z onto x).
+inline const Eigen::Quaterniond kZToX{Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY())};
 /// The distance (m) below which two shapes placed exactly touching push on each other: MuJoCo
 /// applies contact force only below a pair's margin, and a body set down at distance 0 would fall
 /// for a step. Each shape's margin carries half of it.
