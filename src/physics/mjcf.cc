@@ -18,12 +18,10 @@
 
 namespace partsim {
 
+using internal::kZToX;
 using internal::SceneImpl;
 
 namespace {
-
-// MuJoCo capsules and cylinders lie along z; partsim's along x.
-const Eigen::Quaterniond kZToX(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()));
 
 Pose PoseOf(const double* pos, const double* quat) {
   return Pose(Eigen::Vector3d(pos[0], pos[1], pos[2]),
@@ -435,6 +433,14 @@ MjcfModel LoadMjcf(Scene& scene, const std::string& path, const Pose& pose) {
   SceneImpl& s = scene.impl();
   s.CheckUser();
   if (!std::filesystem::exists(path)) throw Error("load_mjcf: no file '" + path + "'");
+  // MuJoCo's parser also imports URDF: partsim's URDF loader is the one for those
+  const std::string root = RootElement(path);
+  if (root != "mujoco")
+    throw Error("load_mjcf: " + path + ": " +
+                (root.empty()
+                     ? std::string("no root element (not an MJCF file)")
+                     : "the root element is <" + root + ">, not <mujoco>" +
+                           (root == "robot" ? " (a URDF: load it with the URDF loader)" : "")));
   char err[1024] = "";
   std::shared_ptr<mjSpec> spec(mj_parseXML(path.c_str(), nullptr, err, sizeof(err)),
                                internal::MjSpecDeleter());

@@ -273,6 +273,56 @@ TEST(MjcfTest, BadMjcfGivesMuJoCosMessageAndLeavesTheSceneAsItWas) {
   fs::remove_all(dir);
 }
 
+// Hostile files: bytes that are not text, bodies nested past what MuJoCo's parser takes, numbers
+// past a double's range, a root that is not <mujoco>. Each is refused with a message that names
+// the file; the scene is as it was, and the detection of MJCF files survives them.
+TEST(MjcfTest, HostileFilesAreRefusedByNameAndTheSceneGoesOn) {
+  const fs::path dir = TempDir("hostile");
+  Scene scene;
+  scene.AddGround(0.0);
+  scene.Step(5);
+  const std::vector<char> state = scene.Pack();
+  std::string garbage = "<mujoco>\n<worldbody>\n<body name=\"";
+  for (int i = 0; i < 3000; ++i) garbage += static_cast<char>(128 + (i * 37) % 128);
+  garbage += std::string("\0\xff\xfe<<>>", 8) + "\"/></worldbody></mujoco>\n";
+  std::string deep = "<mujoco><worldbody>";
+  for (int i = 0; i < 2000; ++i) deep += "<body><geom size=\".01\"/>";
+  for (int i = 0; i < 2000; ++i) deep += "</body>";
+  deep += "</worldbody></mujoco>\n";
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"garbage.xml", garbage},
+      {"deep.xml", deep},
+      {"huge.xml",
+       "<mujoco><worldbody><body pos=\"1e999 0 0\"><geom size=\".1\"/></body>"
+       "</worldbody></mujoco>\n"},
+      {"robot.xml", "<robot name=\"r\"><link name=\"a\"/></robot>\n"},
+      {"empty.xml", ""},
+  };
+  for (const auto& [name, text] : files) {
+    Write(dir / name, text);
+    try {
+      LoadMjcf(scene, (dir / name).string());
+      ADD_FAILURE() << name << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(scene.Pack() == state) << name;
+    EXPECT_TRUE(GetMjcfModels(scene).empty()) << name;
+  }
+  // MuJoCo's parser would import the URDF: partsim names it and its own loader instead
+  try {
+    LoadMjcf(scene, (dir / "robot.xml").string());
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("<robot>, not <mujoco> (a URDF"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(IsMjcfFile((dir / "robot.xml").string()));
+  EXPECT_FALSE(IsMjcfFile((dir / "empty.xml").string()));
+  EXPECT_TRUE(IsMjcfFile((dir / "garbage.xml").string()));  // a <mujoco> root, refused later
+  scene.Step(10);
+  fs::remove_all(dir);
+}
+
 TEST(MjcfTest, IsMjcfFileReadsTheRootElement) {
   const fs::path dir = TempDir("detect");
   Write(dir / "a.xml", "<?xml version=\"1.0\"?>\n<!-- a model -->\n<mujoco model=\"x\"/>\n");
