@@ -3647,7 +3647,7 @@ def write_ply(path: str, positions: numpy.ndarray, colors: typing.Optional[numpy
     ...
 
 def write_png(path: str, image: numpy.ndarray) -> None:
-    """8-bit PNG from uint8 (h, w) grey or (h, w, c) with c = 2, 3 or 4."""
+    """8-bit PNG from an image (h, w) grey or (h, w, c) with c = 2, 3 or 4: uint8 written as is; float16/32/64 in [0, 1], clipped to [0, 1], times 255 and rounded (NaN raises PartsimError, a ValueError); bool as 0 or 255. Other dtypes (uint16, int64, ...) raise TypeError: their range is the caller's to map to 0 to 255."""
     ...
 
 def write_segmentation_png(path: str, ids: numpy.ndarray) -> None:

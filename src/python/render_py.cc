@@ -328,12 +328,37 @@ void BindImageIo(py::module_& m) {
       "when the picture did not take Color or Segmentation.");
   m.def(
       "write_png",
-      [](const std::string& path, const CArray<uint8_t>& image) {
+      [](const std::string& path, const py::array& image) {
         std::array<int, 3> s = ImageShape(image, "write_png", true);
-        WritePng(path, s[1], s[0], s[2], image.data());
+        const char kind = image.dtype().kind();
+        if (kind == 'u' && image.itemsize() == 1) {
+          WritePng(path, s[1], s[0], s[2], CArray<uint8_t>::ensure(image).data());
+        } else if (kind == 'f') {
+          CArray<float> values = CArray<float>::ensure(image);
+          std::vector<uint8_t> bytes;
+          try {
+            bytes = UnitFloatsToUint8(values.data(), values.size());
+          } catch (const Error& e) {
+            throw Error(std::string("write_png: image ") + e.what());
+          }
+          WritePng(path, s[1], s[0], s[2], bytes.data());
+        } else if (kind == 'b') {
+          CArray<bool> mask = CArray<bool>::ensure(image);
+          std::vector<uint8_t> bytes(mask.data(), mask.data() + mask.size());
+          for (uint8_t& b : bytes) b = b ? 255 : 0;
+          WritePng(path, s[1], s[0], s[2], bytes.data());
+        } else {
+          throw py::type_error("write_png: image has dtype " +
+                               py::str(image.dtype()).cast<std::string>() +
+                               "; expected uint8 (0 to 255), a float type (0 to 1) or bool "
+                               "(a mask); convert it first, e.g. image.astype(numpy.uint8)");
+        }
       },
       py::arg("path"), py::arg("image"),
-      "8-bit PNG from uint8 (h, w) grey or (h, w, c) with c = 2, 3 or 4.");
+      "8-bit PNG from an image (h, w) grey or (h, w, c) with c = 2, 3 or 4: uint8 written as "
+      "is; float16/32/64 in [0, 1], clipped to [0, 1], times 255 and rounded (NaN raises "
+      "PartsimError, a ValueError); bool as 0 or 255. Other dtypes (uint16, int64, ...) raise "
+      "TypeError: their range is the caller's to map to 0 to 255.");
   m.def(
       "write_depth_png",
       [](const std::string& path, const CArray<float>& depth) {

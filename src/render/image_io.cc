@@ -253,6 +253,17 @@ std::vector<uint8_t> ToRgba8(const std::vector<float>& rgba) {
   return out;
 }
 
+std::vector<uint8_t> UnitFloatsToUint8(const float* values, size_t count) {
+  std::vector<uint8_t> out(count);
+  for (size_t i = 0; i < count; ++i) {
+    const float v = values[i];
+    if (std::isnan(v))
+      throw Error("value " + std::to_string(i) + " is NaN; expected values in [0, 1]");
+    out[i] = static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+  }
+  return out;
+}
+
 std::array<uint8_t, 3> SegmentationColor(uint32_t id) {
   if (id == 0) return {0, 0, 0};
   // hue from the golden-ratio sequence (neighbouring ids get far-apart hues); saturation and

@@ -232,6 +232,57 @@ def test_image_writers(tmp_path):
         partsim.write_depth_png(str(tmp_path / "d.png"), np.zeros((2, 2, 2), np.float32))
 
 
+def read_png_pixels(path):
+    from PIL import Image
+    with Image.open(path) as image:
+        return np.asarray(image)
+
+
+def test_write_png_of_floats_scales_zero_to_one_onto_0_to_255(tmp_path):
+    # float images in [0, 1], numpy's convention: 0.5 grey is 128 (0.5 * 255 = 127.5 rounds up),
+    # values outside [0, 1] are clipped, and float64, float32 and float16 agree
+    grey = np.full((2, 3), 0.5)
+    for dtype in (np.float64, np.float32, np.float16):
+        partsim.write_png(str(tmp_path / "grey.png"), grey.astype(dtype))
+        assert (read_png_pixels(tmp_path / "grey.png") == 128).all(), dtype
+    rgb = np.zeros((2, 2, 3), np.float32)
+    rgb[0, 0] = [1.0, 0.25, -0.5]
+    rgb[1, 1] = [2.0, 0.2, 1.0 / 255]
+    partsim.write_png(str(tmp_path / "rgb.png"), rgb)
+    pixels = read_png_pixels(tmp_path / "rgb.png")
+    assert pixels.dtype == np.uint8 and pixels.shape == (2, 2, 3)
+    assert pixels[0, 0].tolist() == [255, 64, 0]  # 63.75 rounds to 64; -0.5 clips to 0
+    assert pixels[1, 1].tolist() == [255, 51, 1]
+    assert pixels[0, 1].tolist() == [0, 0, 0]
+    # a non-contiguous float view is read with its strides
+    partsim.write_png(str(tmp_path / "view.png"), rgb[:, ::-1])
+    assert (read_png_pixels(tmp_path / "view.png") == pixels[:, ::-1]).all()
+    # uint8 is written as it is
+    levels = np.arange(12, dtype=np.uint8).reshape(3, 4) * 20
+    partsim.write_png(str(tmp_path / "levels.png"), levels)
+    assert (read_png_pixels(tmp_path / "levels.png") == levels).all()
+    # a bool mask is black and white
+    mask = np.array([[True, False], [False, True]])
+    partsim.write_png(str(tmp_path / "mask.png"), mask)
+    assert read_png_pixels(tmp_path / "mask.png").tolist() == [[255, 0], [0, 255]]
+
+
+def test_write_png_refuses_nan_and_dtypes_of_no_known_range(tmp_path):
+    image = np.full((2, 2, 3), 0.5, np.float32)
+    image[1, 0, 2] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        partsim.write_png(str(tmp_path / "nan.png"), image)
+    assert not (tmp_path / "nan.png").exists()
+    # uint16 (0 to 65535, or 0 to 4095 from a 12-bit sensor?), other integers and complex
+    # numbers have no one mapping onto 0 to 255: the caller converts them
+    for dtype in (np.uint16, np.int64, np.int8, np.uint32, np.complex64):
+        with pytest.raises(TypeError, match=np.dtype(dtype).name):
+            partsim.write_png(str(tmp_path / "x.png"), np.zeros((2, 2), dtype))
+    with pytest.raises(TypeError, match="object"):
+        partsim.write_png(str(tmp_path / "x.png"), np.zeros((2, 2), object))
+    assert not (tmp_path / "x.png").exists()
+
+
 def test_ply_and_npy_writers(tmp_path):
     positions = np.arange(12, dtype=np.float32).reshape(4, 3)
     colors = np.full((4, 4), 200, np.uint8)

@@ -5,10 +5,12 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "partsim/render/camera.h"
@@ -123,6 +125,23 @@ TEST_F(ImageIoTest, WritesLandWholeOrNotAtAll) {
   EXPECT_EQ(names, (std::vector<std::string>{"g.png", "taken.png"}));
   EXPECT_TRUE(fs::exists(dir_ / "taken.png" / "inside"));
   EXPECT_EQ(ReadPng(Path("g.png")).width, 3);
+}
+
+// Floats in [0, 1] to bytes: v * 255 rounded to the nearest (0.5 -> 127.5 -> 128), clipped
+// outside [0, 1] (infinities too); a NaN is named by its index.
+TEST(UnitFloatsToUint8Test, ScalesClipsAndRoundsAndNamesNaN) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<float> in = {0.0f,         0.5f,  1.0f, 0.25f, 1.0f / 255,
+                                 127.4f / 255, -3.0f, 7.0f, -inf,  inf};
+  EXPECT_EQ(UnitFloatsToUint8(in.data(), in.size()),
+            (std::vector<uint8_t>{0, 128, 255, 64, 1, 127, 0, 255, 0, 255}));
+  const std::vector<float> nan = {0.1f, 0.2f, std::nanf(""), 0.3f};
+  try {
+    UnitFloatsToUint8(nan.data(), nan.size());
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("value 2 is NaN"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(ImageIoTest, DepthPngIsSixteenBitMillimetres) {

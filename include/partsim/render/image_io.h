@@ -44,6 +44,11 @@ PointCloud MakePointCloud(const Camera& camera, PointCloudFrame frame = PointClo
 /// sRGB 8-bit encoding of linear RGBA floats (clamped to [0, 1]; alpha stays linear).
 std::vector<uint8_t> ToRgba8(const std::vector<float>& rgba);
 
+/// 8-bit values of floats in [0, 1] (an image in numpy's float convention): each clipped to
+/// [0, 1], times 255, rounded to the nearest; no transfer curve. Throws partsim::Error naming the
+/// index of the first NaN.
+std::vector<uint8_t> UnitFloatsToUint8(const float* values, size_t count);
+
 /// Colour of a segmentation id: black for 0 (background), else a fixed bright colour that
 /// depends only on the id (so images of several views and runs agree).
 std::array<uint8_t, 3> SegmentationColor(uint32_t id);
