@@ -40,6 +40,8 @@ import partsim  # noqa: E402
 import partsim.envs as envs  # noqa: E402
 
 EPISODE = 100  # max_episode_steps of the environments
+# every configuration steps the same cabinet: the first generated one with a drawer
+OBJECT = partsim.find_task_objects(partsim.TaskType.PULL_DRAWER, 1, 0)[0]
 
 
 class Bare:
@@ -50,7 +52,7 @@ class Bare:
     num_envs = 1
 
     def __init__(self):
-        self.env = envs.OpenCabinetEnv(max_episode_steps=EPISODE)
+        self.env = envs.OpenCabinetEnv(objects=OBJECT, max_episode_steps=EPISODE)
         self.env.reset(seed=0)
         self.task = self.env.task
         self.scale = np.array([envs.MAX_LINEAR_SPEED] * 3 + [envs.MAX_ANGULAR_SPEED] * 3 + [1.0])
@@ -75,7 +77,7 @@ class Physics:
     num_envs = 1
 
     def __init__(self):
-        self.env = envs.OpenCabinetEnv(max_episode_steps=EPISODE)
+        self.env = envs.OpenCabinetEnv(objects=OBJECT, max_episode_steps=EPISODE)
         self.env.reset(seed=0)
         self.scene = self.env.task.scene
         rate = self.env.task.options.control_rate
@@ -97,7 +99,7 @@ class Single:
         self.name = f"OpenCabinetEnv, {obs_mode}" + (" 128x96" if obs_mode == "visual" else "")
         self.num_envs = 1
         self.env = envs.OpenCabinetEnv(
-            obs_mode=obs_mode, max_episode_steps=EPISODE, camera_size=(128, 96)
+            obs_mode=obs_mode, objects=OBJECT, max_episode_steps=EPISODE, camera_size=(128, 96)
         )
         self.env.reset(seed=0)
 
@@ -114,7 +116,9 @@ class Vector:
     def __init__(self, n):
         self.name = f"VectorOpenCabinetEnv x{n}, mobility"
         self.num_envs = n
-        self.env = envs.VectorOpenCabinetEnv(n, obs_mode="mobility", max_episode_steps=EPISODE)
+        self.env = envs.VectorOpenCabinetEnv(
+            n, obs_mode="mobility", objects=OBJECT, max_episode_steps=EPISODE
+        )
         self.env.reset(seed=0)
 
     def step(self, a):
