@@ -23,7 +23,7 @@ if not os.path.isdir(os.path.join(os.path.dirname(partsim.__file__), "learn")):
     partsim.__path__.append(os.path.join(REPO, "python", "partsim"))
 
 import partsim.learn as learn  # noqa: E402
-from partsim.envs import Box, Dict  # noqa: E402
+from gymnasium.spaces import Box, Dict  # noqa: E402
 from partsim.learn import reach, replay, sac, trainer  # noqa: E402
 from partsim.learn.reach import ReachEnv, make_reach_vector_env  # noqa: E402
 from partsim.learn.replay import ReplayBuffer  # noqa: E402
