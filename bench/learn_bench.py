@@ -35,6 +35,7 @@ sys.path.insert(
 )
 
 import torch  # noqa: E402
+from gymnasium.spaces import Box, Dict  # noqa: E402
 
 import partsim  # noqa: E402
 import partsim.envs as envs  # noqa: E402
@@ -43,16 +44,15 @@ from partsim.learn import SAC, ReplayBuffer, TrainConfig, Trainer  # noqa: E402
 
 def spaces(obs):
     """The observation space of an environment with ``obs`` observations (no scene made)."""
-    state = envs.Box(-np.inf, np.inf, (envs.ROBOT_STATE_SIZE,), np.float32)
+    state = Box(-np.inf, np.inf, (envs.ROBOT_STATE_SIZE,), np.float32)
     if obs == "raw":
-        return envs.Box(-np.inf, np.inf, (2 * envs.RAW_MAX_DOF + envs.ROBOT_STATE_SIZE,),
-                        np.float32)
+        return Box(-np.inf, np.inf, (2 * envs.RAW_MAX_DOF + envs.ROBOT_STATE_SIZE,), np.float32)
     if obs == "mobility":
-        return envs.Box(-np.inf, np.inf, (11 + envs.ROBOT_STATE_SIZE,), np.float32)
+        return Box(-np.inf, np.inf, (11 + envs.ROBOT_STATE_SIZE,), np.float32)
     h, w = 96, 128
-    return envs.Dict({"rgb": envs.Box(0, 255, (h, w, 3), np.uint8),
-                      "depth": envs.Box(0.0, np.inf, (h, w), np.float32),
-                      "mask": envs.Box(0, 1, (h, w), np.uint8), "state": state})
+    return Dict({"rgb": Box(0, 255, (h, w, 3), np.uint8),
+                 "depth": Box(0.0, np.inf, (h, w), np.float32),
+                 "mask": Box(0, 1, (h, w), np.uint8), "state": state})
 
 
 def filled_buffer(space, n=2048, seed=0):
@@ -60,7 +60,7 @@ def filled_buffer(space, n=2048, seed=0):
     buffer = ReplayBuffer(n, space, 7, seed=seed)
 
     def sample(k):
-        if isinstance(space, envs.Dict):
+        if isinstance(space, Dict):
             return {"rgb": rng.integers(0, 255, (k, 96, 128, 3), dtype=np.uint8),
                     "depth": rng.uniform(0.5, 3, (k, 96, 128)).astype(np.float32),
                     "mask": rng.integers(0, 2, (k, 96, 128), dtype=np.uint8),

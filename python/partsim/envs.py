@@ -1,168 +1,44 @@
-"""Gymnasium-style environments of partsim's drawer-pulling and door-opening tasks.
+"""Gymnasium environments of partsim's drawer-pulling and door-opening tasks.
 
-The classes follow the Gymnasium API (``reset(seed=..., options=...)`` returns ``(obs, info)``;
-``step(action)`` returns ``(obs, reward, terminated, truncated, info)``; ``observation_space``,
-``action_space``, ``render()``, ``close()``) without importing the gymnasium package, which is
-not installable everywhere: the spaces here (``Box``, ``Dict``) have the same attributes and
-methods as Gymnasium's. A gymnasium user can wrap an instance with ``gymnasium.Env`` conventions
-directly.
+:class:`OpenCabinetEnv` is a ``gymnasium.Env`` and :class:`VectorOpenCabinetEnv` a
+``gymnasium.vector.VectorEnv``; their spaces are ``gymnasium.spaces.Box`` and ``Dict``.
+``import partsim`` registers them with Gymnasium as ``partsim/OpenCabinetDrawer-v0``
+(``task="drawer"``) and ``partsim/OpenCabinetDoor-v0`` (``task="door"``), 250 steps per
+episode; keyword arguments of ``gymnasium.make`` and ``gymnasium.make_vec`` go to the
+constructors.
 
 Example::
 
-    import partsim.envs as envs
-    env = envs.OpenCabinetEnv(task="drawer", obs_mode="mobility")
+    import gymnasium as gym
+    import partsim  # registers the ids
+
+    env = gym.make("partsim/OpenCabinetDrawer-v0", obs_mode="mobility")
     obs, info = env.reset(seed=0)
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+
+    vec = gym.make_vec("partsim/OpenCabinetDoor-v0", num_envs=4,
+                       vectorization_mode="vector_entry_point")
+    obs, infos = vec.reset(seed=0)
 """
 
 from __future__ import annotations
 
 import concurrent.futures
+import functools
 import numbers
 import os
 import warnings
 from typing import Any
 
+import gymnasium
 import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
 
 from . import _partsim as _ps
 
-__all__ = ["Box", "Dict", "OpenCabinetEnv", "VectorOpenCabinetEnv"]
-
-
-class Box:
-    """A box in R^n: ``low <= x <= high`` elementwise, with a shape and dtype (Gymnasium's
-    ``spaces.Box``)."""
-
-    def __init__(self, low, high, shape=None, dtype=np.float32, seed=None):
-        self.dtype = np.dtype(dtype)
-        if shape is None:
-            shape = np.shape(low) if np.ndim(low) else np.shape(high)
-        self.shape = tuple(int(s) for s in shape)
-        self.low = np.broadcast_to(np.asarray(low, dtype=self.dtype), self.shape).copy()
-        self.high = np.broadcast_to(np.asarray(high, dtype=self.dtype), self.shape).copy()
-        if np.any(self.low > self.high):
-            raise ValueError("Box: low exceeds high")
-        self._rng = np.random.default_rng(seed)
-
-    def seed(self, seed=None):
-        """Reseeds the generator that ``sample`` draws from (None: fresh entropy); returns
-        ``[seed]``."""
-        self._rng = np.random.default_rng(seed)
-        return [seed]
-
-    @property
-    def np_random(self):
-        """The ``numpy.random.Generator`` that ``sample`` draws from."""
-        return self._rng
-
-    def sample(self, mask=None):
-        """A uniform sample (bounded dimensions), normal (unbounded), exponential (half-bounded),
-        as Gymnasium does."""
-        if np.issubdtype(self.dtype, np.integer):
-            return self._rng.integers(self.low, self.high, endpoint=True).astype(self.dtype)
-        low, high = self.low.astype(np.float64), self.high.astype(np.float64)
-        out = np.empty(self.shape)
-        bounded = np.isfinite(low) & np.isfinite(high)
-        lower_only = np.isfinite(low) & ~np.isfinite(high)
-        upper_only = ~np.isfinite(low) & np.isfinite(high)
-        free = ~np.isfinite(low) & ~np.isfinite(high)
-        out[bounded] = self._rng.uniform(low[bounded], high[bounded])
-        out[lower_only] = low[lower_only] + self._rng.exponential(size=lower_only.sum())
-        out[upper_only] = high[upper_only] - self._rng.exponential(size=upper_only.sum())
-        out[free] = self._rng.normal(size=free.sum())
-        return out.astype(self.dtype)
-
-    def contains(self, x) -> bool:
-        """True when ``x`` (an array or anything ``numpy.asarray`` takes) has this shape, a
-        dtype that casts safely to this dtype, and every entry within ``[low, high]``."""
-        if not isinstance(x, np.ndarray):
-            try:
-                x = np.asarray(x, dtype=self.dtype)
-            except (ValueError, TypeError, OverflowError):
-                return False
-        return bool(
-            np.can_cast(x.dtype, self.dtype)
-            and x.shape == self.shape
-            and np.all(x >= self.low)
-            and np.all(x <= self.high)
-        )
-
-    def __contains__(self, x) -> bool:
-        return self.contains(x)
-
-    def __repr__(self):
-        return f"Box({self.low.min()}, {self.high.max()}, {self.shape}, {self.dtype})"
-
-    def __eq__(self, other):
-        return (
-            isinstance(other, Box)
-            and self.shape == other.shape
-            and self.dtype == other.dtype
-            and np.array_equal(self.low, other.low)
-            and np.array_equal(self.high, other.high)
-        )
-
-
-class Dict:
-    """A dictionary of spaces (Gymnasium's ``spaces.Dict``)."""
-
-    def __init__(self, spaces: dict, seed=None):
-        self.spaces = dict(spaces)
-        self.shape = None
-        self.dtype = None
-        self.seed(seed)
-
-    def seed(self, seed=None):
-        """Reseeds every sub-space from one ``numpy.random.SeedSequence(seed)`` (a child seed
-        each); returns ``[seed]``."""
-        ss = np.random.SeedSequence(seed)
-        for space, child in zip(self.spaces.values(), ss.spawn(len(self.spaces))):
-            space.seed(int(child.generate_state(1)[0]))
-        return [seed]
-
-    def sample(self, mask=None):
-        """A dict with one sample of each sub-space (``mask`` is accepted and ignored)."""
-        return {k: s.sample() for k, s in self.spaces.items()}
-
-    def contains(self, x) -> bool:
-        """True when ``x`` is a dict with exactly these keys and each value lies in its
-        sub-space."""
-        return (
-            isinstance(x, dict)
-            and x.keys() == self.spaces.keys()
-            and all(s.contains(x[k]) for k, s in self.spaces.items())
-        )
-
-    def __contains__(self, x) -> bool:
-        return self.contains(x)
-
-    def __getitem__(self, key):
-        return self.spaces[key]
-
-    def __iter__(self):
-        return iter(self.spaces)
-
-    def __len__(self):
-        return len(self.spaces)
-
-    def keys(self):
-        """The sub-spaces' names."""
-        return self.spaces.keys()
-
-    def values(self):
-        """The sub-spaces (``Box`` or ``Dict``)."""
-        return self.spaces.values()
-
-    def items(self):
-        """(name, sub-space) pairs."""
-        return self.spaces.items()
-
-    def __eq__(self, other):
-        return isinstance(other, Dict) and self.spaces == other.spaces
-
-    def __repr__(self):
-        return "Dict(" + ", ".join(f"{k!r}: {s}" for k, s in self.spaces.items()) + ")"
+__all__ = ["OpenCabinetEnv", "VectorOpenCabinetEnv"]
 
 
 # Scale of the normalised action: a unit action is this TCP speed.
@@ -176,25 +52,18 @@ _ACTION_SCALE = np.array([MAX_LINEAR_SPEED] * 3 + [MAX_ANGULAR_SPEED] * 3 + [1.0
 OBS_MODES = ("raw", "mobility", "visual")
 
 
-class _ClosedByContext:
-    """``with env:`` closes the environment at the end of the block."""
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
-
-
-class OpenCabinetEnv(_ClosedByContext):
+class OpenCabinetEnv(gymnasium.Env):
     """Drawer pulling (``task="drawer"``) or door opening (``task="door"``) on generated cabinets
-    or PartNet-Mobility folders with the flying gripper.
+    or PartNet-Mobility folders with the flying gripper, as a ``gymnasium.Env``.
 
-    ``objects``: generated StorageFurniture indices (ints) and/or PartNet-Mobility folders (str or
-    path-like; real or generated objects whose semantics.txt labels a ``drawer`` or a
-    ``rotation_door`` with a handle), one or a list; None takes the first generated object with a
-    target.
+    ``objects``: generated StorageFurniture indices (ints, of the generator's ``dataset_seed``)
+    and/or PartNet-Mobility folders (str or path-like; real or generated objects whose
+    semantics.txt labels a ``drawer`` or a ``rotation_door`` with a handle), one or a list; an
+    object without a target for the task raises ``ValueError`` naming it. None: the first
+    ``pool_size`` generated objects with a target. Each episode's object is drawn from
+    ``objects`` by the environment's generator (``np_random``, which ``reset(seed=...)``
+    reseeds), so different seeds give different cabinets and the same seed the same one; each
+    object's task is built at its first episode and kept.
 
     Action: 7 values in [-1, 1]: the gripper's TCP twist in the world frame, scaled by 0.5 m/s
     (linear) and 1.5 rad/s (angular), then the gripper command (-1 close, 1 open). Actions outside
@@ -214,6 +83,12 @@ class OpenCabinetEnv(_ClosedByContext):
     step once 90% is reached, -0.1 when a held grasp is lost, and -0.5 x the TCP's distance to
     the handle until the target is first touched. ``terminated`` on success (90% of the range) or
     failure (the part pushed the wrong way); ``truncated`` after ``max_episode_steps``.
+
+    Made by ``gymnasium.make`` (which sets ``spec``), the environment leaves truncation to the
+    ``TimeLimit`` wrapper that make adds (the registered 250 steps, or make's
+    ``max_episode_steps``; -1 for none), so that the two limits never disagree; made directly,
+    it truncates after its own ``max_episode_steps``. ``with env:`` closes it at the end of
+    the block.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 25}
@@ -230,6 +105,7 @@ class OpenCabinetEnv(_ClosedByContext):
         render_mode: str | None = None,
         camera_size=(128, 96),
         render_backend: str = "rasterizer",
+        pool_size: int = 16,
     ):
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode must be one of {OBS_MODES}, got {obs_mode!r}")
@@ -237,12 +113,14 @@ class OpenCabinetEnv(_ClosedByContext):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         if max_episode_steps < 1:
             raise ValueError("max_episode_steps must be at least 1")
+        if pool_size < 1:
+            raise ValueError("pool_size must be at least 1")
         self.task_type = _ps.parse_task_type(task)
         self.obs_mode = obs_mode
         self.render_mode = render_mode
         self.max_episode_steps = int(max_episode_steps)
         if objects is None:
-            objects = _ps.find_task_objects(self.task_type, 1, dataset_seed)
+            objects = _ps.find_task_objects(self.task_type, int(pool_size), dataset_seed)
         elif isinstance(objects, (numbers.Integral, str, os.PathLike)):
             objects = [objects]
         self.objects = [
@@ -252,13 +130,15 @@ class OpenCabinetEnv(_ClosedByContext):
             raise ValueError(
                 "objects must name at least one StorageFurniture index or PartNet-Mobility folder"
             )
+        for obj in self.objects:
+            if isinstance(obj, str) and not os.path.isfile(os.path.join(obj, "mobility.urdf")):
+                raise ValueError(f"objects: {obj!r} is not a PartNet-Mobility folder")
+        _check_targets(self.objects, task, self.task_type, dataset_seed)
         self._options = []
         for obj in self.objects:
             o = _ps.TaskOptions()
             o.type = self.task_type
             if isinstance(obj, str):
-                if not os.path.isfile(os.path.join(obj, "mobility.urdf")):
-                    raise ValueError(f"objects: {obj!r} is not a PartNet-Mobility folder")
                 o.object_folder = obj
             else:
                 o.object_index = obj
@@ -274,24 +154,26 @@ class OpenCabinetEnv(_ClosedByContext):
         self._tasks: dict[tuple[int, int], Any] = {}
         self._task = None
         self._steps = 0
-        self._np_random = np.random.default_rng()
+        self._truncate_at = self.max_episode_steps
         self._closed = False
 
-        self.action_space = Box(-1.0, 1.0, (7,), np.float32)
-        state = Box(-np.inf, np.inf, (ROBOT_STATE_SIZE,), np.float32)
+        self.action_space = spaces.Box(-1.0, 1.0, (7,), np.float32)
+        state = spaces.Box(-np.inf, np.inf, (ROBOT_STATE_SIZE,), np.float32)
         if obs_mode == "raw":
-            self.observation_space = Box(
+            self.observation_space = spaces.Box(
                 -np.inf, np.inf, (2 * RAW_MAX_DOF + ROBOT_STATE_SIZE,), np.float32
             )
         elif obs_mode == "mobility":
-            self.observation_space = Box(-np.inf, np.inf, (11 + ROBOT_STATE_SIZE,), np.float32)
+            self.observation_space = spaces.Box(
+                -np.inf, np.inf, (11 + ROBOT_STATE_SIZE,), np.float32
+            )
         else:
             w, h = int(camera_size[0]), int(camera_size[1])
-            self.observation_space = Dict(
+            self.observation_space = spaces.Dict(
                 {
-                    "rgb": Box(0, 255, (h, w, 3), np.uint8),
-                    "depth": Box(0.0, np.inf, (h, w), np.float32),
-                    "mask": Box(0, 1, (h, w), np.uint8),
+                    "rgb": spaces.Box(0, 255, (h, w, 3), np.uint8),
+                    "depth": spaces.Box(0.0, np.inf, (h, w), np.float32),
+                    "mask": spaces.Box(0, 1, (h, w), np.uint8),
                     "state": state,
                 }
             )
@@ -299,29 +181,20 @@ class OpenCabinetEnv(_ClosedByContext):
     # --- Gymnasium API ---------------------------------------------------------------------
 
     @property
-    def np_random(self) -> np.random.Generator:
-        """The environment's ``numpy.random.Generator``: it draws each episode's object, target
-        and task seed; ``reset(seed=...)`` reseeds it."""
-        return self._np_random
-
-    @property
-    def unwrapped(self):
-        """The environment itself (Gymnasium's ``Env.unwrapped``; there are no wrappers)."""
-        return self
-
-    @property
     def task(self):
         """The current ``ArticulationTask`` (after reset)."""
         return self._task
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        """Starts an episode. ``seed`` reseeds the environment's generator (same seed, same
-        episode); ``options`` may hold ``object`` (an index into ``objects``) and ``target`` (a
-        drawer or door of that object). Options apply to this episode only: a later reset
-        without them draws the object and the target from the generator again."""
+        """Starts an episode. ``seed`` reseeds the environment's generator ``np_random``
+        (Gymnasium's ``Env.reset``; same seed, same episode) and the action and observation
+        spaces; without it the generator goes on. The generator draws the episode's object, its
+        target and the task's seed. ``options`` may hold ``object`` (an index into ``objects``)
+        and ``target`` (a drawer or door of that object). Options apply to this episode only: a
+        later reset without them draws the object and the target from the generator again."""
         self._check_open()
+        super().reset(seed=seed)
         if seed is not None:
-            self._np_random = np.random.default_rng(seed)
             self.action_space.seed(seed)
             self.observation_space.seed(seed)
         options = dict(options or {})
@@ -330,7 +203,7 @@ class OpenCabinetEnv(_ClosedByContext):
             raise ValueError(f"reset: unknown options {sorted(unknown)} (known: object, target)")
         k = options.get("object")
         if k is None:
-            k = int(self._np_random.integers(len(self.objects)))
+            k = int(self.np_random.integers(len(self.objects)))
         if not isinstance(k, numbers.Integral) or not 0 <= k < len(self.objects):
             raise ValueError(f"reset: options['object'] = {k} is not in [0, {len(self.objects)})")
         k = int(k)
@@ -346,17 +219,20 @@ class OpenCabinetEnv(_ClosedByContext):
             finally:
                 opts.target = -1
         self._task = self._tasks[key]
-        self._task.reset(int(self._np_random.integers(0, 2**62)))
+        self._task.reset(int(self.np_random.integers(0, 2**62)))
         lo, hi = np.asarray(self._task.target_joint.get_limits(), dtype=float).reshape(-1)[:2]
         self._target_range = float(hi - lo)
         self._steps = 0
+        # gymnasium.make sets spec and adds a TimeLimit wrapper, which then truncates alone
+        self._truncate_at = self.max_episode_steps if self.spec is None else None
         return self._observation(), self._info()
 
     def step(self, action):
         """Applies a (7,) action for one control period (1 / control_rate s) and returns
         ``(obs, reward, terminated, truncated, info)``: the observation of ``obs_mode``, the
         dense reward (float), ``terminated`` on success or failure, ``truncated`` after
-        ``max_episode_steps`` steps, and ``info`` with ``success``, ``progress`` (fraction of the
+        ``max_episode_steps`` steps (see the class's note on ``gymnasium.make``), and ``info``
+        with ``success``, ``progress`` (fraction of the
         range opened), ``opened`` (how far the target is open: rad for a door, m for a drawer),
         ``object`` (index or folder name), ``target`` (link name), ``touching``
         and ``elapsed`` (simulated s). Raises ``RuntimeError`` before ``reset`` or after
@@ -379,7 +255,9 @@ class OpenCabinetEnv(_ClosedByContext):
         self._steps += 1
         reward = float(self._task.get_reward())
         terminated = bool(self._task.is_success() or self._task.is_failure())
-        truncated = bool(not terminated and self._steps >= self.max_episode_steps)
+        truncated = bool(
+            not terminated and self._truncate_at is not None and self._steps >= self._truncate_at
+        )
         return self._observation(), reward, terminated, truncated, self._info()
 
     def render(self):
@@ -461,16 +339,40 @@ class OpenCabinetEnv(_ClosedByContext):
         }
 
 
-def _batch_space(space, n):
-    """The space of ``n`` stacked samples of ``space`` (Gymnasium's ``batch_space``)."""
-    if isinstance(space, Dict):
-        return Dict({k: _batch_space(s, n) for k, s in space.items()})
-    return Box(
-        np.broadcast_to(space.low, (n,) + space.shape),
-        np.broadcast_to(space.high, (n,) + space.shape),
-        (n,) + space.shape,
-        space.dtype,
-    )
+def _check_targets(objects, task: str, task_type, dataset_seed: int):
+    """Raises ValueError naming the first of ``objects`` (generated indices, or folders that
+    hold a mobility.urdf) that has no target for the task: no link labelled
+    ``task_target_label`` with a handle (and, for a folder, a joint range)."""
+    label = _ps.task_target_label(task_type)
+    indices = [o for o in objects if not isinstance(o, str)]
+    if indices:
+        if min(indices) < 0:
+            raise ValueError(f"objects: {min(indices)} is not a StorageFurniture index (< 0)")
+        with_target = _indices_with_target(task_type, dataset_seed, max(indices))
+    for obj in objects:
+        if isinstance(obj, str):
+            if _ps.find_task_targets(_ps.PartNetMobilityLoader().parse(obj), task_type):
+                continue
+            what = f"the PartNet-Mobility folder {obj!r}"
+            why = f"no link labelled '{label}' in semantics.txt with a handle and a joint range"
+        else:
+            if obj in with_target:
+                continue
+            what = f"StorageFurniture object {obj} (dataset_seed {dataset_seed})"
+            why = (
+                f"no link labelled '{label}' with a handle; partsim.find_task_objects lists "
+                f"the objects that have one"
+            )
+        raise ValueError(f"objects: {what} has no target for task {task!r} ({why})")
+
+
+@functools.lru_cache(maxsize=64)
+def _indices_with_target(task_type, dataset_seed: int, last: int) -> frozenset:
+    """The generated StorageFurniture indices up to ``last`` whose object has a target for the
+    task. find_task_objects lists such indices in increasing order, and at most last + 1 of
+    them are <= last, so its first last + 1 reach past ``last``."""
+    found = _ps.find_task_objects(task_type, last + 1, dataset_seed)
+    return frozenset(i for i in found if i <= last)
 
 
 def _stack(items):
@@ -503,6 +405,19 @@ def _vector_seeds(seed, num_envs: int) -> list:
     return seeds
 
 
+def _autoreset_mode(mode) -> AutoresetMode:
+    """An AutoresetMode from itself, its value ("NextStep", "SameStep", "Disabled") or its
+    name in any case ("next_step", "SAME_STEP", ...)."""
+    if isinstance(mode, AutoresetMode):
+        return mode
+    if isinstance(mode, str):
+        for m in AutoresetMode:
+            if mode in (m.value, m.name) or mode.upper() == m.name:
+                return m
+    names = ", ".join(f"AutoresetMode.{m.name} ({m.value!r})" for m in AutoresetMode)
+    raise ValueError(f"autoreset_mode must be one of {names}, got {mode!r}")
+
+
 def _task_action(a):
     """The task's action for actions in [-1, 1] (clipped), one per row: TCP twist in m/s and
     rad/s, gripper command."""
@@ -520,49 +435,76 @@ def _warn_no_render_mode(cls_name):
     )
 
 
-class VectorOpenCabinetEnv(_ClosedByContext):
+class VectorOpenCabinetEnv(gymnasium.vector.VectorEnv):
     """``num_envs`` copies of :class:`OpenCabinetEnv` stepped together on ``workers`` threads
     (default: one per copy; the simulation releases the GIL, so the copies run in parallel on
-    several cores). Copy i always runs on thread ``i % workers``: the rasterizer's OpenGL context
+    several cores), as a ``gymnasium.vector.VectorEnv``. The other keyword arguments go to
+    every copy. Copy i always runs on thread ``i % workers``: the rasterizer's OpenGL context
     stays current on the thread that last rendered with it, so a scene cannot move between
     threads. Copies without cameras (state observations, no render mode) have no such context:
     ``step`` advances their physics in one ``step_tasks`` call, a thread per copy without the
     GIL, which saves a hand-off to a worker per copy and step; their resets still run on the
     workers.
 
-    Follows Gymnasium's vector API: ``reset`` returns batched observations and an info dict of
-    arrays; ``step(actions)`` with actions of shape (num_envs, 7) returns batched
-    ``(obs, rewards, terminations, truncations, infos)``. Autoreset is Gymnasium 1.x's
-    "next-step" mode: after a sub-environment's episode ends, its next ``step`` ignores the
-    action and returns the first observation of a new episode (reward 0, not terminated).
+    ``reset`` returns batched observations and an info dict of arrays; ``step(actions)`` with
+    actions of shape (num_envs, 7) returns batched ``(obs, rewards, terminations, truncations,
+    infos)``. ``autoreset_mode`` (a ``gymnasium.vector.AutoresetMode`` or its value or name as a
+    string; also in ``metadata["autoreset_mode"]``) says what happens after a copy's episode
+    ends, as Gymnasium 1.x documents:
+
+    * ``NEXT_STEP`` (default): the copy's next ``step`` ignores its action and returns the
+      first observation of a new episode (reward 0, not terminated, not truncated).
+    * ``SAME_STEP``: the step that ends the episode resets the copy at once and returns the new
+      episode's first observation and info; the last observation and info of the ended episode
+      are in ``infos["final_obs"]`` (an object array, None for the other copies) and
+      ``infos["final_info"]`` (a dict of arrays), with the masks ``infos["_final_obs"]`` and
+      ``infos["_final_info"]``.
+    * ``DISABLED``: nothing resets by itself; ``reset(options={"reset_mask": mask})`` resets the
+      copies where the bool mask (num_envs,) is True, and ``step`` raises ``RuntimeError`` while
+      a copy whose episode ended has not been reset.
     """
 
-    metadata = OpenCabinetEnv.metadata
-
-    def __init__(self, num_envs: int, workers: int | None = None, **kwargs):
+    def __init__(
+        self,
+        num_envs: int,
+        workers: int | None = None,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        **kwargs,
+    ):
         if num_envs < 1:
             raise ValueError("num_envs must be at least 1")
+        self.autoreset_mode = _autoreset_mode(autoreset_mode)
+        self.metadata = {**OpenCabinetEnv.metadata, "autoreset_mode": self.autoreset_mode}
         self.num_envs = int(num_envs)
+        workers = min(int(workers or self.num_envs), self.num_envs)
+        if workers < 1:
+            raise ValueError("workers must be at least 1")
         self.envs = [OpenCabinetEnv(**kwargs) for _ in range(self.num_envs)]
         self.single_action_space = self.envs[0].action_space
         self.single_observation_space = self.envs[0].observation_space
         self.render_mode = self.envs[0].render_mode
-        self.action_space = _batch_space(self.single_action_space, self.num_envs)
-        self.observation_space = _batch_space(self.single_observation_space, self.num_envs)
-        workers = min(int(workers or self.num_envs), self.num_envs)
-        if workers < 1:
-            raise ValueError("workers must be at least 1")
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self._threads = [
             concurrent.futures.ThreadPoolExecutor(max_workers=1, thread_name_prefix="partsim-env")
             for _ in range(workers)
         ]
-        self._needs_reset = np.zeros(self.num_envs, dtype=bool)
+        # copies whose episode ended and that have not been reset since
+        self._ended = np.zeros(self.num_envs, dtype=bool)
+        # each copy's last observation, for the batch of a partial reset
+        self._env_obs = [None] * self.num_envs
         # cameras (visual observations, rgb_array rendering) tie each copy to its thread
         self._gl = any(e._options[0].cameras for e in self.envs)
-        self._closed = False
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
 
     def _check_open(self):
-        if self._closed:
+        if self.closed:
             raise RuntimeError("the vector environment is closed")
 
     def _map(self, fn):
@@ -576,31 +518,81 @@ class VectorOpenCabinetEnv(_ClosedByContext):
         return [f.result() for f in futures]
 
     def reset(self, *, seed=None, options=None):
-        """Resets every sub-environment: ``seed`` None, an int (sub-environment i gets
-        ``seed + i``) or a sequence of ``num_envs`` seeds (None entries allowed)."""
+        """Resets every sub-environment, or with ``options["reset_mask"]`` (a bool numpy array
+        of shape (num_envs,) with at least one True) those where the mask is True. ``seed``:
+        None, an int (sub-environment i gets ``seed + i``) or a sequence of ``num_envs`` seeds
+        (None entries allowed; the entries of the copies not reset are ignored). The other
+        options go to every copy's reset. Returns the batched observations (a copy not reset
+        keeps its last one) and the infos of the copies reset (the ``_key`` masks say which)."""
         self._check_open()
         seeds = _vector_seeds(seed, self.num_envs)
-        results = self._map(lambda i: self.envs[i].reset(seed=seeds[i], options=options))
-        self._needs_reset[:] = False
-        return _stack([r[0] for r in results]), self._infos([r[1] for r in results])
+        options = dict(options or {})
+        mask = options.pop("reset_mask", None)
+        if mask is None:
+            indices = np.arange(self.num_envs)
+        else:
+            if not isinstance(mask, np.ndarray) or mask.dtype != np.bool_:
+                raise TypeError(
+                    f"reset: options['reset_mask'] must be a numpy array of bool, got {mask!r}"
+                )
+            if mask.shape != (self.num_envs,):
+                raise ValueError(
+                    f"reset: options['reset_mask'] must have shape ({self.num_envs},), got "
+                    f"{mask.shape}"
+                )
+            if not mask.any():
+                raise ValueError("reset: options['reset_mask'] resets no sub-environment")
+            indices = np.flatnonzero(mask)
+            never = [i for i in range(self.num_envs) if self._env_obs[i] is None and not mask[i]]
+            if never:
+                raise RuntimeError(
+                    f"reset: sub-environments {never} were never reset; reset all of them first "
+                    f"(reset without reset_mask)"
+                )
+        results = self._map_some(
+            lambda i: self.envs[i].reset(seed=seeds[i], options=options or None), indices
+        )
+        for i, r in zip(indices, results):
+            self._env_obs[i] = r[0]
+        self._ended[indices] = False
+        if mask is None:
+            infos = _stack_infos([r[1] for r in results])
+        else:
+            infos = {}
+            for i, r in zip(indices, results):
+                infos = self._add_info(infos, r[1], int(i))
+        return _stack(self._env_obs), infos
 
     def step(self, actions):
         """Steps every sub-environment with its row of ``actions`` (num_envs, 7) and returns
         batched ``(obs, rewards, terminations, truncations, infos)``: observations stacked
         along a first axis of num_envs, rewards float64 (num_envs,), terminations and
         truncations bool (num_envs,), infos a dict of arrays (each key ``k`` with a bool mask
-        ``_k``). A sub-environment whose episode ended is reset instead (next-step autoreset).
-        Raises ``ValueError`` for a wrong shape or non-finite actions."""
+        ``_k``). Episodes that end are reset as ``autoreset_mode`` says (see the class).
+        Raises ``ValueError`` for a wrong shape or non-finite actions, ``RuntimeError``
+        before ``reset``, after ``close`` or (``DISABLED``) while an ended episode is not
+        reset."""
         self._check_open()
         actions = np.asarray(actions, dtype=np.float64)
         if actions.shape != (self.num_envs, 7):
             raise ValueError(f"actions must have shape ({self.num_envs}, 7), got {actions.shape}")
         if not np.all(np.isfinite(actions)):
             raise ValueError("actions hold NaN or infinite values")
+        # which copies start a new episode instead of stepping (next-step autoreset)
+        if self.autoreset_mode is AutoresetMode.NEXT_STEP:
+            restart = self._ended
+        else:
+            if self._ended.any():
+                raise RuntimeError(
+                    f"step: the episodes of sub-environments {np.flatnonzero(self._ended).tolist()}"
+                    f" ended and autoreset_mode is DISABLED: reset them first with "
+                    f"reset(options={{'reset_mask': mask}})"
+                )
+            restart = np.zeros(self.num_envs, dtype=bool)
 
         def one(i):
             env = self.envs[i]
-            if self._needs_reset[i]:
+            if restart[i]:
                 obs, info = env.reset()
                 return obs, 0.0, False, False, info
             return env.step(actions[i])
@@ -611,11 +603,11 @@ class VectorOpenCabinetEnv(_ClosedByContext):
             # no OpenGL context to keep on its thread: the resets on the workers, then every
             # other copy's physics in one call that steps them on a thread each
             results = [None] * self.num_envs
-            resets = np.flatnonzero(self._needs_reset)
+            resets = np.flatnonzero(restart)
             if len(resets):
                 for i, r in zip(resets, self._map_some(one, resets)):
                     results[i] = r
-            rest = np.flatnonzero(~self._needs_reset)
+            rest = np.flatnonzero(~restart)
             if len(rest):
                 envs = [self.envs[i] for i in rest]
                 if any(e._task is None for e in envs):
@@ -625,13 +617,29 @@ class VectorOpenCabinetEnv(_ClosedByContext):
                     results[i] = e._after_step()
         terminated = np.array([r[2] for r in results], dtype=bool)
         truncated = np.array([r[3] for r in results], dtype=bool)
-        self._needs_reset = terminated | truncated
+        self._ended = terminated | truncated
+        obs = [r[0] for r in results]
+        infos = [r[4] for r in results]
+        final = None
+        if self.autoreset_mode is AutoresetMode.SAME_STEP and self._ended.any():
+            # the ended episodes' last observation and info go to final_obs / final_info; the
+            # copies start their next episode in this step
+            final = np.flatnonzero(self._ended)
+            last = [(obs[i], infos[i]) for i in final]
+            for i, (o, info) in zip(final, self._map_some(lambda i: self.envs[i].reset(), final)):
+                obs[i], infos[i] = o, info
+            self._ended[:] = False
+        self._env_obs = obs
+        infos = _stack_infos(infos)
+        if final is not None:
+            for i, (o, info) in zip(final, last):
+                infos = self._add_info(infos, {"final_obs": o, "final_info": info}, int(i))
         return (
-            _stack([r[0] for r in results]),
+            _stack(obs),
             np.array([r[1] for r in results], dtype=np.float64),
             terminated,
             truncated,
-            self._infos([r[4] for r in results]),
+            infos,
         )
 
     def render(self):
@@ -646,16 +654,9 @@ class VectorOpenCabinetEnv(_ClosedByContext):
             return None
         return tuple(self._map(lambda i: self.envs[i].render()))
 
-    def close(self):
-        """Closes every sub-environment on its own thread and stops the threads; closing twice
-        does nothing."""
-        if self._closed:
-            return
+    def close_extras(self, **kwargs):
+        """Closes every sub-environment on its own thread and stops the threads (``close``,
+        Gymnasium's, calls it once; closing twice does nothing)."""
         self._map(lambda i: self.envs[i].close())  # frees the GL objects on their thread
         for t in self._threads:
             t.shutdown(wait=True)
-        self._closed = True
-
-    @staticmethod
-    def _infos(items):
-        return _stack_infos(items)

@@ -1,28 +1,44 @@
-"""Conformance of partsim.envs with the Gymnasium API rules (written from Gymnasium's
-documentation, without the gymnasium package): reset/step signatures and return types,
-observations inside observation_space, seeding and determinism, termination and truncation,
-render and close, the Box and Dict spaces, bad actions, clipping, and the vector environment
-(batched spaces, next-step autoreset, the same results as the single environments).
+"""Behaviour of partsim.envs: reset/step signatures and return types, observations inside
+observation_space (Gymnasium's spaces), seeding and determinism, termination and truncation,
+render and close, bad actions, clipping, the objects (targets checked when the environment is
+made, the pool that objects=None draws from), and the vector environment (batched spaces, the
+three autoreset modes, partial resets, the same results as the single environments).
+Gymnasium's own checks, registration, make and wrappers: test_gymnasium.py.
 
 Environments are slow to build (the cabinet is generated and compiled), so a few module-scoped
-ones are shared; every test starts by resetting the environment it uses with a seed.
+ones are shared; every test starts by resetting the environment it uses with a seed. Unless a
+test says otherwise, an environment has one cabinet: the first generated one with a target.
 """
 
 import inspect
 
 import numpy as np
 import pytest
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
 
+import partsim
 import partsim.envs as envs
 
 SMALL = (32, 24)  # camera width, height
 SEED = 7
 
 
+def first_object(task="drawer"):
+    """The first generated StorageFurniture index with a target for the task."""
+    return partsim.find_task_objects(partsim.parse_task_type(task), 1, 0)[0]
+
+
 def make(**kwargs):
     kw = dict(task="drawer", obs_mode="mobility", max_episode_steps=4, camera_size=SMALL)
     kw.update(kwargs)
+    kw.setdefault("objects", first_object(kw["task"]))
     return envs.OpenCabinetEnv(**kw)
+
+
+def make_vec(num_envs, **kwargs):
+    kwargs.setdefault("objects", first_object(kwargs.get("task", "drawer")))
+    return envs.VectorOpenCabinetEnv(num_envs, **kwargs)
 
 
 def flat(obs):
@@ -98,7 +114,7 @@ def test_class_attributes_and_spaces():
 
 def test_spaces_of_the_modes(mode_env):
     e = mode_env
-    assert e.action_space == envs.Box(-1.0, 1.0, (7,), np.float32)
+    assert e.action_space == spaces.Box(-1.0, 1.0, (7,), np.float32)
     if e.obs_mode == "raw":
         assert e.observation_space.shape == (46,)
     elif e.obs_mode == "mobility":
@@ -334,76 +350,16 @@ def test_out_of_range_actions_are_clipped(env, twin):
     assert np.array_equal(a[0], b[0])
 
 
-# --- spaces ------------------------------------------------------------------------------
-
-
-def test_box_sample_and_contains():
-    box = envs.Box(-1.0, 2.0, (3, 4), np.float32, seed=0)
-    assert box.shape == (3, 4) and box.dtype == np.float32
-    for _ in range(50):
-        x = box.sample()
-        assert x.shape == (3, 4) and x.dtype == np.float32
-        assert np.all(x >= -1.0) and np.all(x <= 2.0)
-        assert box.contains(x) and x in box
-    a = envs.Box(-1.0, 2.0, (3, 4), seed=5).sample()
-    assert np.array_equal(a, envs.Box(-1.0, 2.0, (3, 4), seed=5).sample())
-    # rejections: shape, dtype, range, NaN, other types
-    assert not box.contains(np.zeros((4, 3), np.float32))
-    assert not box.contains(np.zeros(12, np.float32))
-    assert not box.contains(np.zeros((3, 4), np.float64))  # not safely castable to float32
-    assert not box.contains(np.full((3, 4), 2.5, np.float32))
-    assert not box.contains(np.full((3, 4), -1.5, np.float32))
-    x = np.zeros((3, 4), np.float32)
-    x[1, 2] = np.nan
-    assert not box.contains(x)
-    assert not box.contains("a string")
-    assert not box.contains(None)
-    assert box.contains(np.zeros((3, 4), np.float16))  # safe cast
-    assert box.contains([[0.0] * 4] * 3)  # a nested list is converted
-
-
-def test_box_bounds_kinds():
-    with pytest.raises(ValueError):
-        envs.Box(1.0, 0.0, (2,))
-    low, high = np.array([0.0, -np.inf, -np.inf, 1.0]), np.array([1.0, np.inf, 0.0, np.inf])
-    b = envs.Box(low, high, seed=1)
-    assert b.shape == (4,)
-    for _ in range(50):
-        x = b.sample()
-        assert np.all(np.isfinite(x)) and b.contains(x)
-    u = envs.Box(0, 255, (5, 6, 3), np.uint8, seed=2)
-    x = u.sample()
-    assert x.dtype == np.uint8 and u.contains(x)
-    assert not u.contains(x.astype(np.int64))
-    assert not u.contains(np.zeros((5, 6, 3), np.float32))
-
-
-def test_dict_space():
-    d = envs.Dict({"a": envs.Box(-1, 1, (2,)), "b": envs.Box(0, 255, (2, 2), np.uint8)}, seed=3)
-    assert set(d.keys()) == {"a", "b"} and len(d) == 2 and list(d) == ["a", "b"]
-    assert d["b"].dtype == np.uint8
-    s = d.sample()
-    assert isinstance(s, dict) and d.contains(s) and s in d
-    d2 = envs.Dict({"a": envs.Box(-1, 1, (2,)), "b": envs.Box(0, 255, (2, 2), np.uint8)}, seed=3)
-    s2 = d2.sample()
-    assert all(np.array_equal(s[k], s2[k]) for k in s)
-    assert d == d2
-    assert not d.contains({"a": s["a"]})  # a key missing
-    assert not d.contains({**s, "c": 0})  # an extra key
-    assert not d.contains({"a": np.array([2.0, 0.0], np.float32), "b": s["b"]})
-    assert not d.contains([s["a"], s["b"]])
-
-
 # --- the vector environment ----------------------------------------------------------------
 
 
 def test_vector_env_spaces_shapes_autoreset_and_determinism():
     n, steps = 2, 3
-    vec = envs.VectorOpenCabinetEnv(
+    vec = make_vec(
         n, obs_mode="mobility", max_episode_steps=steps, init_on_handle=False
     )
     assert vec.num_envs == n
-    assert vec.single_action_space == envs.Box(-1, 1, (7,), np.float32)
+    assert vec.single_action_space == spaces.Box(-1, 1, (7,), np.float32)
     assert vec.action_space.shape == (n, 7)
     assert vec.single_observation_space.shape == (25,)
     assert vec.observation_space.shape == (n, 25)
@@ -465,7 +421,7 @@ def test_vector_env_visual_observations():
     # rendered on two threads: every sub-environment keeps to its thread, since a scene's GL
     # context stays current on the thread that last rendered with it
     n, steps = 2, 2
-    vec = envs.VectorOpenCabinetEnv(
+    vec = make_vec(
         n, obs_mode="visual", max_episode_steps=steps, camera_size=SMALL, init_on_handle=False
     )
     w, h = SMALL
@@ -492,8 +448,8 @@ def test_vector_env_visual_observations():
 
 def test_vector_env_fewer_workers_than_envs():
     kw = dict(obs_mode="mobility", max_episode_steps=3, init_on_handle=False)
-    a = envs.VectorOpenCabinetEnv(3, workers=1, **kw)
-    b = envs.VectorOpenCabinetEnv(3, workers=2, **kw)
+    a = make_vec(3, workers=1, **kw)
+    b = make_vec(3, workers=2, **kw)
     xa, xb = a.reset(seed=SEED)[0], b.reset(seed=SEED)[0]
     assert np.array_equal(xa, xb)
     for act in random_actions(4, seed=2):
@@ -532,7 +488,7 @@ def test_env_on_a_partnet_mobility_folder(tmp_path):
 
 def test_vector_env_render():
     n = 2
-    vec = envs.VectorOpenCabinetEnv(
+    vec = make_vec(
         n, render_mode="rgb_array", camera_size=SMALL, init_on_handle=False, workers=2
     )
     assert vec.render_mode == "rgb_array"
@@ -547,7 +503,7 @@ def test_vector_env_render():
         # the frame of sub-environment i is what that environment renders itself
         assert np.array_equal(f, vec.envs[i].render())
     vec.close()
-    plain = envs.VectorOpenCabinetEnv(1, init_on_handle=False)
+    plain = make_vec(1, init_on_handle=False)
     plain.reset(seed=SEED)
     with pytest.warns(UserWarning, match="VectorOpenCabinetEnv"):
         assert plain.render() is None

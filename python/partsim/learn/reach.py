@@ -4,7 +4,7 @@ velocity targets, has to bring its tip to a target drawn per episode.
 
 It follows partsim.envs' conventions (``reset(seed=...) -> (obs, info)``, ``step(action) ->
 (obs, reward, terminated, truncated, info)``, ``observation_space`` and ``action_space`` as
-partsim.envs.Box), and :func:`make_reach_vector_env` batches copies of it with the trainer's
+gymnasium.spaces.Box), and :func:`make_reach_vector_env` batches copies of it with the trainer's
 :class:`~.trainer.SyncVectorEnv` (next-step autoreset, as VectorOpenCabinetEnv), so that the
 trainer runs here on the code path of the real tasks.
 """
@@ -12,9 +12,9 @@ trainer runs here on the code path of the real tasks.
 from __future__ import annotations
 
 import numpy as np
+from gymnasium.spaces import Box
 
 from .. import _partsim as _ps
-from ..envs import Box
 from .trainer import SyncVectorEnv
 
 __all__ = ["ReachEnv", "make_reach_vector_env"]
