@@ -12,6 +12,7 @@ test says otherwise, an environment has one cabinet: the first generated one wit
 
 import inspect
 
+import gymnasium
 import numpy as np
 import pytest
 from gymnasium import spaces
@@ -104,6 +105,9 @@ def check_obs(space, obs):
 
 
 def test_class_attributes_and_spaces():
+    assert issubclass(envs.OpenCabinetEnv, gymnasium.Env)
+    assert issubclass(envs.VectorOpenCabinetEnv, gymnasium.vector.VectorEnv)
+    assert not hasattr(envs, "Box") and not hasattr(envs, "Dict")  # Gymnasium's are used
     assert "rgb_array" in envs.OpenCabinetEnv.metadata["render_modes"]
     assert envs.OpenCabinetEnv.metadata["render_fps"] > 0
     sig = inspect.signature(envs.OpenCabinetEnv.reset)
@@ -114,6 +118,7 @@ def test_class_attributes_and_spaces():
 
 def test_spaces_of_the_modes(mode_env):
     e = mode_env
+    assert type(e.observation_space) is (spaces.Dict if e.obs_mode == "visual" else spaces.Box)
     assert e.action_space == spaces.Box(-1.0, 1.0, (7,), np.float32)
     if e.obs_mode == "raw":
         assert e.observation_space.shape == (46,)
@@ -508,3 +513,173 @@ def test_vector_env_render():
     with pytest.warns(UserWarning, match="VectorOpenCabinetEnv"):
         assert plain.render() is None
     plain.close()
+
+
+# --- autoreset modes and partial resets ---------------------------------------------------------
+
+
+def single_run(seed, actions_and_resets):
+    """Observations and infos of one environment (2-step episodes) reset with ``seed``, then
+    given actions, or None for a reset without a seed: [(obs, info)] after each call."""
+    e = make(max_episode_steps=2, init_on_handle=False)
+    out = [e.reset(seed=seed)]
+    for a in actions_and_resets:
+        if a is None:
+            out.append(e.reset())
+        else:
+            obs, _, _, _, info = e.step(a)
+            out.append((obs, info))
+    e.close()
+    return out
+
+
+def test_autoreset_mode_argument_and_metadata():
+    for mode, want in [
+        (None, AutoresetMode.NEXT_STEP),
+        (AutoresetMode.SAME_STEP, AutoresetMode.SAME_STEP),
+        ("SameStep", AutoresetMode.SAME_STEP),
+        ("same_step", AutoresetMode.SAME_STEP),
+        ("DISABLED", AutoresetMode.DISABLED),
+        ("NextStep", AutoresetMode.NEXT_STEP),
+    ]:
+        kw = {} if mode is None else {"autoreset_mode": mode}
+        vec = make_vec(1, init_on_handle=False, **kw)
+        assert vec.autoreset_mode is want and vec.metadata["autoreset_mode"] is want
+        vec.close()
+    # per instance: the class and the single environment's metadata are not changed
+    assert "autoreset_mode" not in envs.OpenCabinetEnv.metadata
+    with pytest.raises(ValueError, match="autoreset_mode"):
+        make_vec(1, autoreset_mode="sometimes")
+
+
+def test_same_step_autoreset_returns_the_next_episode_and_the_final_observation():
+    n, zero = 2, np.zeros(7)
+    vec = make_vec(n, max_episode_steps=2, init_on_handle=False, autoreset_mode="SameStep")
+    obs0, _ = vec.reset(seed=SEED)
+    _, _, terms, truncs, infos = vec.step(np.zeros((n, 7)))
+    assert not truncs.any() and "final_obs" not in infos
+    obs, rewards, terms, truncs, infos = vec.step(np.zeros((n, 7)))
+    assert truncs.all() and not terms.any()
+    assert infos["_final_obs"].all() and infos["_final_info"].all()
+    for i in range(n):
+        ref = single_run(SEED + i, [zero, zero, None, zero])
+        # the episode's last observation and info in final_*, the next episode's first returned
+        assert np.array_equal(infos["final_obs"][i], ref[2][0])
+        assert infos["final_info"]["elapsed"][i] == ref[2][1]["elapsed"] > 0
+        assert np.array_equal(obs[i], ref[3][0])
+        assert infos["elapsed"][i] == 0.0
+    # the next step is a step of the new episode (no reset step as in next-step mode)
+    obs, rewards, terms, truncs, infos = vec.step(np.zeros((n, 7)))
+    assert "final_obs" not in infos and not truncs.any()
+    for i in range(n):
+        ref = single_run(SEED + i, [zero, zero, None, zero])
+        assert np.array_equal(obs[i], ref[4][0])
+        assert infos["elapsed"][i] == ref[4][1]["elapsed"] > 0
+    vec.close()
+
+
+def test_same_step_autoreset_with_cameras():
+    # the copies' resets run on their own threads, where their OpenGL contexts live
+    vec = make_vec(2, obs_mode="visual", camera_size=SMALL, max_episode_steps=1,
+                   init_on_handle=False, autoreset_mode=AutoresetMode.SAME_STEP)
+    first, _ = vec.reset(seed=SEED)
+    obs, _, _, truncs, infos = vec.step(np.zeros((2, 7)))
+    assert truncs.all() and infos["_final_obs"].all()
+    assert set(infos["final_obs"][0]) == {"rgb", "depth", "mask", "state"}
+    assert vec.observation_space.contains(obs)
+    # the new episodes were drawn by the generators after their first: not the seeded start
+    assert not np.array_equal(obs["state"], first["state"])
+    vec.close()
+
+
+def test_disabled_autoreset_needs_masked_resets():
+    n, zero = 2, np.zeros(7)
+    vec = make_vec(n, max_episode_steps=2, init_on_handle=False, autoreset_mode="Disabled")
+    vec.reset(seed=SEED)
+    vec.step(np.zeros((n, 7)))
+    last, _, _, truncs, infos = vec.step(np.zeros((n, 7)))
+    assert truncs.all() and "final_obs" not in infos
+    with pytest.raises(RuntimeError, match=r"sub-environments \[0, 1\].*reset_mask"):
+        vec.step(np.zeros((n, 7)))
+    # reset only copy 0: copy 1 keeps its last observation and gives no info
+    obs, infos = vec.reset(options={"reset_mask": np.array([True, False])})
+    ref0 = single_run(SEED, [zero, zero, None])
+    assert np.array_equal(obs[0], ref0[3][0]) and np.array_equal(obs[1], last[1])
+    assert infos["_elapsed"].tolist() == [True, False] and infos["elapsed"][0] == 0.0
+    with pytest.raises(RuntimeError, match=r"sub-environments \[1\]"):
+        vec.step(np.zeros((n, 7)))
+    vec.reset(options={"reset_mask": np.array([False, True])})
+    obs, _, _, truncs, infos = vec.step(np.zeros((n, 7)))
+    assert not truncs.any() and np.allclose(infos["elapsed"], 1 / 25)  # one step in
+    for i in range(n):
+        assert np.array_equal(obs[i], single_run(SEED + i, [zero, zero, None, zero])[4][0])
+    # bad masks
+    with pytest.raises(TypeError):
+        vec.reset(options={"reset_mask": [True, False]})
+    with pytest.raises(ValueError, match="shape"):
+        vec.reset(options={"reset_mask": np.ones(3, dtype=bool)})
+    with pytest.raises(ValueError, match="no sub-environment"):
+        vec.reset(options={"reset_mask": np.zeros(n, dtype=bool)})
+    vec.close()
+
+
+def test_reset_mask_in_next_step_mode_and_before_a_full_reset():
+    n = 2
+    vec = make_vec(n, max_episode_steps=3, init_on_handle=False)
+    with pytest.raises(RuntimeError, match="never reset"):
+        vec.reset(options={"reset_mask": np.array([True, False])})
+    a, _ = vec.reset(seed=SEED)
+    b, _ = vec.reset(seed=[SEED + 5, SEED + 6], options={"reset_mask": np.array([False, True])})
+    assert np.array_equal(b[0], a[0]) and not np.array_equal(b[1], a[1])
+    assert np.array_equal(b[1], make(max_episode_steps=3, init_on_handle=False).reset(
+        seed=SEED + 6)[0])
+    vec.close()
+
+
+# --- objects: targets checked when made, the pool of objects=None ------------------------------
+
+
+def test_objects_without_a_target_are_refused_when_made(tmp_path):
+    no_drawer = min(set(range(10)) - set(partsim.find_task_objects(
+        partsim.TaskType.PULL_DRAWER, 10, 0)))
+    no_door = min(set(range(10)) - set(partsim.find_task_objects(
+        partsim.TaskType.OPEN_DOOR, 10, 0)))
+    with pytest.raises(ValueError, match=rf"StorageFurniture object {no_drawer} .*'drawer'"):
+        envs.OpenCabinetEnv(task="drawer", objects=[first_object("drawer"), no_drawer])
+    with pytest.raises(ValueError, match=rf"StorageFurniture object {no_door} .*'door'"):
+        envs.VectorOpenCabinetEnv(2, task="door", objects=no_door)
+    with pytest.raises(ValueError, match="-3"):
+        envs.OpenCabinetEnv(objects=-3)
+    # a folder: the generator's first door-only cabinet, written by a door task
+    o = partsim.TaskOptions()
+    o.type, o.object_index, o.asset_dir, o.cameras = (
+        partsim.TaskType.OPEN_DOOR, no_drawer, str(tmp_path), False)
+    partsim.ArticulationTask(o)
+    folder = next(p.parent for p in tmp_path.rglob("mobility.urdf"))
+    with pytest.raises(ValueError, match=rf"{folder.name}.*'drawer'.*semantics.txt"):
+        envs.OpenCabinetEnv(task="drawer", objects=[folder])
+    door = envs.OpenCabinetEnv(task="door", objects=[folder], max_episode_steps=2)
+    assert door.reset(seed=0)[1]["object"] == folder.name
+    door.close()
+
+
+def test_default_objects_are_a_pool_drawn_by_the_seed():
+    e = envs.OpenCabinetEnv(task="door", max_episode_steps=2, init_on_handle=False)
+    assert e.objects == partsim.find_task_objects(partsim.TaskType.OPEN_DOOR, 16, 0)
+    seeds = range(6)
+    drawn = [e.reset(seed=s)[1]["object"] for s in seeds]
+    assert len(set(drawn)) > 1  # different seeds, different cabinets
+    assert set(drawn) <= set(e.objects)
+    # the same seed, the same cabinet and the same first observation
+    obs, info = e.reset(seed=3)
+    again, info_again = e.reset(seed=3)
+    assert info["object"] == info_again["object"] == drawn[3]
+    assert np.array_equal(obs, again)
+    assert [e.reset(seed=s)[1]["object"] for s in seeds] == drawn
+    assert len(e._tasks) == len(set(drawn))  # one task per cabinet drawn, built lazily
+    e.close()
+    one = envs.OpenCabinetEnv(pool_size=1, max_episode_steps=2)
+    assert one.objects == [first_object("drawer")]
+    one.close()
+    with pytest.raises(ValueError, match="pool_size"):
+        envs.OpenCabinetEnv(pool_size=0)
