@@ -222,6 +222,155 @@ def test_update_returns_the_losses_and_moves_the_targets_by_polyak():
         assert torch.allclose(agent.critic_target.state_dict()[k], expected, atol=1e-7), k
 
 
+# --- one update against a hand computation ----------------------------------------------------
+
+
+def linear_layers(state, prefix):
+    """[(weight, bias)] of the Linear layers of an MLP's state_dict under ``prefix``, in order,
+    as float64 leaves that record gradients."""
+    indices = sorted({int(k[len(prefix):].split(".")[0]) for k in state if k.startswith(prefix)})
+    return [(state[f"{prefix}{i}.weight"].double().clone().requires_grad_(),
+             state[f"{prefix}{i}.bias"].double().clone().requires_grad_()) for i in indices]
+
+
+def mlp(layers, x):
+    """x @ W^T + b through the layers, ReLU between them."""
+    for i, (w, b) in enumerate(layers):
+        x = x @ w.T + b
+        if i < len(layers) - 1:
+            x = torch.clamp(x, min=0.0)
+    return x
+
+
+def gaussian_tanh(actor, features, noise):
+    """The squashed Gaussian by its definition: u = mean + std * noise, a = tanh(u),
+    log pi(a) = sum_i [log N(u_i; mean_i, std_i) - log(1 - tanh(u_i)^2)]."""
+    out = mlp(actor, features)
+    d = out.shape[1] // 2
+    mean, log_std = out[:, :d], torch.clamp(out[:, d:], sac.LOG_STD_MIN, sac.LOG_STD_MAX)
+    std = torch.exp(log_std)
+    u = mean + std * noise
+    log_normal = -((u - mean) / std) ** 2 / 2 - torch.log(std) - math.log(math.sqrt(2 * math.pi))
+    a = torch.tanh(u)
+    return a, (log_normal - torch.log(1 - a ** 2)).sum(dim=1)
+
+
+def adam_first_step(p, grad, lr, betas=(0.9, 0.999), eps=1e-8):
+    """A parameter after Adam's first step from zero moments: m = (1 - b1) g, v = (1 - b2) g^2,
+    p - lr (m / (1 - b1)) / (sqrt(v / (1 - b2)) + eps)."""
+    m, v = (1 - betas[0]) * grad, (1 - betas[1]) * grad ** 2
+    return p - lr * (m / (1 - betas[0])) / (torch.sqrt(v / (1 - betas[1])) + eps)
+
+
+def test_one_update_equals_a_hand_computation():
+    """SAC.update's losses, gradients and new parameters (critics, actor, temperature, Polyak
+    targets) against the SAC equations written here in float64 on copies of the weights, with
+    the noise drawn from a generator seeded as the agent's (seed + 1, next actions first)."""
+    obs_dim, action_dim, n, seed = 3, 2, 8, 11
+    cfg = SACConfig(hidden_sizes=(5, 4), batch_size=n, lr=1e-3, gamma=0.9, tau=0.1,
+                    init_alpha=0.5)
+    agent = SAC(Box(-np.inf, np.inf, (obs_dim,)), Box(-1, 1, (action_dim,)), cfg, seed=seed)
+    rng = np.random.default_rng(4)
+    batch = {"obs": rng.normal(size=(n, obs_dim)).astype(np.float32),
+             "action": rng.uniform(-1, 1, (n, action_dim)).astype(np.float32),
+             "reward": rng.normal(size=n).astype(np.float32),
+             "next_obs": rng.normal(size=(n, obs_dim)).astype(np.float32),
+             "terminated": np.arange(n) % 3 == 1}
+    # tiny Q networks differ mostly by their output bias: level Q2 with Q1 on the batch (the
+    # target too), so that each is the smaller one for some rows and the min matters
+    with torch.no_grad():
+        q1_0, q2_0 = agent.critic(torch.from_numpy(batch["obs"]),
+                                  torch.from_numpy(batch["action"]))
+        agent.critic.q2[-1].bias += (q1_0 - q2_0).mean()
+        agent.critic_target.load_state_dict(agent.critic.state_dict())
+    # the agent's weights before the update, as float64 leaves
+    actor = linear_layers(agent.actor.state_dict(), "net.")
+    critic = {h: linear_layers(agent.critic.state_dict(), h + ".") for h in ("q1", "q2")}
+    target = {h: [(w.detach(), b.detach()) for w, b in
+                  linear_layers(agent.critic_target.state_dict(), h + ".")]
+              for h in ("q1", "q2")}
+    log_alpha = torch.tensor(math.log(cfg.init_alpha), dtype=torch.float64, requires_grad=True)
+    gen = torch.Generator().manual_seed(seed + 1)
+    next_noise = torch.randn((n, action_dim), generator=gen).double()
+    new_noise = torch.randn((n, action_dim), generator=gen).double()
+    s, a = torch.from_numpy(batch["obs"]).double(), torch.from_numpy(batch["action"]).double()
+    s2 = torch.from_numpy(batch["next_obs"]).double()
+    r = torch.from_numpy(batch["reward"]).double()
+    done = torch.from_numpy(batch["terminated"]).double()
+    alpha = math.exp(float(log_alpha))
+    lr = cfg.lr
+
+    # critics: y = r + gamma (1 - d) (min(Q1'(s', a'), Q2'(s', a')) - alpha log pi(a'|s')),
+    # a' ~ pi(.|s'); loss = MSE(Q1(s, a), y) + MSE(Q2(s, a), y)
+    with torch.no_grad():
+        a2, logp2 = gaussian_tanh(actor, s2, next_noise)
+        x2 = torch.cat([s2, a2], 1)
+        q1_next, q2_next = mlp(target["q1"], x2)[:, 0], mlp(target["q2"], x2)[:, 0]
+        q_next = torch.min(q1_next, q2_next)
+        y = r + cfg.gamma * (1 - done) * (q_next - alpha * logp2)
+    x = torch.cat([s, a], 1)
+    q1, q2 = mlp(critic["q1"], x)[:, 0], mlp(critic["q2"], x)[:, 0]
+    loss_q1, loss_q2 = ((q1 - y) ** 2).mean(), ((q2 - y) ** 2).mean()
+    (loss_q1 + loss_q2).backward()
+    new_critic = {h: [(adam_first_step(w.detach(), w.grad, lr),
+                       adam_first_step(b.detach(), b.grad, lr)) for w, b in critic[h]]
+                  for h in critic}
+
+    # actor, against the critics after their step: mean(alpha log pi(a~|s) - min Q(s, a~))
+    a_new, logp = gaussian_tanh(actor, s, new_noise)
+    xn = torch.cat([s, a_new], 1)
+    q1_pi, q2_pi = mlp(new_critic["q1"], xn)[:, 0], mlp(new_critic["q2"], xn)[:, 0]
+    q_pi = torch.min(q1_pi, q2_pi)
+    # the data make each Q the smaller one somewhere, in the target and here
+    for lower in (q1_next < q2_next, q1_pi < q2_pi):
+        assert 0 < int(lower.sum()) < n
+    loss_pi = (alpha * logp - q_pi).mean()
+    loss_pi.backward()
+    new_actor = [(adam_first_step(w.detach(), w.grad, lr), adam_first_step(b.detach(), b.grad, lr))
+                 for w, b in actor]
+
+    # temperature: -mean(log_alpha (log pi + target entropy)), target entropy -action_dim
+    loss_alpha = -(log_alpha * (logp.detach() - action_dim)).mean()
+    loss_alpha.backward()
+    new_log_alpha = adam_first_step(log_alpha.detach(), log_alpha.grad, lr)
+
+    # targets: (1 - tau) target + tau critic (after its step)
+    new_target = {h: [((1 - cfg.tau) * tw + cfg.tau * w, (1 - cfg.tau) * tb + cfg.tau * b)
+                      for (tw, tb), (w, b) in zip(target[h], new_critic[h])] for h in target}
+
+    stats = agent.update(batch)
+    expected = {"q1_loss": loss_q1, "q2_loss": loss_q2, "policy_loss": loss_pi,
+                "alpha_loss": loss_alpha, "alpha": alpha, "entropy": -logp.mean(),
+                "q_mean": q1.mean()}
+    for k, v in expected.items():
+        assert stats[k] == pytest.approx(float(v), abs=1e-5), k
+    # the gradients, as Adam's first moments hold them: (1 - beta1) g
+    for (w, b), (pw, pb) in zip(actor, [(agent.actor.net[i].weight, agent.actor.net[i].bias)
+                                        for i in range(0, len(agent.actor.net), 2)]):
+        for mine, p in ((w, pw), (b, pb)):
+            got = agent.actor_optimizer.state[p]["exp_avg"].double() / 0.1
+            assert torch.allclose(got, mine.grad, atol=1e-5), "actor gradient"
+
+    def check(layers, module, what):
+        linears = [m for m in module if isinstance(m, torch.nn.Linear)]
+        assert len(linears) == len(layers), what
+        for (w, b), m in zip(layers, linears):
+            assert torch.allclose(m.weight.detach().double(), w, atol=1e-5, rtol=0), what
+            assert torch.allclose(m.bias.detach().double(), b, atol=1e-5, rtol=0), what
+
+    check(new_actor, agent.actor.net, "actor")
+    for h in ("q1", "q2"):
+        for (w, b), m in zip(critic[h], [m for m in getattr(agent.critic, h)
+                                         if isinstance(m, torch.nn.Linear)]):
+            got = agent.critic_optimizer.state[m.weight]["exp_avg"].double() / 0.1
+            assert torch.allclose(got, w.grad, atol=1e-5), h + " gradient"
+        check(new_critic[h], getattr(agent.critic, h), h)
+        check(new_target[h], getattr(agent.critic_target, h), h + " target")
+    assert float(agent.log_alpha) == pytest.approx(float(new_log_alpha), abs=1e-6)
+    # every step moved something: the parameters differ from before by about lr
+    assert float(agent.log_alpha) != pytest.approx(math.log(cfg.init_alpha), abs=lr / 2)
+
+
 def test_state_dict_resumes_bit_identically(tmp_path):
     space, actions = Box(-np.inf, np.inf, (5,)), Box(-1, 1, (2,))
     rng = np.random.default_rng(0)
