@@ -40,6 +40,12 @@ set(PARTSIM_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/partsim)
 set(PARTSIM_PYTHON_INSTALL_DIR lib/python3/dist-packages CACHE STRING
     "Where the Python package goes, relative to the prefix (Debian's path under /usr)")
 
+# `partsim learn` runs the Python package: an installed command finds it at this path from the
+# prefix (src/tools/learn_command.cc)
+# prefix (src/tools/learn_command.cc); the build tree's runs the interpreter it was built for
+set_source_files_properties(${CMAKE_SOURCE_DIR}/src/tools/learn_command.cc PROPERTIES
+  COMPILE_DEFINITIONS "PARTSIM_PYTHON_INSTALL_DIR=\"${PARTSIM_PYTHON_INSTALL_DIR}\";PARTSIM_BUILD_PYTHON=\"${PYTHON_EXECUTABLE}\"")
+
 install(TARGETS partsim EXPORT partsimTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT partsim)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/include/partsim DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
@@ -78,6 +84,44 @@ endif()
 # the browser viewer's web bundle (scripts/build_web.sh builds it into build/web), when built
 install(DIRECTORY ${CMAKE_BINARY_DIR}/web/ DESTINATION ${CMAKE_INSTALL_DATADIR}/partsim/web
         COMPONENT partsim OPTIONAL)
+
+# The wheel (pyproject.toml, built by scikit-build-core): component "wheel", installed only when
+# asked for by name (EXCLUDE_FROM_ALL: `cmake --install` and the .deb leave it out). Its prefix is
+# the wheel's site-packages, and the package folder is a prefix of its own:
+#   partsim/                          the Python package, _partsim*.so, the stubs and py.typed
+#   partsim/bin/partsim               the command line (the `partsim` entry point runs it)
+#   partsim/lib/libmujoco.so.X.Y.Z    MuJoCo, found through the RUNPATHs below
+#   partsim/share/partsim/web/        the viewer's page
+# The system libraries (Mesa's EGL, Embree, assimp, OMPL, FFmpeg, ...) are not bundled: the wheel
+# is for Debian 12 with those packages (partsim/__init__.py names what is missing).
+set(PARTSIM_WHEEL_PACKAGE partsim)
+if(TARGET partsim_py)
+  install(TARGETS partsim_py LIBRARY DESTINATION ${PARTSIM_WHEEL_PACKAGE} COMPONENT wheel
+          EXCLUDE_FROM_ALL)
+  install(DIRECTORY ${CMAKE_SOURCE_DIR}/python/partsim/ DESTINATION ${PARTSIM_WHEEL_PACKAGE}
+          COMPONENT wheel EXCLUDE_FROM_ALL PATTERN "__pycache__" EXCLUDE)
+  set_property(TARGET partsim_py APPEND PROPERTY INSTALL_RPATH "$ORIGIN/lib")
+endif()
+if(TARGET partsim_cli)
+  install(TARGETS partsim_cli RUNTIME DESTINATION ${PARTSIM_WHEEL_PACKAGE}/bin COMPONENT wheel
+          EXCLUDE_FROM_ALL)
+  set_property(TARGET partsim_cli APPEND PROPERTY INSTALL_RPATH "$ORIGIN/../lib")
+endif()
+install(FILES ${PARTSIM_MUJOCO_LIBRARY} DESTINATION ${PARTSIM_WHEEL_PACKAGE}/lib COMPONENT wheel
+        EXCLUDE_FROM_ALL)
+install(DIRECTORY ${CMAKE_BINARY_DIR}/web/ DESTINATION ${PARTSIM_WHEEL_PACKAGE}/share/partsim/web
+        COMPONENT wheel EXCLUDE_FROM_ALL OPTIONAL)
+# the page itself (scripts/build_web.sh: three.js and roslib from npm, bundled into build's web/):
+# a target the wheel's build asks for (pyproject.toml); without npm the wheel has no page, and the
+# viewer says how to build one
+find_program(PARTSIM_NPM npm)
+if(PARTSIM_NPM)
+  add_custom_target(partsim_web COMMAND ${CMAKE_COMMAND} -E env PARTSIM_WEB_OUT=${CMAKE_BINARY_DIR}/web
+                    bash ${CMAKE_SOURCE_DIR}/scripts/build_web.sh VERBATIM)
+else()
+  add_custom_target(partsim_web COMMAND ${CMAKE_COMMAND} -E echo
+                    "partsim: no npm, so no viewer page (scripts/build_web.sh builds it)")
+endif()
 
 # the Debian package
 set(CPACK_GENERATOR DEB)

@@ -4,7 +4,8 @@
 # Debian's libmujoco is never looked at.
 #
 #   PARTSIM_MUJOCO_DIR  the package folder (site-packages/mujoco); by default asked of the venv's
-#                       interpreter (PARTSIM_VENV_PYTHON, default .venv/bin/python)
+#                       interpreter (PARTSIM_VENV_PYTHON, default .venv/bin/python, or for a
+#                       wheel's build without .venv the interpreter that builds it)
 #
 # The version is the one requirements.lock pins (the one place that names it): the library found
 # must be that version's, or configuration stops and says what to run.
@@ -14,7 +15,14 @@ if(NOT PARTSIM_MUJOCO_VERSION MATCHES "^[0-9]+\\.[0-9]+\\.[0-9]+$")
   message(FATAL_ERROR "requirements.lock pins no mujoco-core==X.Y.Z")
 endif()
 
-set(PARTSIM_VENV_PYTHON ${CMAKE_SOURCE_DIR}/.venv/bin/python CACHE FILEPATH
+# a wheel's build (pip install ., scikit-build-core) asks its own interpreter, whose build
+# environment holds mujoco-core (pyproject.toml's build requirements)
+if(SKBUILD AND NOT EXISTS ${CMAKE_SOURCE_DIR}/.venv/bin/python)
+  set(_venv_python ${Python_EXECUTABLE})
+else()
+  set(_venv_python ${CMAKE_SOURCE_DIR}/.venv/bin/python)
+endif()
+set(PARTSIM_VENV_PYTHON ${_venv_python} CACHE FILEPATH
     "The project venv's interpreter (scripts/setup.sh makes it)")
 if(NOT PARTSIM_MUJOCO_DIR)
   if(NOT EXISTS ${PARTSIM_VENV_PYTHON})

@@ -4,7 +4,8 @@ id-to-name table as JSON.
 
 The cabinet (StorageFurniture) comes from partsim's generator, run through the `partsim`
 command line (`partsim assets generate`), into DIR/object/. The command is found as
-$PARTSIM_CLI, else beside the imported package in a build tree (<build>/partsim), else on PATH.
+$PARTSIM_CLI, else the one that goes with the
+imported package (a wheel's, a build tree's, an install prefix's), else on PATH.
 
 Run from any folder (with partsim importable: installed, or PYTHONPATH=<repo>/build/python):
 
@@ -20,7 +21,6 @@ points that see a surface), segmentation.json (id -> name and part label) and ca
 import argparse
 import json
 import os
-import shutil
 import subprocess
 import sys
 
@@ -30,14 +30,9 @@ import partsim
 
 
 def find_cli():
-    """The partsim command: $PARTSIM_CLI, <build>/partsim beside <build>/python/partsim, or PATH."""
-    if os.environ.get("PARTSIM_CLI"):
-        return os.environ["PARTSIM_CLI"]
-    package = os.path.dirname(os.path.abspath(partsim.__file__))
-    built = os.path.join(os.path.dirname(os.path.dirname(package)), "partsim")
-    if os.path.isfile(built) and os.access(built, os.X_OK):
-        return built
-    found = shutil.which("partsim")
+    """The partsim command that goes with the imported package (partsim.find_cli: $PARTSIM_CLI,
+    the wheel's, the build tree's, the install prefix's, else PATH)."""
+    found = partsim.find_cli()
     if not found:
         sys.exit("the partsim command was not found: set PARTSIM_CLI or put partsim on PATH")
     return found

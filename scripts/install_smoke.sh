@@ -48,10 +48,21 @@ echo "-- partsim tasks demo from $work"
 partsim tasks demo --size 320x240 --every 5 --out "$work/demo"
 [ -s "$work/demo/demo.mp4" ] || { echo "no video at $work/demo/demo.mp4"; exit 1; }
 echo "-- partsim learn (the installed Python package's learning protocol) from $work"
-partsim learn --help | grep -q "partsim learn train" || { echo "partsim learn --help failed"; exit 1; }
+help="$(partsim learn --help)"
+grep -q "partsim learn train" <<<"$help" || { echo "partsim learn --help failed: $help"; exit 1; }
 /usr/bin/python3 -c "import partsim.learn.protocol as p, os, sys; \
 assert os.path.realpath(p.__file__).startswith(os.path.realpath(sys.argv[1]) + '/'), p.__file__" \
   "$prefix"
+# a short run with the project venv's interpreter (Gymnasium is not a Debian package), without
+# PYTHONPATH: the installed command puts the installed package on the path itself
+env -u PYTHONPATH PARTSIM_PYTHON="$src/.venv/bin/python" partsim learn train --task drawer \
+  --obs mobility --train-objects 1 --test-objects 1 --steps 10 --num-envs 1 --warmup-steps 5 \
+  --batch-size 4 --buffer-size 100 --hidden 8 --quiet --out "$work/run" >"$work/learn.txt"
+grep -q '"steps": 10' "$work/learn.txt" || { echo "partsim learn train: $(cat "$work/learn.txt")"; exit 1; }
+echo "-- an example that runs the command line finds the installed one, without PATH's help"
+env PATH=/usr/bin:/bin "$src/.venv/bin/python" "$src/examples/cabinet_generator.py" \
+  --out "$work/cabinet" >/dev/null
+ls "$work/cabinet" | grep -q . || { echo "cabinet_generator wrote nothing"; exit 1; }
 echo "-- the viewer's page, installed, found by the installed package (from $work)"
 [ -f "$prefix/share/partsim/web/index.html" ] || { echo "no $prefix/share/partsim/web/index.html"; exit 1; }
 /usr/bin/python3 - "$prefix" <<'PY'

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs, builds (from scratch on a clean checkout, else what changed) and runs the whole test
 # suite: GoogleTest through CTest, pytest, the source format check, the installed partsim (a
-# temporary prefix and the Debian package, each used from outside the tree) and the URDF and OBJ
-# fuzzers under AddressSanitizer.
+# temporary prefix and the Debian package, each used from outside the tree), the wheel (installed
+# into a new venv) and the URDF and OBJ fuzzers under AddressSanitizer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -58,6 +58,10 @@ else
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get remove -y -q partsim
   [ "$status" -eq 0 ]
 fi
+
+echo "== the wheel: built by scikit-build-core over build/, installed into a new venv outside the tree"
+bash scripts/build_wheel.sh
+bash scripts/wheel_smoke.sh build/dist/partsim-*.whl
 
 echo "== URDF and OBJ fuzzers (libFuzzer + AddressSanitizer)"
 bash scripts/run_fuzz.sh

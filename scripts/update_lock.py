@@ -7,6 +7,7 @@ Usage: .venv/bin/python scripts/update_lock.py   (needs PyPI; touches nothing bu
 
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -39,7 +40,8 @@ def main() -> int:
         if "sha256" not in hashes:
             print(f"update_lock: pip gave no sha256 for {name} {version}", file=sys.stderr)
             return 1
-        lines.append(f"{name.lower()}=={version} \\\n    --hash=sha256:{hashes['sha256']}\n")
+        name = re.sub(r"[-_.]+", "-", name).lower()  # the normalised name (PEP 503)
+        lines.append(f"{name}=={version} \\\n    --hash=sha256:{hashes['sha256']}\n")
     with open(os.path.join(root, "requirements.lock"), "w", encoding="utf-8") as f:
         f.writelines(lines)
     print(f"update_lock: {len(items)} packages written to requirements.lock")

@@ -10,13 +10,46 @@ registered with it (`gymnasium.make("partsim/OpenCabinetDrawer-v0")`).
 
 import sys as _sys
 
-from ._partsim import *  # noqa: F401,F403
+# The Debian 12 packages of the shared libraries the compiled module and the command line link
+# (a wheel carries MuJoCo but not these): a missing one is named with the command that installs
+# them all. Mesa's EGL and its CPU rasterizer (libegl-mesa0, libgl1-mesa-dri) are loaded when a
+# renderer starts.
+SYSTEM_PACKAGES = {
+    "libEGL.so.1": "libegl1", "libOpenGL.so.0": "libopengl0", "libembree3.so.3": "libembree3-3",
+    "libassimp.so.5": "libassimp5", "libompl.so.16": "libompl16",
+    "libavcodec.so.59": "libavcodec59", "libavformat.so.59": "libavformat59",
+    "libavutil.so.57": "libavutil57", "libswscale.so.6": "libswscale6",
+    "libpng16.so.16": "libpng16-16", "libjpeg.so.62": "libjpeg62-turbo",
+    "libqhull_r.so.8.0": "libqhull-r8.0", "libtinyxml2.so.9": "libtinyxml2-9",
+    "libHACD.so.3.24": "libbullet-extras3.24", "libboost_thread.so.1.74.0": "libboost-thread1.74.0",
+}
+_MESA = ("libegl-mesa0", "libgl1-mesa-dri")
+
+
+def _missing_library_message(error: ImportError) -> str:
+    """The ImportError's text, with the Debian packages to install when it names a missing
+    system library."""
+    text = str(error)
+    missing = next((lib for lib in SYSTEM_PACKAGES if lib in text), None)
+    if missing is None and "cannot open shared object file" not in text:
+        return text
+    packages = " ".join(sorted(set(SYSTEM_PACKAGES.values()) | set(_MESA)))
+    what = f"{missing} (Debian's {SYSTEM_PACKAGES[missing]})" if missing else "a system library"
+    return (f"partsim's compiled module cannot load: {what} is missing ({text}). partsim needs "
+            f"these Debian 12 packages: apt-get install {packages}")
+
+
+try:
+    from ._partsim import *  # noqa: F401,F403
+except ImportError as _e:
+    raise ImportError(_missing_library_message(_e)) from _e
 from ._partsim import PartsimError, PartsimIndexError  # noqa: F401  (explicit for readers)
 from ._partsim import __version__  # noqa: F401  (the project's version, set by CMake)
 from ._sapien import (  # noqa: F401
     Engine, KuafuRenderer, RenderBodyComponent, RenderMaterial, SapienContact, SapienRenderer,
     SceneConfig, Viewer, VulkanRenderer, physx, render, set_log_level, utils)
 from . import vision  # noqa: F401  (partsim.vision: COCO masks, the perception evaluators)
+from ._cli import find_cli  # noqa: F401  (the command line that goes with this package)
 
 
 # SAPIEN 2 scripts say `import sapien.core as sapien`: partsim.core is partsim itself

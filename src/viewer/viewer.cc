@@ -104,23 +104,22 @@ std::string FindWebRoot(const std::string& web_root) {
   std::vector<std::string> candidates;
   if (const char* env = std::getenv("PARTSIM_WEB_DIR")) candidates.push_back(env);
   // an installed copy beside the binary that holds this code, wherever the prefix is (a .deb
-  // in /usr, cmake --install to any PREFIX): PREFIX/bin/partsim, PREFIX/lib/libpartsim.so and
-  // PREFIX/lib/python3/dist-packages/partsim/_partsim*.so all find PREFIX/share/partsim/web
+  // in /usr, cmake --install to any PREFIX, a wheel): PREFIX/bin/partsim,
+  // PREFIX/lib/<multiarch>/libpartsim.so and PREFIX/lib/python3/dist-packages/partsim/_partsim*.so
+  // all find PREFIX/share/partsim/web; in a wheel, site-packages/partsim is the prefix of its
+  // bin/partsim and holds _partsim*.so itself
   Dl_info info{};
   if (dladdr(reinterpret_cast<const void*>(&FindWebRoot), &info) != 0 &&
       info.dli_fname != nullptr) {
     std::error_code ec;
     const fs::path dir = fs::canonical(fs::path(info.dli_fname), ec).parent_path();
     if (!ec) {
-      candidates.push_back((dir / "../share/partsim/web").lexically_normal().string());
-      candidates.push_back((dir / "../../../../share/partsim/web").lexically_normal().string());
+      for (const char* up : {"..", "../..", "../../../..", "."})
+        candidates.push_back((dir / up / "share/partsim/web").lexically_normal().string());
     }
   }
 #ifdef PARTSIM_BUILD_WEB_DIR
   candidates.push_back(PARTSIM_BUILD_WEB_DIR);
-#endif
-#ifdef PARTSIM_INSTALL_WEB_DIR
-  candidates.push_back(PARTSIM_INSTALL_WEB_DIR);
 #endif
   for (const std::string& c : candidates) {
     std::error_code ec;

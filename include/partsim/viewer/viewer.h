@@ -152,9 +152,9 @@ class Viewer {
 
 /// The web bundle folder for a viewer with option `web_root`: web_root if given, else
 /// $PARTSIM_WEB_DIR, else PREFIX/share/partsim/web for the prefix the binary holding this code
-/// is installed in (found at run time), else the build tree's web/, else the configured
-/// install prefix's share/partsim/web, the first that
-/// holds an index.html; "" when none does (a given web_root is returned even then).
+/// is installed in (found at run time: a cmake --install prefix, /usr for the .deb, the package
+/// folder for a wheel), else the build tree's web/, the first that holds an index.html; "" when
+/// none does (a given web_root is returned even then).
 std::string FindWebRoot(const std::string& web_root);
 
 }  // namespace partsim
