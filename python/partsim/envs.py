@@ -120,20 +120,23 @@ class OpenCabinetEnv(gymnasium.Env):
         self.render_mode = render_mode
         self.max_episode_steps = int(max_episode_steps)
         if objects is None:
-            objects = _ps.find_task_objects(self.task_type, int(pool_size), dataset_seed)
-        elif isinstance(objects, (numbers.Integral, str, os.PathLike)):
-            objects = [objects]
-        self.objects = [
-            os.fspath(o) if isinstance(o, (str, os.PathLike)) else int(o) for o in objects
-        ]
-        if not self.objects:
-            raise ValueError(
-                "objects must name at least one StorageFurniture index or PartNet-Mobility folder"
-            )
-        for obj in self.objects:
-            if isinstance(obj, str) and not os.path.isfile(os.path.join(obj, "mobility.urdf")):
-                raise ValueError(f"objects: {obj!r} is not a PartNet-Mobility folder")
-        _check_targets(self.objects, task, self.task_type, dataset_seed)
+            # the pool: objects with a target, by construction
+            self.objects = _ps.find_task_objects(self.task_type, int(pool_size), dataset_seed)
+        else:
+            if isinstance(objects, (numbers.Integral, str, os.PathLike)):
+                objects = [objects]
+            self.objects = [
+                os.fspath(o) if isinstance(o, (str, os.PathLike)) else int(o) for o in objects
+            ]
+            if not self.objects:
+                raise ValueError(
+                    "objects must name at least one StorageFurniture index or PartNet-Mobility "
+                    "folder"
+                )
+            for obj in self.objects:
+                if isinstance(obj, str) and not os.path.isfile(os.path.join(obj, "mobility.urdf")):
+                    raise ValueError(f"objects: {obj!r} is not a PartNet-Mobility folder")
+            _check_targets(self.objects, task, self.task_type, dataset_seed)
         self._options = []
         for obj in self.objects:
             o = _ps.TaskOptions()
