@@ -2,6 +2,7 @@
 #include "partsim/assets/partnet_mobility.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -541,15 +542,126 @@ Articulation PartNetMobilityLoader::Load(const std::string& folder) {
   return scene_->AddArticulation(Parse(folder).articulation);
 }
 
+namespace {
+
+// A folder on the way down from a dataset's root: resolved, as reached, and whether it was
+// reached through a symbolic link of its own.
+struct SearchStep {
+  fs::path resolved;
+  fs::path reached;
+  bool link = false;
+};
+
+// True when `folder` is `inside` or one of the folders above it (both resolved).
+bool Holds(const fs::path& folder, const fs::path& inside) {
+  auto f = folder.begin(), i = inside.begin();
+  for (; f != folder.end(); ++f, ++i)
+    if (i == inside.end() || *f != *i) return false;
+  return true;
+}
+
+// One step of FindDatasetFolders: the folder at the end of `chain`, the folders from the root
+// down to it, against which each link's target is checked for a loop.
+void SearchDatasetFolder(std::vector<SearchStep>* chain,
+                         const std::function<bool(const std::string&)>& is_object,
+                         std::vector<std::string>* found,
+                         std::vector<UnreadableFolder>* unreadable) {
+  const fs::path dir = chain->back().reached;
+  auto cannot_read = [&](const fs::path& what, const std::string& reason) {
+    if (!unreadable) throw Error("'" + what.string() + "': " + reason);
+    unreadable->push_back({what.string(), reason});
+  };
+  if (is_object(dir.string())) {
+    found->push_back(dir.string());
+    return;  // an object's own subfolders (textured_objs/, images/) hold no objects
+  }
+  // the entries in path order, so that the search and its first error do not depend on the
+  // order the file system lists them in
+  std::error_code ec;
+  fs::directory_iterator it(dir, ec), end;
+  if (ec) return cannot_read(dir, "cannot read the folder: " + ec.message());
+  std::vector<fs::path> entries;
+  for (; it != end; it.increment(ec)) {
+    if (ec) return cannot_read(dir, "cannot read the folder: " + ec.message());
+    entries.push_back(it->path());
+  }
+  std::sort(entries.begin(), entries.end());
+  for (const fs::path& entry : entries) {
+    std::error_code kind;
+    const bool link = fs::is_symlink(fs::symlink_status(entry, kind));
+    if (!link && !fs::is_directory(fs::symlink_status(entry, kind))) continue;
+    if (link) {
+      // a link: followed when it leads to a folder
+      const fs::file_status target = fs::status(entry, kind);
+      if (kind.value() == ELOOP) {
+        cannot_read(entry, "symbolic link in a loop of links (" + kind.message() + ")");
+        continue;
+      }
+      if (kind || !fs::exists(target)) {
+        cannot_read(entry, "symbolic link to '" + fs::read_symlink(entry, kind).string() +
+                               "', which does not exist");
+        continue;
+      }
+      if (!fs::is_directory(target)) continue;
+    }
+    const fs::path resolved = fs::canonical(entry, kind);
+    if (kind) {
+      cannot_read(entry, "cannot resolve the folder: " + kind.message());
+      continue;
+    }
+    // a folder on the way down from the root, or one that holds such a folder: the search
+    // would come back to where it is, again and again; the link to blame is the last one on
+    // the way (this entry itself, but for a folder that is in two places)
+    const bool loop = std::any_of(chain->begin(), chain->end(),
+                                  [&](const SearchStep& s) { return Holds(resolved, s.resolved); });
+    if (loop) {
+      std::string through;
+      if (!link)
+        for (auto s = chain->rbegin(); s != chain->rend(); ++s)
+          if (s->link) {
+            through = " through the symbolic link '" + s->reached.string() + "'";
+            break;
+          }
+      cannot_read(entry, std::string(link ? "symbolic link" : "folder") + " to '" +
+                             resolved.string() + "'" + through +
+                             ", a folder that holds it (a loop of links)");
+      continue;
+    }
+    chain->push_back({resolved, entry, link});
+    SearchDatasetFolder(chain, is_object, found, unreadable);
+    chain->pop_back();
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> FindDatasetFolders(
+    const std::string& root, const std::function<bool(const std::string& folder)>& is_object,
+    std::vector<UnreadableFolder>* unreadable) {
+  std::error_code ec;
+  if (!fs::is_directory(root, ec)) throw Error("dataset folder '" + root + "' is not a folder");
+  std::vector<SearchStep> chain = {{fs::canonical(root, ec), root, false}};
+  if (ec) throw Error("dataset folder '" + root + "': " + ec.message());
+  std::vector<std::string> found;
+  SearchDatasetFolder(&chain, is_object, &found, unreadable);
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+std::vector<std::string> FindPartNetMobilityFolders(const std::string& root,
+                                                    std::vector<UnreadableFolder>* unreadable) {
+  return FindDatasetFolders(
+      root,
+      [](const std::string& folder) {
+        std::error_code ec;
+        return fs::is_regular_file(fs::path(folder) / "mobility.urdf", ec);
+      },
+      unreadable);
+}
+
 std::vector<PartNetBatchEntry> ParsePartNetMobilityBatch(const std::string& root,
                                                          const PartNetMobilityLoader& loader) {
-  std::vector<std::string> folders;
-  if (!fs::is_directory(root))
-    throw Error("PartNet-Mobility batch: '" + root + "' is not a folder");
-  for (const auto& e : fs::recursive_directory_iterator(root))
-    if (e.is_regular_file() && e.path().filename() == "mobility.urdf")
-      folders.push_back(e.path().parent_path().string());
-  std::sort(folders.begin(), folders.end());
+  const std::vector<std::string> folders = FindPartNetMobilityFolders(root);
   std::vector<PartNetBatchEntry> out;
   for (const std::string& f : folders) {
     PartNetBatchEntry entry;

@@ -20,6 +20,7 @@
 #include "commands.h"
 #include "core/progress.h"
 #include "partsim/assets/generator.h"
+#include "partsim/assets/partnet_mobility.h"
 #include "partsim/assets/quality.h"
 #include "partsim/render/visibility.h"
 
@@ -38,7 +39,13 @@ constexpr const char* kCheckUsage =
     "Checks every PartNet-Mobility folder under DIR: it loads and its files agree; at rest "
     "nothing\n"
     "moves; each movable part covers its range without jamming; each shows in some view. Prints\n"
-    "the failures, a summary and the models/parts table beside the SAPIEN paper's.\n"
+    "the failures, a summary and the models/parts table beside the SAPIEN paper's. The object\n"
+    "folders are found at any depth, through symbolic links to folders.\n"
+    "  --jobs J          objects checked at once (default 2)\n"
+    "  --no-visibility   skip the view check (renders nothing)\n"
+    "  --backend B       the view check's renderer: rasterizer (default) or pathtracer\n"
+    "  --report FILE     also write every object's checks, then the summary, to FILE\n"
+    "  --limit N         check only the first N folders, in path order\n"
     "Exit code: 0 all passed, 1 some failed, 2 bad command line.\n";
 
 // A generate run was stopped while writing this object: it fails without being loaded.
@@ -93,14 +100,20 @@ int RunQualityCommand(int argc, char** argv) {
   // every object folder, in path order: one that holds any file of the dataset's layout (a
   // folder with textured_objs/ alone fails to load, it is not skipped), and the leftovers of
   // generate runs that were stopped (*.partial, failed without loading)
-  std::set<std::string> found;
-  for (const auto& e : std::filesystem::recursive_directory_iterator(dir)) {
-    const std::string name = e.path().filename().string();
-    if (name == "mobility_v2.json" || name == "mobility.urdf" || name == "semantics.txt" ||
-        (name == "textured_objs" && e.is_directory()))
-      found.insert(e.path().parent_path().string());
+  // (at any depth, through symbolic links: a folder of links picks a subset of the dataset)
+  std::vector<std::string> folders;
+  try {
+    folders = FindDatasetFolders(dir, [](const std::string& folder) {
+      namespace fs = std::filesystem;
+      const fs::path f(folder);
+      std::error_code ec;
+      return fs::exists(f / "mobility_v2.json", ec) || fs::exists(f / "mobility.urdf", ec) ||
+             fs::exists(f / "semantics.txt", ec) || fs::is_directory(f / "textured_objs", ec);
+    });
+  } catch (const Error& e) {
+    std::cerr << "partsim assets check: " << e.what() << "\n";
+    return 1;
   }
-  std::vector<std::string> folders(found.begin(), found.end());
   if (limit >= 0 && static_cast<long long>(folders.size()) > limit)
     folders.resize(static_cast<size_t>(limit));
   if (folders.empty()) {

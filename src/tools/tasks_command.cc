@@ -17,6 +17,8 @@
 #include "arg_parser.h"
 #include "commands.h"
 #include "partsim/assets/generator.h"
+#include "partsim/assets/partnet_mobility.h"
+#include "partsim/core/error.h"
 #include "partsim/tasks/tasks.h"
 
 namespace partsim::tools {
@@ -27,7 +29,7 @@ constexpr char kTasksUsage[] = R"(usage:
                      [--video FILE | --no-video] [--frames] [--size WxH]
   partsim tasks evaluate [--task drawer|door] [--count N] [--seed S] [--jobs J]
                          [--no-cameras] [--csv FILE]
-                         [--dataset ROOT [--ids A,B,...] [--targets all]]
+                         [--dataset ROOT [--ids A,B,...] [--targets all|one]]
 
 demo       generates a cabinet (StorageFurniture object N of 0..344, default the first with a
            drawer or door), runs the heuristic solver with the flying gripper and reports
@@ -43,9 +45,30 @@ evaluate   runs the heuristic solver on the first N cabinets (default 20) that h
            generated, sorted by name; --ids keeps the named folders): the first N (all with
            --ids) that have a target, i.e. a link labelled 'drawer' ('rotation_door') in
            semantics.txt with a handle; --targets all runs every target of each object.
+
+demo and evaluate:
   --task drawer|door   which task (default drawer)
   --seed S             episode seed (default 0)
+demo:
+  --object N           the generated StorageFurniture object, 0 to 344 (default: the first
+                       with a drawer or door)
+  --out DIR            output folder (default out/demo)
+  --every K            one frame every K control steps (default 2)
+  --video FILE         the video's file (default DIR/demo.mp4)
+  --no-video           record no video
+  --frames             also write the frames as DIR/frame_NNNNN.png
+  --size WxH           picture size in pixels (default 640x480)
+evaluate:
+  --count N            number of objects (default 20; with --ids, every named one)
   --jobs J             episodes in parallel (default 1)
+  --no-cameras         perceive the handle from the meshes, not segmented point clouds
+  --csv FILE           one row per episode: object, target, success, progress, seconds, stage,
+                       message
+  --dataset ROOT       the PartNet-Mobility folders under ROOT (at any depth, through symbolic
+                       links to folders) instead of generated cabinets
+  --ids A,B,...        with --dataset: only the folders of these names, in this order
+  --targets all|one    with --dataset: every target of each object, or one drawn by the seed
+                       (default one)
 )";
 
 struct TasksArgs {
@@ -139,11 +162,13 @@ std::vector<Episode> DatasetEpisodes(const TasksArgs& a) {
   std::error_code ec;
   if (!fs::is_directory(a.dataset, ec))
     throw std::runtime_error("--dataset '" + a.dataset + "' is not a folder");
+  // object folders at any depth, through symbolic links (a subset of the dataset)
   std::vector<fs::path> folders;
-  for (auto it = fs::recursive_directory_iterator(a.dataset, ec);
-       !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
-    if (it->path().filename() == "mobility.urdf") folders.push_back(it->path().parent_path());
-  std::sort(folders.begin(), folders.end());
+  try {
+    for (const std::string& f : FindPartNetMobilityFolders(a.dataset)) folders.emplace_back(f);
+  } catch (const Error& e) {
+    throw std::runtime_error(std::string("--dataset: ") + e.what());
+  }
   if (!a.ids.empty()) {
     std::vector<fs::path> keep;
     for (const std::string& id : a.ids) {

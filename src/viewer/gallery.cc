@@ -33,32 +33,6 @@ using Json = nlohmann::json;
 
 std::string Dump(const Json& j) { return j.dump(-1, ' ', false, Json::error_handler_t::replace); }
 
-/// Object folders (holding mobility.urdf) under `dir`, at any depth, and the folders that could
-/// not be listed.
-void FindObjectFolders(const fs::path& dir, std::vector<fs::path>* objects,
-                       std::vector<std::pair<fs::path, std::string>>* unreadable) {
-  std::error_code ec;
-  if (fs::is_regular_file(dir / "mobility.urdf", ec)) {
-    objects->push_back(dir);
-    return;  // an object's own subfolders (textured_objs/, images/) hold no objects
-  }
-  fs::directory_iterator it(dir, ec), end;
-  if (ec) {
-    unreadable->emplace_back(dir, "cannot read the folder: " + ec.message());
-    return;
-  }
-  std::vector<fs::path> subfolders;
-  for (; it != end; it.increment(ec)) {
-    if (ec) {
-      unreadable->emplace_back(dir, "cannot read the folder: " + ec.message());
-      break;
-    }
-    std::error_code kind;
-    if (it->is_directory(kind) && !it->is_symlink(kind)) subfolders.push_back(it->path());
-  }
-  for (const fs::path& sub : subfolders) FindObjectFolders(sub, objects, unreadable);
-}
-
 /// The folder's name relative to the root ("." for the root itself).
 std::string Relative(const fs::path& folder, const fs::path& root) {
   std::string rel = folder.lexically_relative(root).generic_string();
@@ -102,11 +76,13 @@ Gallery::Gallery(const GalleryOptions& options) : options_(options) {
   if (!fs::is_directory(root, ec))
     throw Error("dataset folder '" + options.root + "' is not a folder");
 
-  std::vector<fs::path> folders;
-  std::vector<std::pair<fs::path, std::string>> unreadable;
-  FindObjectFolders(root, &folders, &unreadable);
-  std::sort(folders.begin(), folders.end());
-  for (const auto& [dir, why] : unreadable) errors_.push_back({Relative(dir, root), why});
+  // object folders at any depth, through symbolic links; what cannot be searched (a folder
+  // that cannot be read, a link loop) is listed with the errors
+  std::vector<UnreadableFolder> unreadable;
+  const std::vector<std::string> found = FindPartNetMobilityFolders(options.root, &unreadable);
+  const std::vector<fs::path> folders(found.begin(), found.end());
+  for (const UnreadableFolder& u : unreadable)
+    errors_.push_back({Relative(u.folder, root), u.reason});
 
   PartNetMobilityLoader loader;
   loader.urdf.load_collisions = false;  // labels and joints: the scan draws and steps nothing

@@ -139,10 +139,11 @@ std::vector<std::string> FindObjectFolders(const std::string& root) {
   if (!fs::is_directory(root))
     throw Error("vision dataset: --dataset '" + root + "' is not a folder");
   std::vector<std::string> folders;
-  for (const auto& e : fs::recursive_directory_iterator(root))
-    if (e.is_regular_file() && e.path().filename() == "mobility.urdf")
-      folders.push_back(e.path().parent_path().string());
-  std::sort(folders.begin(), folders.end());
+  try {
+    folders = FindPartNetMobilityFolders(root);
+  } catch (const Error& e) {
+    throw Error(std::string("vision dataset: --dataset ") + e.what());
+  }
   if (folders.empty())
     throw Error("vision dataset: no PartNet-Mobility object (a folder with mobility.urdf) under '" +
                 root + "'");
@@ -150,7 +151,8 @@ std::vector<std::string> FindObjectFolders(const std::string& root) {
 }
 
 std::string ObjectName(const std::string& root, const std::string& folder) {
-  std::string rel = fs::relative(folder, root).generic_string();
+  // lexically: a folder reached through a symbolic link keeps the link's name
+  std::string rel = fs::path(folder).lexically_relative(root).generic_string();
   if (rel.empty() || rel == ".") rel = fs::path(folder).filename().string();
   std::replace(rel.begin(), rel.end(), '/', '_');
   return rel;

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -215,6 +216,78 @@ TEST_F(PartNetMobilityTest, BrokenFilesAreNamedAndTheBatchGoesOn) {
   EXPECT_NE(batch[2].error.find("mobility_v2.json: malformed JSON"), std::string::npos)
       << batch[2].error;
   EXPECT_FALSE(batch[3].ok);
+}
+
+// A subset of a dataset as a folder of symbolic links to object folders (and to a category
+// folder of objects): every object is found, by the path through its link.
+TEST_F(PartNetMobilityTest, DatasetSearchFollowsLinksToFolders) {
+  const fs::path base = fs::temp_directory_path() / "partsim_pm/links";
+  fs::remove_all(base);
+  Folder a("links/data/a");
+  Folder b("links/data/cat/b");
+  Folder c("links/data/cat/c");
+  const fs::path subset = base / "subset";
+  fs::create_directories(subset / "plain");
+  fs::create_directory_symlink(a.dir, subset / "link_a");
+  fs::create_directory_symlink("../data/cat", subset / "link_cat");  // relative link
+  Write(subset / "plain/readme.txt", "not an object");
+  fs::create_symlink(subset / "plain/readme.txt", subset / "link_to_file");  // not followed
+  const std::vector<std::string> found = FindPartNetMobilityFolders(subset.string());
+  const std::vector<std::string> expected = {(subset / "link_a").string(),
+                                             (subset / "link_cat/b").string(),
+                                             (subset / "link_cat/c").string()};
+  EXPECT_EQ(found, expected);
+  // the batch reads them too
+  std::vector<PartNetBatchEntry> batch =
+      ParsePartNetMobilityBatch(subset.string(), PartNetMobilityLoader());
+  ASSERT_EQ(batch.size(), 3u);
+  for (const PartNetBatchEntry& e : batch) EXPECT_TRUE(e.ok) << e.folder << ": " << e.error;
+}
+
+// Links that would make the search go round forever are refused by the link's name: a link to a
+// folder above it, and two links that lead to one another. A link to nothing is named too.
+TEST_F(PartNetMobilityTest, DatasetSearchRefusesLinkLoopsByName) {
+  const fs::path base = fs::temp_directory_path() / "partsim_pm/loops";
+  fs::remove_all(base);
+  Folder a("loops/up/a");
+  fs::create_directories(base / "up/deeper");
+  fs::create_directory_symlink("..", base / "up/deeper/to_parent");
+  fs::create_directories(base / "pair");
+  fs::create_symlink("second", base / "pair/first");
+  fs::create_symlink("first", base / "pair/second");
+  fs::create_directories(base / "above/inner");
+  fs::create_directory_symlink("../..", base / "above/inner/to_above_the_root");
+  fs::create_directories(base / "dangling");
+  fs::create_symlink("no_such_folder", base / "dangling/gone");
+
+  auto expect_refused = [](const fs::path& root, const fs::path& link) {
+    try {
+      FindPartNetMobilityFolders(root.string());
+      ADD_FAILURE() << "no error for " << link;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(link.string()), std::string::npos) << e.what();
+    }
+  };
+  expect_refused(base / "up", base / "up/deeper/to_parent");
+  expect_refused(base / "above", base / "above/inner/to_above_the_root");
+  expect_refused(base / "pair", base / "pair/first");  // the first in path order
+  expect_refused(base / "dangling", base / "dangling/gone");
+
+  // with a list for what cannot be searched, the rest is still found
+  std::vector<UnreadableFolder> unreadable;
+  const std::vector<std::string> found = FindPartNetMobilityFolders(base.string(), &unreadable);
+  EXPECT_EQ(found, std::vector<std::string>{a.Path()});
+  std::vector<std::string> named;
+  for (const UnreadableFolder& u : unreadable) named.push_back(u.folder);
+  std::sort(named.begin(), named.end());
+  EXPECT_EQ(named, (std::vector<std::string>{
+                       (base / "above/inner/to_above_the_root").string(),
+                       (base / "dangling/gone").string(), (base / "pair/first").string(),
+                       (base / "pair/second").string(), (base / "up/deeper/to_parent").string()}));
+  for (const UnreadableFolder& u : unreadable)
+    EXPECT_NE(u.reason.find(u.folder.find("gone") != std::string::npos ? "does not exist" : "loop"),
+              std::string::npos)
+        << u.folder << ": " << u.reason;
 }
 
 TEST_F(PartNetMobilityTest, BrokenFolderLeavesTheSceneUsable) {

@@ -5,12 +5,14 @@
 #include <sys/wait.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -636,6 +638,74 @@ TEST_F(CliTest, TasksEvaluateRunsOnADatasetFolderTree) {
   EXPECT_EQ(r.code, 1) << r.output;
   EXPECT_TRUE(Contains(r.output, "no PartNet-Mobility folder 'nope'")) << r.output;
   EXPECT_EQ(RunCli("tasks evaluate --ids 1").code, 2);
+}
+
+// A subset of a dataset as a folder of symbolic links to object folders, the usual way to pick
+// one: each command that reads a dataset tree sees the linked objects, by the links' names, and
+// refuses a link loop by the link's name (the gallery lists it and shows the rest).
+TEST_F(CliTest, DatasetCommandsFollowSymbolicLinksAndRefuseLoops) {
+  const fs::path data = dir_ / "data";
+  RunResult g = RunCli("assets generate --categories StorageFurniture --per-category 4 --out '" +
+                       data.string() + "'");
+  ASSERT_EQ(g.code, 0) << g.output;
+  std::vector<std::string> ids;
+  for (const auto& e : fs::directory_iterator(data))
+    if (fs::exists(e.path() / "mobility.urdf")) ids.push_back(e.path().filename().string());
+  std::sort(ids.begin(), ids.end());
+  ASSERT_EQ(ids.size(), 4u);
+  // the subset: two absolute links, and a relative link in a subfolder of plain folders
+  const fs::path subset = dir_ / "subset";
+  fs::create_directories(subset / "more");
+  fs::create_directory_symlink(data / ids[0], subset / "first");
+  fs::create_directory_symlink(data / ids[1], subset / "second");
+  fs::create_directory_symlink("../../data/" + ids[2], subset / "more" / "third");
+  const std::string root = "'" + subset.string() + "'";
+
+  RunResult r = RunCli("assets check " + root + " --no-visibility");
+  EXPECT_TRUE(Contains(r.output, "checked 3 objects")) << r.output;
+
+  r = RunCli("view --dataset " + root + " --port 0 --duration 0.2");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Contains(r.output, "3 objects under")) << r.output;
+  EXPECT_TRUE(Contains(r.output, "(0 folders could not be read)")) << r.output;
+
+  r = RunCli("vision detection-dataset --dataset " + root + " --out '" + (dir_ / "det").string() +
+             "' --views 1 --size 32 --no-point-clouds --quiet");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Contains(r.output, "3 objects (3 rendered now")) << r.output;
+  // objects are named by their paths under ROOT, through the links
+  EXPECT_TRUE(fs::exists(dir_ / "det" / "objects" / "more_third")) << r.output;
+
+  const fs::path csv = dir_ / "episodes.csv";
+  r = RunCli("tasks evaluate --task drawer --dataset " + root +
+             " --ids first,second,third --no-cameras --jobs 3 --csv '" + csv.string() + "'");
+  EXPECT_FALSE(Contains(r.output, "no PartNet-Mobility folder")) << r.output;
+  std::ifstream in(csv);
+  std::string csv_text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // objects without a drawer are skipped by name; the others have a row
+  for (const char* id : {"first", "second", "third"})
+    EXPECT_TRUE(Contains(csv_text, std::string("\n") + id + ",") ||
+                Contains(r.output, std::string(id) + ": skipped"))
+        << id << "\n"
+        << r.output << csv_text;
+
+  // a link to a folder above it: refused by name, not followed round and round
+  const fs::path loop = subset / "more" / "back_up";
+  fs::create_directory_symlink("..", loop);
+  for (const std::string& command :
+       {"assets check " + root + " --no-visibility",
+        "vision detection-dataset --dataset " + root + " --out '" + (dir_ / "det2").string() +
+            "' --views 1 --size 32 --quiet",
+        "tasks evaluate --task drawer --dataset " + root + " --no-cameras"}) {
+    r = RunCli(command);
+    EXPECT_EQ(r.code, 1) << command << "\n" << r.output;
+    EXPECT_TRUE(Contains(r.output, loop.string())) << command << "\n" << r.output;
+    EXPECT_TRUE(Contains(r.output, "loop")) << command << "\n" << r.output;
+  }
+  r = RunCli("view --dataset " + root + " --port 0 --duration 0.2");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(Contains(r.output, "3 objects under")) << r.output;
+  EXPECT_TRUE(Contains(r.output, "more/back_up: symbolic link")) << r.output;
 }
 
 TEST_F(CliTest, TasksEvaluateOnTheRealSamplesSaysWhatItFound) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -108,6 +109,28 @@ Pose StandingRootPose(const Articulation& articulation, double altitude = 0.0);
 /// Moves the articulation's root to StandingRootPose.
 void PlaceOnGround(Articulation& articulation, double altitude = 0.0);
 
+/// A folder that a dataset search could not list, and why.
+struct UnreadableFolder {
+  std::string folder;  ///< the path as reached from the root (through links, not resolved)
+  std::string reason;  ///< e.g. "cannot read the folder: Permission denied"
+};
+
+/// The folders under `root` (`root` itself included) that `is_object` accepts, sorted by path,
+/// searched at any depth without looking inside an accepted folder. Symbolic links to folders
+/// are followed (a folder of links is the usual way to pick a subset of a dataset), and the
+/// paths returned go through them, as reached from `root`. What cannot be searched is added to
+/// `unreadable` with the reason when it is given, else throws partsim::Error naming it: a
+/// folder that cannot be listed, a link whose target is missing, and a link loop (a link to a
+/// folder that holds it, or links that lead to one another), named by the link, which is not
+/// followed. Throws when `root` is not a folder.
+std::vector<std::string> FindDatasetFolders(
+    const std::string& root, const std::function<bool(const std::string& folder)>& is_object,
+    std::vector<UnreadableFolder>* unreadable = nullptr);
+
+/// FindDatasetFolders of PartNet-Mobility objects: the folders that hold mobility.urdf.
+std::vector<std::string> FindPartNetMobilityFolders(
+    const std::string& root, std::vector<UnreadableFolder>* unreadable = nullptr);
+
 /// Result of reading one folder of a batch.
 struct PartNetBatchEntry {
   std::string folder;
@@ -116,8 +139,9 @@ struct PartNetBatchEntry {
   PartNetMobilityObject object;
 };
 
-/// Parses every object folder under `root` (a folder holding mobility.urdf, at any depth),
-/// sorted by path; a bad folder is reported in its entry and the rest are still read.
+/// Parses every object folder under `root` (FindPartNetMobilityFolders: a folder holding
+/// mobility.urdf, at any depth, through links), sorted by path; a bad folder is reported in its
+/// entry and the rest are still read.
 std::vector<PartNetBatchEntry> ParsePartNetMobilityBatch(const std::string& root,
                                                          const PartNetMobilityLoader& loader);
 
