@@ -22,6 +22,7 @@ constexpr char kAssetsUsage[] = R"(usage:
                           [--seed S] [--jobs J] [--by-category] [--overwrite]
   partsim assets categories
   partsim assets check DIR [--jobs J] [--no-visibility] [--backend B] [--report FILE]
+                       [--limit N]
   partsim assets decompose MESH --out DIR [--concavity C] [--max-pieces N]
 
 generate     writes DIR/<anno_id>/ folders in the PartNet-Mobility format, laid out as the

@@ -34,6 +34,20 @@ constexpr char kDetectionDatasetUsage[] =
       "<object category>/<part label>"), split by object within each category. Same seed,
       same bytes, whatever --jobs and --shard; objects already done are skipped
       (docs/vision.md).
+        --dataset ROOT       the objects: folders holding mobility.urdf, at any depth, through
+                             symbolic links to folders (a folder of links picks a subset)
+        --out DIR            output folder
+        --views N            pictures per object (motion: samples per target part; default 20)
+        --size PX            picture width and height in pixels (default 512)
+        --seed S             seed of the joint states, the cameras and the split (default 0)
+        --split F            fraction of each category's objects in the train split (0.75)
+        --jobs J             worker threads, each rendering whole objects (default 1)
+        --shard i/N          render only the objects whose index % N is i (several processes
+                             or machines into one DIR); the split files cover every object done
+        --backend B          rasterizer (default) or pathtracer
+        --no-point-clouds    detection: write no point cloud NPZ files
+        --merge-only         render nothing: write the split files from the objects done
+        --quiet              no progress lines on stderr
 )";
 
 constexpr char kMotionDatasetUsage[] =
