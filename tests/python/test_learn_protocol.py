@@ -177,6 +177,51 @@ def test_resume_after_an_interruption_continues_the_same_run(tmp_path):
             assert torch.equal(v, sb[name][k]), f"{name}.{k} differs after the resume"
 
 
+# a run shorter than its first log row and first checkpoint: 4 environments step together, so
+# 10 steps end at 12
+SHORT = ["--task", "drawer", "--obs", "mobility", "--seed", "0", "--train-objects", "2",
+         "--test-objects", "2", "--num-envs", "4", "--hidden", "16,16", "--quiet"]
+
+
+def progress_rows(run):
+    with open(run / "progress.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def test_a_run_shorter_than_a_log_interval_finishes_and_a_rerun_exits_0(tmp_path):
+    run = tmp_path / "run"
+    first = learn("train", "--steps", "10", "--out", run, *SHORT)
+    assert json.loads(first.stdout.splitlines()[-1])["env_steps"] == 12
+    rows = progress_rows(run)
+    assert [int(r["env_steps"]) for r in rows] == [12]  # the run's last step, logged
+    assert int(rows[0]["updates"]) == 0 and rows[0]["q1_loss"] == ""  # all warm-up
+    assert json.loads((run / "checkpoint.json").read_text())["env_steps"] == 12
+    assert (run / "curves.png").stat().st_size > 1000
+
+    # the same command again: finished, nothing changes
+    files = {name: (run / name).read_bytes()
+             for name in ("run.json", "progress.csv", "checkpoint.json", "curves.png")}
+    again = learn("train", "--steps", "10", "--out", run, *SHORT)
+    assert "already finished" in again.stderr and "12 environment steps" in again.stderr
+    assert json.loads(again.stdout.splitlines()[-1]) == {"env_steps": 12,
+                                                         "already_finished": True}
+    for name, data in files.items():
+        assert (run / name).read_bytes() == data, name
+    # asking fewer steps than the run's own is still refused
+    fewer = learn("train", "--steps", "8", "--out", run, *SHORT, check=False)
+    assert fewer.returncode == 2 and "has trained 12 steps already" in fewer.stderr
+
+
+def test_the_last_row_of_a_short_run_gives_way_when_it_is_continued(tmp_path):
+    run = tmp_path / "run"
+    learn("train", "--steps", "10", "--log-interval", "8", "--out", run, *SHORT)
+    assert [int(r["env_steps"]) for r in progress_rows(run)] == [8, 12]
+    # trained further: the row at 12 was the end of the shorter run, not an interval's
+    learn("train", "--steps", "20", "--log-interval", "8", "--out", run, *SHORT)
+    assert [int(r["env_steps"]) for r in progress_rows(run)] == [8, 16, 20]
+    assert json.loads((run / "run.json").read_text())["config"]["steps"] == 20
+
+
 @pytest.mark.parametrize("args, message", [
     (["train", "--task", "window", "--out", "X"], "task must be 'door' or 'drawer'"),
     (["train", "--obs", "depth", "--out", "X"], "obs must be"),

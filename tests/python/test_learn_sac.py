@@ -630,6 +630,17 @@ def test_a_run_continued_to_more_steps_equals_a_longer_run(tmp_path):
         ["agent.pt", "buffer.npz", "loop.json"]
 
 
+def test_a_finished_run_resumed_as_it_is_keeps_its_last_row(tmp_path):
+    # 150 steps is not a multiple of the log interval (40): the last row is the run's end
+    reach_run(tmp_path / "run", 150)
+    before = (tmp_path / "run" / "progress.csv").read_bytes()
+    assert [int(r["env_steps"]) for r in csv_rows(tmp_path / "run" / "progress.csv")] == \
+        [40, 80, 120, 150]
+    _, summary = reach_run(tmp_path / "run", 150, resume=True)
+    assert summary["env_steps"] == 150
+    assert (tmp_path / "run" / "progress.csv").read_bytes() == before
+
+
 def test_evaluate_single_and_vector_environments():
     agent = SAC(ReachEnv().observation_space, ReachEnv().action_space, SMALL, seed=0)
     single = evaluate(ReachEnv(max_episode_steps=10), agent, 3, seed=7)

@@ -247,11 +247,14 @@ def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
     (steps, seconds, environment steps/s, updates/s).
 
     A folder holding a run of the same configuration continues from its last checkpoint: a run
-    cut short by a crash loses nothing, a finished run returns at once, and one started again
-    with more ``steps`` goes on to them (equal to a run of that length from the start when the
-    steps done are a multiple of ``checkpoint_interval``). A folder holding a different run is
-    refused with the options that differ. Torch runs on one thread per
-    process unless ``torch.set_num_threads`` was called before.
+    cut short by a crash loses nothing, and one started again with more ``steps`` goes on to
+    them (equal to a run of that length from the start when the steps done are a multiple of
+    ``checkpoint_interval``). A run that has trained ``steps`` already (the environments step
+    together, so a run may end up to ``num_envs - 1`` steps past them) is finished: it returns
+    at once, changing nothing, with ``already_finished`` True in the summary. A folder holding a
+    different run, or one that has trained more steps than ``steps`` and than its own
+    configuration asks, is refused with a ValueError. Torch runs on one thread per process
+    unless ``torch.set_num_threads`` was called before.
     """
     import torch
 
@@ -275,9 +278,11 @@ def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
             raise ValueError(f"{out!r}: the objects of the run changed (the dataset under "
                              f"{config.dataset!r} is not what it was)")
         done = _checkpoint_steps(out)
-        if config.steps < done:
+        if config.steps < done and config.steps < int(old["config"].get("steps", 0)):
             raise ValueError(f"{out!r} has trained {done} steps already, more than --steps "
                              f"{config.steps}")
+        if done >= config.steps:
+            return {"env_steps": done, "already_finished": True}
     if not resume or doc != old:
         os.makedirs(out, exist_ok=True)
         tmp = run_file + ".tmp"
@@ -301,7 +306,8 @@ def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
     finally:
         env.close()
     try:
-        plot_curves(out)
+        if summary and summary.get("env_steps", 0) > 0:  # a run of 0 steps has no rows
+            plot_curves(out)
     except ImportError:  # matplotlib is optional: the CSV has the curves
         pass
     summary = dict(summary or {})
@@ -545,8 +551,8 @@ USAGE = """usage:
 train      trains SAC on N training objects (generated StorageFurniture, or the PartNet-Mobility
            folders under ROOT) into the folder RUN: run.json, progress.csv (returns, success,
            losses, steps/s), checkpoints, curves.png. Run it again with the same options to
-           continue after a crash (a finished run is left as it is), or with a larger --steps
-           to train it further.
+           continue after a crash (a finished run is left as it is and exits 0), or with a
+           larger --steps to train it further.
 evaluate   plays the run's policy deterministically, --episodes per object, on its training
            and its unseen test objects; writes RUN/eval.json and RUN/eval.csv and prints the
            paper's metric (door: final angle, degrees; drawer: success at 80% of the range).
@@ -636,6 +642,11 @@ def main(argv=None) -> int:
                 fields["dataset"] = os.path.abspath(fields["dataset"])
             config = RunConfig(**fields)
             summary = train(config, opts["out"], quiet=opts.get("quiet", False))
+            if summary.get("already_finished"):
+                print(f"partsim learn train: {opts['out']!r} is already finished "
+                      f"({summary['env_steps']} environment steps for --steps "
+                      f"{config.steps}); nothing to do (a larger --steps trains it further)",
+                      file=sys.stderr)
             print(json.dumps(summary))
             return 0
         if command == "evaluate":

@@ -21,6 +21,12 @@ objects repeats the steps after its last checkpoint exactly as an uninterrupted 
 environments whose ``reset(seed=...)`` fixes everything that follows (partsim's do). The end of
 a run is a segment end too: a run of 2k steps continued to 4k equals a 4k run when k is a
 multiple of the checkpoint interval.
+
+The last row of progress.csv is at the run's last step, also when that is not a multiple of
+``log_interval`` (a run shorter than one interval gets that row alone). Such a row sums up the
+steps since the previous row, and the last checkpoint keeps it aside. A run continued to more
+steps drops it and logs on from the checkpoint's state, as the longer run does. A finished run
+resumed as it is writes it back.
 """
 
 from __future__ import annotations
@@ -165,6 +171,9 @@ class Trainer:
         self.csv_bytes = 0
         self.wall_before = 0.0  # seconds of training before this process's train()
         self._t_start = time.perf_counter()
+        # the CSV text of the row written at the run's end past csv_bytes (see the module's
+        # docstring), or None
+        self._final_row = None
 
     @staticmethod
     def _empty_window():
@@ -177,7 +186,7 @@ class Trainer:
             "update_credit": self.update_credit, "rng": self.rng.bit_generator.state,
             "window": self._window, "csv_bytes": self.csv_bytes,
             "wall_s": self.wall_before + time.perf_counter() - self._t_start,
-            "config": dataclasses.asdict(self.config),
+            "config": dataclasses.asdict(self.config), "final_row": self._final_row,
         }
 
     def _load_loop_state(self, s: dict):
@@ -188,6 +197,7 @@ class Trainer:
         self._window = s["window"]
         self.csv_bytes = int(s["csv_bytes"])
         self.wall_before = float(s.get("wall_s", 0.0))
+        self._final_row = s.get("final_row")
 
     # --- checkpoints ------------------------------------------------------------------------
 
@@ -219,8 +229,8 @@ class Trainer:
 
     def load_checkpoint(self) -> bool:
         """Restores the last checkpoint of the run folder into the agent, the buffer and the
-        loop state, and cuts progress.csv back to its length then; False when there is
-        none."""
+        loop state, and cuts progress.csv back to its length then (with the run's final row
+        when the checkpoint is at the end of ``total_steps``); False when there is none."""
         d = self.checkpoint_dir()
         if d is None:
             return False
@@ -231,6 +241,9 @@ class Trainer:
         if os.path.exists(self.csv_path):
             with open(self.csv_path, "r+b") as f:
                 f.truncate(self.csv_bytes)
+                if self._final_row and self.env_steps >= self.config.total_steps:
+                    f.seek(self.csv_bytes)
+                    f.write(self._final_row.encode())
         return True
 
     # --- the loop ---------------------------------------------------------------------------
@@ -316,11 +329,16 @@ class Trainer:
                         losses[k] = losses.get(k, 0.0) + float(v)
                     self._window["updates"] += 1
 
-            if self.env_steps >= next_log:
+            logged = self.env_steps >= next_log
+            if logged:
                 self._log_row()
                 next_log = (self.env_steps // cfg.log_interval + 1) * cfg.log_interval
             if self.env_steps >= next_ckpt or self.env_steps >= cfg.total_steps:
                 self.segment += 1
+                self._final_row = None
+                if self.env_steps >= cfg.total_steps and not logged:
+                    # the run's last step: a row for it, kept out of csv_bytes and the window
+                    self._final_row = self._log_row(final=True)
                 self.save_checkpoint()
                 next_ckpt = (self.env_steps // interval + 1) * interval
                 if self.env_steps < cfg.total_steps:
@@ -333,16 +351,18 @@ class Trainer:
                 "env_steps_per_s": steps / wall if wall > 0 else float("nan"),
                 "updates_per_s": updates / wall if wall > 0 else float("nan")}
 
-    def _log_row(self):
-        """Appends a row to progress.csv from the window's statistics and prints a progress
-        line."""
+    def _log_row(self, final=False):
+        """Appends a row to progress.csv from the window's statistics, prints a progress line
+        and returns the row's text. ``final``: the row at the run's last step, off the log
+        interval; csv_bytes, the window and the rates' reference point stay as they were."""
         w = self._window
         now = time.perf_counter()
         t0, s0, u0 = self._last_log
         dt = max(now - t0, 1e-9)
         steps_per_s = (self.env_steps - s0) / dt
         updates_per_s = (self.agent.updates - u0) / dt
-        self._last_log = (now, self.env_steps, self.agent.updates)
+        if not final:
+            self._last_log = (now, self.env_steps, self.agent.updates)
         row = {
             "env_steps": self.env_steps, "episodes": self.episodes,
             "updates": self.agent.updates,
@@ -359,10 +379,12 @@ class Trainer:
         data = buf.getvalue().encode()
         with open(self.csv_path, "ab") as f:
             f.write(data)
-        self.csv_bytes += len(data)
-        self._window = self._empty_window()
+        if not final:
+            self.csv_bytes += len(data)
+            self._window = self._empty_window()
         if not self.config.quiet:
             self._print_progress(row, steps_per_s)
+        return buf.getvalue()
 
     def _print_progress(self, row, steps_per_s):
         total = self.config.total_steps
