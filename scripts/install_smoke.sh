@@ -58,7 +58,7 @@ assert os.path.realpath(p.__file__).startswith(os.path.realpath(sys.argv[1]) + '
 env -u PYTHONPATH PARTSIM_PYTHON="$src/.venv/bin/python" partsim learn train --task drawer \
   --obs mobility --train-objects 1 --test-objects 1 --steps 10 --num-envs 1 --warmup-steps 5 \
   --batch-size 4 --buffer-size 100 --hidden 8 --quiet --out "$work/run" >"$work/learn.txt"
-grep -q '"steps": 10' "$work/learn.txt" || { echo "partsim learn train: $(cat "$work/learn.txt")"; exit 1; }
+grep -q '"env_steps": 10' "$work/learn.txt" || { echo "partsim learn train: $(cat "$work/learn.txt")"; exit 1; }
 echo "-- an example that runs the command line finds the installed one, without PATH's help"
 env PATH=/usr/bin:/bin "$src/.venv/bin/python" "$src/examples/cabinet_generator.py" \
   --out "$work/cabinet" >/dev/null

@@ -84,7 +84,7 @@ grep -q "partsim learn train" <<<"$help" || { echo "partsim learn --help failed:
 partsim learn train --task drawer --obs mobility --train-objects 1 --test-objects 1 --steps 10 \
   --num-envs 1 --warmup-steps 5 --batch-size 4 --buffer-size 100 --hidden 8 --quiet \
   --out "$work/run" >"$work/learn.txt"
-grep -q '"steps": 10' "$work/learn.txt" || { echo "partsim learn train: $(cat "$work/learn.txt")"; exit 1; }
+grep -q '"env_steps": 10' "$work/learn.txt" || { echo "partsim learn train: $(cat "$work/learn.txt")"; exit 1; }
 "$py" -c "import partsim.learn.protocol as p, os, sys; \
 assert os.path.realpath(p.__file__).startswith(os.path.realpath(sys.argv[1]) + '/'), p.__file__" \
   "$work/venv"
