@@ -21,22 +21,7 @@ echo "-- partsim on PATH: $(command -v partsim)"
 partsim --version
 
 echo "-- import partsim from $work"
-/usr/bin/python3 - "$prefix" <<'PY'
-import os, sys
-import partsim
-prefix = sys.argv[1]
-assert os.path.realpath(partsim.__file__).startswith(os.path.realpath(prefix) + "/"), partsim.__file__
-scene = partsim.Scene(timestep=1 / 500)
-scene.add_ground(0.0)
-b = scene.create_actor_builder()
-b.add_box_collision(half_size=[0.1, 0.1, 0.1])
-box = b.build(name="box")
-box.set_pose(partsim.Pose([0, 0, 0.5]))
-scene.step(1000)
-z = box.get_pose().p[2]
-assert abs(z - 0.1) < 0.01, z
-print("import partsim:", partsim.__file__, "- box at rest at z = %.3f m" % z)
-PY
+/usr/bin/python3 "$src/scripts/smoke_checks.py" scene "$prefix"
 
 echo "-- a C++ program with find_package(partsim)"
 cmake -S "$src/examples/cpp/hello_partsim" -B "$work/hello" -DCMAKE_PREFIX_PATH="$prefix" \
@@ -65,18 +50,5 @@ env PATH=/usr/bin:/bin "$src/.venv/bin/python" "$src/examples/cabinet_generator.
 ls "$work/cabinet" | grep -q . || { echo "cabinet_generator wrote nothing"; exit 1; }
 echo "-- the viewer's page, installed, found by the installed package (from $work)"
 [ -f "$prefix/share/partsim/web/index.html" ] || { echo "no $prefix/share/partsim/web/index.html"; exit 1; }
-/usr/bin/python3 - "$prefix" <<'PY'
-import os, sys, urllib.request
-import partsim
-prefix = os.path.realpath(sys.argv[1])
-viewer = partsim.Viewer(partsim.Scene())
-try:
-    root = os.path.realpath(viewer.web_root)
-    assert root == os.path.join(prefix, "share/partsim/web"), root
-    page = urllib.request.urlopen(f"http://127.0.0.1:{viewer.port}/", timeout=10).read()
-    assert b"viewer.js" in page, page[:200]
-finally:
-    viewer.close()
-print("viewer page:", root)
-PY
+/usr/bin/python3 "$src/scripts/smoke_checks.py" viewer "$prefix/share/partsim/web"
 echo "install smoke test: all passed ($prefix)"

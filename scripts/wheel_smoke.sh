@@ -35,42 +35,22 @@ echo "-- partsim on PATH: $(command -v partsim)"
 partsim --version
 
 echo "-- import partsim, a scene, Gymnasium's registry and the viewer's page (from $work)"
-"$py" - "$work/venv" <<'PY'
-import os, sys, urllib.request
+"$py" "$src/scripts/smoke_checks.py" scene "$work/venv"
+package="$("$py" -c 'import os, partsim; print(os.path.dirname(os.path.realpath(partsim.__file__)))')"
+"$py" "$src/scripts/smoke_checks.py" viewer "$package/share/partsim/web"
+"$py" - <<'PY'
+import os
+import gymnasium as gym
 import partsim
-venv = os.path.realpath(sys.argv[1])
 package = os.path.dirname(os.path.realpath(partsim.__file__))
-assert package.startswith(venv + "/"), partsim.__file__
 assert partsim.find_cli() == os.path.join(package, "bin", "partsim"), partsim.find_cli()
 assert os.path.isfile(os.path.join(package, "_partsim.pyi")), "no type stubs in the wheel"
-scene = partsim.Scene(timestep=1 / 500)
-scene.add_ground(0.0)
-b = scene.create_actor_builder()
-b.add_box_collision(half_size=[0.1, 0.1, 0.1])
-box = b.build(name="box")
-box.set_pose(partsim.Pose([0, 0, 0.5]))
-scene.step(1000)
-z = box.get_pose().p[2]
-assert abs(z - 0.1) < 0.01, z
-print("import partsim:", partsim.__file__, "- box at rest at z = %.3f m" % z)
-
-import gymnasium as gym
 env = gym.make("partsim/OpenCabinetDrawer-v0", obs_mode="mobility")
 obs, info = env.reset(seed=0)
 obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
 assert env.observation_space.contains(obs), obs
 env.close()
 print("gymnasium.make('partsim/OpenCabinetDrawer-v0'): a step, reward %.3f" % reward)
-
-viewer = partsim.Viewer(partsim.Scene())
-try:
-    root = os.path.realpath(viewer.web_root)
-    assert root == os.path.join(package, "share/partsim/web"), root
-    page = urllib.request.urlopen(f"http://127.0.0.1:{viewer.port}/", timeout=10).read()
-    assert b"viewer.js" in page, page[:200]
-finally:
-    viewer.close()
-print("viewer page:", root)
 PY
 
 echo "-- two examples run from $work (one of them runs the command line it finds)"
