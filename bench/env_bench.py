@@ -1,4 +1,4 @@
-"""Steps per second of the Gymnasium-style environments (python/partsim/envs.py).
+"""Steps per second of the Gymnasium environments (python/partsim/envs.py).
 
 Measures, on the drawer task with the gripper starting on the handle:
 

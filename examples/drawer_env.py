@@ -1,4 +1,4 @@
-"""The Gymnasium-style drawer-pulling environment (`partsim.envs.OpenCabinetEnv`): an episode
+"""The Gymnasium drawer-pulling environment (`partsim.envs.OpenCabinetEnv`): an episode
 on a generated cabinet with the flying gripper starting closed on the drawer's handle, driven
 by a few-line heuristic (pull along the drawer's axis, read from the "mobility" observation) or
 by random actions; frames from `env.render()` and the rewards are saved.

@@ -53,7 +53,7 @@ PAGES = [
 # the package's Python modules, one page each: module, page slug, title, summary
 MODULE_PAGES = [
     ("partsim.envs", "envs", "Environments (partsim.envs)",
-     "Gymnasium-style environments of the tasks, in pure Python."),
+     "The tasks as Gymnasium environments (gymnasium.Env, gymnasium.vector.VectorEnv), registered for gymnasium.make."),
     ("partsim.vision", "vision", "Vision (partsim.vision)",
      "COCO masks and RLE, and the evaluators of movable-part detection and motion attributes."),
 ]
