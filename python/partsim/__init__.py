@@ -39,6 +39,19 @@ def _missing_library_message(error: ImportError) -> str:
             f"these Debian 12 packages: apt-get install {packages}")
 
 
+def _check_numpy():
+    """The compiled module is built with Debian 12's pybind11 (2.10), whose numpy arrays use
+    numpy 1.x's C API: with numpy 2 the first array crashes the process, so refuse to load."""
+    import numpy
+
+    if int(numpy.__version__.split(".")[0]) >= 2:
+        raise ImportError(
+            f"partsim needs numpy 1.x (this is numpy {numpy.__version__} from "
+            f"{numpy.__file__}): its compiled module is built with pybind11 2.10, which predates "
+            "numpy 2's C API; install numpy<2 (pip install 'numpy<2')")
+
+
+_check_numpy()
 try:
     from ._partsim import *  # noqa: F401,F403
 except ImportError as _e:

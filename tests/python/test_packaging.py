@@ -71,6 +71,18 @@ def test_a_real_failed_load_names_the_missing_library(tmp_path):
     assert "libpartsim_absent.so.1" in p.stderr and "apt-get install" in p.stderr, p.stderr
 
 
+def test_numpy_2_is_refused_by_name_instead_of_crashing(tmp_path):
+    """With numpy 2 the module's arrays would crash the process (pybind11 2.10): import partsim
+    refuses with a message that names the version and the fix."""
+    fake = tmp_path / "numpy"
+    fake.mkdir()
+    (fake / "__init__.py").write_text("__version__ = '2.4.6'\n")
+    p = subprocess.run([sys.executable, "-c", "import partsim"], capture_output=True, text=True,
+                       cwd=tmp_path, env={**os.environ, "PYTHONPATH": f"{tmp_path}:{PYTHON_DIR}"})
+    assert p.returncode != 0
+    assert "numpy 2.4.6" in p.stderr and "numpy<2" in p.stderr, p.stderr
+
+
 def test_find_cli_finds_the_build_trees_command_line(monkeypatch):
     monkeypatch.delenv("PARTSIM_CLI", raising=False)
     build = os.path.dirname(os.path.abspath(PYTHON_DIR))
