@@ -1,6 +1,11 @@
 #include "viewer/http_util.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cctype>
+#include <filesystem>
 #include <map>
 
 #include "core/ascii.h"
@@ -40,6 +45,38 @@ bool SafeBundlePath(const std::string& path) {
     at = end + 1;
   }
   return path.back() != '/';
+}
+
+std::string RegularFileInside(const std::string& file, const std::string& folder) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path root = fs::canonical(folder, ec);
+  if (ec || folder.empty()) return "";
+  const fs::path real = fs::canonical(file, ec);
+  if (ec) return "";
+  // inside: a relative path from the root that does not climb out of it
+  const fs::path rel = real.lexically_relative(root);
+  if (rel.empty() || rel == "." || *rel.begin() == "..") return "";
+  if (fs::status(real, ec).type() != fs::file_type::regular || ec) return "";
+  return real.string();
+}
+
+bool ReadRegularFile(const std::string& path, std::uintmax_t max_bytes, std::string* bytes) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return false;
+  struct stat st {};
+  bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) &&
+            static_cast<std::uintmax_t>(st.st_size) <= max_bytes;
+  bytes->clear();
+  char buf[65536];
+  while (ok) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n == 0) break;
+    if (n < 0 || bytes->size() + static_cast<size_t>(n) > max_bytes) ok = false;
+    if (ok) bytes->append(buf, static_cast<size_t>(n));
+  }
+  ::close(fd);
+  return ok;
 }
 
 std::string ContentTypeOf(const std::string& path) {

@@ -1,7 +1,9 @@
 // The HTTP side of the viewer, apart from its socket: splitting a request's resource, reading
-// its query, which bundle paths may be served, and their content types.
+// its query, which bundle paths may be served, which files may be read for them, and their
+// content types.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 namespace partsim::internal {
@@ -17,6 +19,16 @@ std::string QueryValue(const std::string& query, const std::string& key);
 /// segments of letters, digits, '.', '_' and '-' that do not start with '.', so that no path
 /// leaves the bundle folder ("/../", "%2e%2e", "\\", "//" and hidden files are refused).
 bool SafeBundlePath(const std::string& path);
+
+/// The canonical path of `file` when, once the links of both are followed, it is a regular file
+/// inside `folder` (or in a folder below it); "" when it is missing, a folder, a device, a FIFO or
+/// a socket, or lies outside (a link out of the folder, "../" that climbs out of it).
+std::string RegularFileInside(const std::string& file, const std::string& folder);
+
+/// Reads a regular file whole into `bytes`: opened without following a last link and without
+/// blocking, then checked with fstat, so a FIFO or a device swapped in is never read. False when
+/// it is not a regular file, cannot be read or holds more than `max_bytes`.
+bool ReadRegularFile(const std::string& path, std::uintmax_t max_bytes, std::string* bytes);
 
 /// K of a path "PREFIX" + K + "SUFFIX" ("/api/mesh/12.bin" with "/api/mesh/" and ".bin": 12),
 /// K a decimal of at most 9 digits; -1 for any other path.

@@ -3,17 +3,20 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 
 #include "partsim/physics/observer.h"
 #include "partsim/physics/scene.h"
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
+#include "viewer/http_util.h"
 
 namespace partsim::internal {
 
 namespace {
 
+namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
 Json PoseJson(const Pose& X) {
@@ -54,10 +57,31 @@ struct Indexer {
     primitive_index[key] = k;
     return k;
   }
-  int Texture(const std::string& path) {
+  int Texture(const VisualShape& v) {
+    const std::string& path = v.material.diffuse_texture;
     if (path.empty()) return -1;
-    auto [it, added] = texture_index.emplace(path, static_cast<int>(content->textures.size()));
-    if (added) content->textures.push_back(path);
+    // a mesh file's texture is sent only from the mesh's folder or the one above it
+    // (PartNet-Mobility: textured_objs/x.mtl names ../images/y.jpg), links followed: an MTL's
+    // map_Kd cannot name /etc/passwd or climb out with ../
+    std::string file;
+    if (v.mesh && !v.mesh->source.empty()) {
+      std::error_code ec;
+      const fs::path dir = fs::absolute(v.mesh->source, ec).parent_path();
+      file = RegularFileInside(path, dir.string());
+      if (file.empty()) file = RegularFileInside(path, dir.parent_path().string());
+    } else {
+      file = RegularFileInside(path, "/");
+    }
+    if (file.empty()) {
+      std::fprintf(stderr,
+                   "partsim viewer: warning: texture '%s' (of %s) is not a file in the folder "
+                   "of its mesh or the one above: the page shows the visual without it\n",
+                   path.c_str(),
+                   v.mesh && !v.mesh->source.empty() ? v.mesh->source.c_str() : "a visual");
+      return -1;
+    }
+    auto [it, added] = texture_index.emplace(file, static_cast<int>(content->textures.size()));
+    if (added) content->textures.push_back(file);
     return it->second;
   }
 };
@@ -136,7 +160,7 @@ std::shared_ptr<SceneContent> MakeSceneContent(Scene& scene, long long version) 
                          {"color", Json::array({c[0], c[1], c[2], c[3]})},
                          {"roughness", v.material.roughness},
                          {"metallic", v.material.metallic},
-                         {"texture", index.Texture(v.material.diffuse_texture)}});
+                         {"texture", index.Texture(v)}});
     }
     body["visuals"] = std::move(visuals);
     Json collisions = Json::array();

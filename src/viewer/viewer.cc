@@ -30,6 +30,7 @@
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
 #include "partsim/server/sim_server.h"
+#include "render/gl_util.h"
 #include "server/ros_json.h"
 #include "server/web_security.h"
 #include "viewer/http_util.h"
@@ -61,6 +62,8 @@ constexpr const char* kStatusTopic = "/partsim/status";
 constexpr const char* kContactsTopic = "/partsim/contacts";
 // files a texture request may send (bytes)
 constexpr std::uintmax_t kMaxTextureBytes = 64u << 20;
+// files of the web bundle the viewer sends (bytes)
+constexpr std::uintmax_t kMaxBundleFileBytes = 256u << 20;
 
 const char kNoBundlePage[] = R"(<!doctype html>
 <html><head><meta charset="utf-8"><title>partsim viewer</title></head>
@@ -874,9 +877,13 @@ struct Viewer::Impl {
     if (!internal::SafeBundlePath(path))
       return fail(400, "bad path '" + path +
                            "': only files of the web bundle are served (no '..', no '%')");
-    const fs::path file = fs::path(web_root.empty() ? "/nonexistent" : web_root) / path.substr(1);
-    std::error_code ec;
-    if (web_root.empty() || !fs::is_regular_file(file, ec)) {
+    // only regular files that stay inside the bundle folder once links are followed: no link
+    // out of it, no folder, no device, no FIFO (never opened)
+    const std::string file =
+        web_root.empty()
+            ? ""
+            : internal::RegularFileInside((fs::path(web_root) / path.substr(1)).string(), web_root);
+    if (file.empty() || !internal::ReadRegularFile(file, kMaxBundleFileBytes, body)) {
       // no bundle (or one without its page): say how to build it
       if (path == "/index.html") {
         *type = "text/html; charset=utf-8";
@@ -886,10 +893,6 @@ struct Viewer::Impl {
       return fail(404, "no file '" + path + "' in the web bundle (" +
                            (web_root.empty() ? "none found" : web_root) + ")");
     }
-    std::ifstream in(file, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    *body = ss.str();
     *type = internal::ContentTypeOf(path);
     return false;
   }
@@ -942,19 +945,21 @@ struct Viewer::Impl {
     }
     const long long tex = internal::PathIndex(path, "/api/texture/", ".png");
     if (tex >= 0 && tex < static_cast<long long>(ct->textures.size())) {
+      // only images leave: the file decoded as PNG or JPEG and sent as a PNG of its pixels
       const std::string& file = ct->textures[tex];
       std::error_code ec;
       const std::uintmax_t size = fs::file_size(file, ec);
-      if (ec || size > kMaxTextureBytes) {
+      internal::Image8 image;
+      try {
+        if (ec || size > kMaxTextureBytes) throw Error("cannot be read");
+        image = internal::LoadImageRgba8(file);
+      } catch (const Error&) {
         *status = 404;
-        *body = "texture " + std::to_string(tex) + " cannot be read\n";
+        *body = "texture " + std::to_string(tex) + " cannot be read as a PNG or JPEG image\n";
         return;
       }
-      std::ifstream in(file, std::ios::binary);
-      std::ostringstream ss;
-      ss << in.rdbuf();
-      *body = ss.str();
-      *type = internal::ImageContentType(*body);
+      *body = internal::EncodePng(image.width, image.height, 4, image.rgba.data());
+      *type = "image/png";
       return;
     }
     std::string extra;

@@ -222,3 +222,96 @@ def test_make_cabinet_urdf_is_the_built_in_cabinet():
     assert partsim.make_cabinet_urdf(seed=3) != urdf
     with pytest.raises(partsim.PartsimError, match="height"):
         partsim.make_cabinet_urdf(height=-1)
+
+
+def http_code(viewer, path, token=True):
+    """The status of a GET (200 or the error's code)."""
+    try:
+        get(viewer, path, token)
+        return 200
+    except urllib.error.HTTPError as e:
+        return e.code
+
+
+def test_bundle_serves_only_regular_files_inside_its_folder(scene, tmp_path):
+    root = tmp_path / "web"
+    root.mkdir()
+    (root / "index.html").write_text("<html>the page</html>")
+    (root / "viewer.js").write_text("let x = 1;")
+    (root / "sub").mkdir()
+    os.symlink("viewer.js", root / "alias.js")  # a link that stays inside is followed
+    os.symlink("/", root / "all")
+    os.symlink("/etc/passwd", root / "passwd.txt")
+    os.symlink(tmp_path, root / "up")
+    (tmp_path / "secret.txt").write_text("not in the bundle")
+    os.mkfifo(root / "fifo.js")
+    viewer = partsim.Viewer(scene, token="tok", web_root=str(root))
+    try:
+        assert get(viewer, "/", token=False) == b"<html>the page</html>"
+        assert get(viewer, "/viewer.js", token=False) == b"let x = 1;"
+        assert get(viewer, "/alias.js", token=False) == b"let x = 1;"
+        # links out of the folder, folders and FIFOs (never opened: the request would hang)
+        for path in ["/all/etc/passwd", "/passwd.txt", "/up/secret.txt", "/all", "/sub",
+                     "/fifo.js"]:
+            assert http_code(viewer, path, token=False) in (403, 404), path
+    finally:
+        viewer.close()
+
+
+def png_bytes(width, height):
+    """A grey 8-bit PNG of width x height pixels."""
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xffffffff))
+
+    rows = b"".join(b"\0" + b"\x80" * width for _ in range(height))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 0, 0,
+                                                              0, 0)) +
+            chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+
+def test_texture_endpoint_serves_only_images_beside_their_mesh(tmp_path, capfd):
+    obj = tmp_path / "object"
+    (obj / "textured_objs").mkdir(parents=True)
+    (obj / "images").mkdir()
+    (obj / "images" / "wood.png").write_bytes(png_bytes(3, 2))
+    (obj / "textured_objs" / "text.png").write_text("root:x:0:0:not an image\n")
+    os.symlink("/etc/passwd", obj / "textured_objs" / "link.png")
+    # PartNet-Mobility's layout: textured_objs/*.mtl name ../images/*
+    maps = {"good": "../images/wood.png", "absolute": "/etc/passwd",
+            "escape": "../../../../../../../../etc/shadow", "link": "link.png",
+            "text": "text.png"}
+    scene = partsim.Scene()
+    for name, map_kd in maps.items():
+        (obj / "textured_objs" / f"{name}.mtl").write_text(f"newmtl m\nKd 1 1 1\nmap_Kd {map_kd}\n")
+        (obj / "textured_objs" / f"{name}.obj").write_text(
+            f"mtllib {name}.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+            "usemtl m\nf 1/1 2/2 3/3\n")
+        b = scene.create_actor_builder()
+        b.add_visual_from_file(str(obj / "textured_objs" / f"{name}.obj"))
+        b.build_kinematic().set_name(name)
+    viewer = partsim.Viewer(scene, token="tok")
+    try:
+        content = json.loads(get(viewer, "/api/scene.json"))  # the scene loads
+        texture = {b["name"]: b["visuals"][0]["texture"] for b in content["bodies"]}
+        # the image beside its mesh, decoded and sent as PNG
+        png = get(viewer, "/api/texture/%d.png" % texture["good"])
+        assert png[:8] == b"\x89PNG\r\n\x1a\n" and png[16:24] == bytes([0, 0, 0, 3, 0, 0, 0, 2])
+        # files out of the object's folder are dropped from the scene with a warning
+        for name in ["absolute", "escape", "link"]:
+            assert texture[name] == -1, name
+        err = capfd.readouterr().err
+        assert "/etc/passwd" in err and "shadow" in err
+        # a file that is not an image is not sent
+        assert texture["text"] >= 0
+        assert http_code(viewer, "/api/texture/%d.png" % texture["text"]) == 404
+        for k in range(len(maps) + 1):
+            try:
+                assert b"root:" not in get(viewer, "/api/texture/%d.png" % k)
+            except urllib.error.HTTPError:
+                pass
+    finally:
+        viewer.close()

@@ -1,7 +1,13 @@
-// Which bundle paths the viewer serves, and how it reads a request's resource.
+// Which bundle paths the viewer serves, which files it reads for them, and how it reads a
+// request's resource.
 #include "viewer/http_util.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 
 namespace partsim::internal {
 namespace {
@@ -12,6 +18,40 @@ TEST(ViewerHttpTest, BundlePathsStayInTheBundle) {
   for (const char* bad : {"", "/", "index.html", "/../x", "/a/../x", "/..", "/.env", "/a/.git/x",
                           "//x", "/a//b", "/a/", "/%2e%2e/x", "/a\\b", "/a b", "/a?b"})
     EXPECT_FALSE(SafeBundlePath(bad)) << bad;
+}
+
+TEST(ViewerHttpTest, OnlyRegularFilesInsideTheFolderAreRead) {
+  namespace fs = std::filesystem;
+  const fs::path dir =
+      fs::temp_directory_path() / ("partsim_http_util_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "root" / "sub");
+  std::ofstream(dir / "root" / "a.js") << "let a;";
+  std::ofstream(dir / "outside.txt") << "secret";
+  fs::create_symlink("a.js", dir / "root" / "alias.js");
+  fs::create_symlink("/", dir / "root" / "all");
+  fs::create_symlink("../outside.txt", dir / "root" / "up.txt");
+  ASSERT_EQ(mkfifo((dir / "root" / "fifo.js").c_str(), 0600), 0);
+  const std::string root = (dir / "root").string();
+  const std::string a = fs::canonical(dir / "root" / "a.js").string();
+  EXPECT_EQ(RegularFileInside(root + "/a.js", root), a);
+  EXPECT_EQ(RegularFileInside(root + "/alias.js", root), a);  // a link that stays inside
+  EXPECT_EQ(RegularFileInside(root + "/sub/../a.js", root), a);
+  for (const char* bad : {"/all/etc/passwd", "/up.txt", "/../outside.txt", "/sub", "/all",
+                          "/fifo.js", "/missing.js", ""})
+    EXPECT_EQ(RegularFileInside(root + bad, root), "") << bad;
+  EXPECT_EQ(RegularFileInside(root + "/a.js", ""), "");
+
+  std::string bytes;
+  EXPECT_TRUE(ReadRegularFile(a, 100, &bytes));
+  EXPECT_EQ(bytes, "let a;");
+  EXPECT_FALSE(ReadRegularFile(a, 5, &bytes));  // larger than allowed
+  // a FIFO returns at once (no writer: a blocking open would wait forever), as do a folder and
+  // a link as the last component
+  EXPECT_FALSE(ReadRegularFile(root + "/fifo.js", 100, &bytes));
+  EXPECT_FALSE(ReadRegularFile(root + "/sub", 100, &bytes));
+  EXPECT_FALSE(ReadRegularFile(root + "/up.txt", 100, &bytes));
+  fs::remove_all(dir);
 }
 
 TEST(ViewerHttpTest, ResourceSplitsIntoPathAndQuery) {
