@@ -1,6 +1,7 @@
 // Parsing JSON from outside (network messages, scene files, dataset files) with a bound on its
-// nesting: a deeper document is refused while it is parsed, before a deep tree exists whose
-// copy, serialisation or destruction would recurse that deep and overflow the stack.
+// nesting: a deeper document is refused before it is parsed, before a deep tree exists whose
+// copy, serialisation or destruction would recurse that deep and overflow the stack. Both steps
+// are linear in the size of the text.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -11,17 +12,41 @@ namespace partsim::internal {
 /// Deepest nesting of arrays and objects accepted: real files and ROS messages nest a handful.
 constexpr int kMaxJsonDepth = 64;
 
+/// Deepest nesting of arrays and objects in `text`, stopping early once it passes `stop_above`;
+/// brackets inside strings and after a NUL byte (which ends the parser's input) do not count.
+/// One pass over the bytes: it does not check that `text` is valid JSON (the parser does that).
+inline int JsonNestingDepth(const std::string& text, int stop_above) {
+  int depth = 0, deepest = 0;
+  bool in_string = false, escaped = false;
+  for (const char ch : text) {
+    if (ch == '\0') break;  // where nlohmann's parser ends the input too
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (ch == '\\')
+        escaped = true;
+      else if (ch == '"')
+        in_string = false;
+    } else if (ch == '"') {
+      in_string = true;
+    } else if (ch == '[' || ch == '{') {
+      if (++depth > deepest && (deepest = depth) > stop_above) break;
+    } else if ((ch == ']' || ch == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
 /// Parses `text`; throws nlohmann::json::exception when it is malformed or nested deeper than
-/// `max_depth` levels ("nested deeper than N levels").
+/// `max_depth` levels ("nested deeper than N levels"). The size is the caller's to bound.
 inline nlohmann::json ParseJsonBounded(const std::string& text, int max_depth = kMaxJsonDepth) {
-  nlohmann::json::parser_callback_t depth_guard =
-      [max_depth](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
-        if (depth > max_depth)
-          throw nlohmann::json::out_of_range::create(
-              406, "nested deeper than " + std::to_string(max_depth) + " levels", nullptr);
-        return true;
-      };
-  return nlohmann::json::parse(text, depth_guard);
+  // the depth first, in one pass; then nlohmann's plain parser, whose callback variant rescans
+  // the enclosing container at every closing bracket (quadratic in the number of containers)
+  if (JsonNestingDepth(text, max_depth) > max_depth)
+    throw nlohmann::json::out_of_range::create(
+        406, "nested deeper than " + std::to_string(max_depth) + " levels", nullptr);
+  return nlohmann::json::parse(text);
 }
 
 }  // namespace partsim::internal
