@@ -216,9 +216,15 @@ TrajectoryCommand JointTrajectoryFromJson(const Json& msg, const std::string& wh
     if (!name.is_string()) throw Error(what + ": joint_names holds a non-string");
     cmd.joint_names.push_back(name.get<std::string>());
   }
-  if (msg["points"].empty()) throw Error(what + ": no points");
-  for (size_t k = 0; k < msg["points"].size(); ++k) {
-    const Json& p = msg["points"][k];
+  const Json& points = msg["points"];
+  if (points.empty()) throw Error(what + ": no points");
+  if (points.size() > kMaxTrajectoryPoints)
+    throw Error(what + ": " + std::to_string(points.size()) + " points, more than the " +
+                std::to_string(kMaxTrajectoryPoints) + " a trajectory may have");
+  cmd.positions.reserve(points.size());
+  cmd.times.reserve(points.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    const Json& p = points[k];
     std::string where = what + " points[" + std::to_string(k) + "]";
     if (!p.is_object() || !p.contains("positions")) throw Error(where + " has no positions");
     cmd.positions.push_back(NumbersFromJson(p["positions"], where + ".positions"));

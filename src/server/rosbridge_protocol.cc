@@ -152,6 +152,15 @@ void RosbridgeProtocol::OnMessage(const ClientPtr& c, const std::string& payload
 }
 
 void RosbridgeProtocol::HandleText(const ClientPtr& c, const std::string& payload) {
+  // a client that has not authenticated may send the auth op alone: anything longer is refused
+  // unparsed, so that it costs the server no more than its bytes
+  if (!c->authenticated && payload.size() > kMaxUnauthenticatedBytes) {
+    Status(c, "error",
+           "authenticate first: before {\"op\": \"auth\"} succeeds, messages are limited to " +
+               std::to_string(kMaxUnauthenticatedBytes) + " bytes (got " +
+               std::to_string(payload.size()) + ")");
+    return;
+  }
   Json j;
   try {
     j = ParseJsonBounded(payload);

@@ -62,6 +62,10 @@ struct Partial {
   size_t bytes = 0;
 };
 
+/// Bytes a message may have before its client has authenticated (with a token set): the auth
+/// op needs a few dozen; longer messages are refused before they are parsed.
+constexpr size_t kMaxUnauthenticatedBytes = 4096;
+
 /// A connected client.
 struct RosbridgeClient {
   std::weak_ptr<void> connection;  ///< the transport's handle of the connection

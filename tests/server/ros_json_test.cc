@@ -391,6 +391,20 @@ TEST(RosJson, BadJointTrajectoriesNameTheField) {
             "/r/traj points[0].positions holds a value that is not a number");
 }
 
+TEST(RosJson, JointTrajectoriesAboveTheBoundAreRefusedNamingTheCount) {
+  auto trajectory = [](size_t n) {
+    Json points = Json::array();
+    for (size_t k = 0; k < n; ++k)
+      points.push_back({{"positions", {0.1}}, {"time_from_start", 0.01 * (k + 1)}});
+    return Json{{"joint_names", {"a"}}, {"points", points}};
+  };
+  EXPECT_EQ(JointTrajectoryFromJson(trajectory(kMaxTrajectoryPoints), "/r/traj").times.size(),
+            kMaxTrajectoryPoints);
+  EXPECT_EQ(
+      ErrorOf([&] { JointTrajectoryFromJson(trajectory(kMaxTrajectoryPoints + 1), "/r/traj"); }),
+      "/r/traj: 10001 points, more than the 10000 a trajectory may have");
+}
+
 TEST(RosJson, PlanRequestReadsJointAndPoseGoalsAndOptions) {
   PlanRequest joint = PlanRequestFromJson(Json{{"joint_goal", {0.1, 0.2}},
                                                {"execute", false},

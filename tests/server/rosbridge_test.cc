@@ -708,6 +708,26 @@ TEST_F(RosbridgeGuardedTest, NothingButAuthUntilTheTokenComesRight) {
   EXPECT_TRUE(WaitFor([&] { return w.Closed(); }));
 }
 
+TEST_F(RosbridgeGuardedTest, LongMessagesBeforeAuthAreRefusedUnparsed) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  // the right token, padded past the pre-auth bound: refused without being read
+  c.Send(json{{"op", "auth"}, {"mac", "s3cret"}, {"pad", std::string(5000, 'x')}, {"id", "long"}});
+  json e = c.WaitMessage([](const json& m) { return IsError(m); });
+  ASSERT_FALSE(e.is_null());
+  EXPECT_NE(e["msg"].get<std::string>().find("messages are limited to 4096 bytes"),
+            std::string::npos)
+      << e.dump();
+  EXPECT_FALSE(e.contains("id")) << e.dump();  // the message was not parsed for its id
+  c.Send(json{{"op", "subscribe"}, {"topic", "/clock"}, {"id", "s"}});
+  json refused = c.WaitMessage([](const json& m) { return m.value("id", "") == "s"; });
+  EXPECT_NE(refused.dump().find("authenticate first"), std::string::npos) << refused.dump();
+  // the short auth op still works on the same connection
+  c.Send(json{{"op", "auth"}, {"mac", "s3cret"}, {"id", "a"}});
+  json ok = c.WaitMessage([](const json& m) { return m.value("id", "") == "a"; });
+  EXPECT_EQ(ok.value("level", ""), "info") << ok.dump();
+}
+
 TEST_F(RosbridgeGuardedTest, ConnectionsBeyondTheCapAreRefused) {
   auto a = std::make_unique<TestClient>(port_);
   TestClient b(port_);
