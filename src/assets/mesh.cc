@@ -19,6 +19,7 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "assets/mesh_claims.h"
 #include "assets/obj_reader.h"
 #include "core/ascii.h"
 #include "core/file_read.h"
@@ -374,6 +375,8 @@ std::vector<LoadedMesh> LoadMeshFile(const std::string& path, const Eigen::Vecto
     for (const internal::FileSubMesh& sub : internal::ReadObjFile(path))
       AppendSubMesh(sub, Eigen::Matrix4d::Identity(), scale, path, &out);
   } else {
+    // assimp allocates what a header claims: the claims are held to the file's size first
+    internal::CheckMeshClaims(path);
     out = internal::LoadMeshFileWithAssimp(path, scale);
   }
   if (out.empty()) throw Error("mesh file '" + path + "' holds no triangles");

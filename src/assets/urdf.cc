@@ -94,7 +94,10 @@ class Parser {
   JointDesc ReadJoint(const RawJoint& raw, ArticulationDesc* desc);
   // a file named by the URDF, resolved; nullopt (and the file noted for the one error that
   // lists them all) when it is missing
-  std::optional<std::string> ResolvePath(const std::string& uri, const std::string& where) const;
+  // `kind` names what the file should be ("mesh file") when the path is a device, a FIFO or a
+  // symbolic link loop
+  std::optional<std::string> ResolvePath(const std::string& uri, const std::string& where,
+                                         const char* kind = "texture file") const;
   // ResolvePath for a mesh file, which must also not be empty (noted like a missing one)
   std::optional<std::string> ResolveMeshFile(const std::string& uri,
                                              const std::string& where) const;
@@ -219,7 +222,7 @@ void Parser::NoteBadFile(const std::string& where, const std::string& uri,
 
 std::optional<std::string> Parser::ResolveMeshFile(const std::string& uri,
                                                    const std::string& where) const {
-  std::optional<std::string> path = ResolvePath(uri, where);
+  std::optional<std::string> path = ResolvePath(uri, where, "mesh file");
   std::error_code ec;
   if (path && fs::file_size(*path, ec) == 0 && !ec) {
     NoteBadFile(where, uri, "is empty");
@@ -228,13 +231,19 @@ std::optional<std::string> Parser::ResolveMeshFile(const std::string& uri,
   return path;
 }
 
-std::optional<std::string> Parser::ResolvePath(const std::string& uri,
-                                               const std::string& where) const {
+std::optional<std::string> Parser::ResolvePath(const std::string& uri, const std::string& where,
+                                               const char* kind) const {
   std::vector<fs::path> tried;
   std::error_code ec;
+  // the first candidate that exists but is no regular file (checked without opening it)
+  std::string not_a_file;
   auto found = [&](const fs::path& p) {
     tried.push_back(p);
-    return fs::is_regular_file(p, ec);
+    if (fs::is_regular_file(p, ec)) return true;
+    const std::string what = internal::NonRegularFileKind(p.string());
+    if (not_a_file.empty() && !what.empty() && what != "a folder")
+      not_a_file = "('" + p.string() + "') is " + what + ", not a " + kind;
+    return false;
   };
   static const std::string kPackage = "package://";
   static const std::string kFile = "file://";
@@ -262,6 +271,10 @@ std::optional<std::string> Parser::ResolvePath(const std::string& uri,
     fs::path p(path);
     if (p.is_relative()) p = base_dir_ / p;
     if (found(p)) return p.lexically_normal().string();
+  }
+  if (!not_a_file.empty()) {
+    NoteBadFile(where, uri, not_a_file);
+    return std::nullopt;
   }
   std::string msg = "not found (tried";
   for (const fs::path& p : tried) msg += " '" + p.string() + "'";
@@ -515,6 +528,15 @@ std::optional<Inertial> Parser::ReadInertial(const XMLElement* e, const std::str
   mass *= s * s * s;
   tensor *= std::pow(s, 5);
   if (!std::isfinite(mass) || !tensor.allFinite()) Fail(where + " is not finite after scaling");
+  // the bounds of the physics (physics/description.cc): at most 1e9 kg, and 1e9 kg at 1e6 m
+  constexpr double kMaxMass = 1e9, kMaxInertia = 1e21;
+  if (mass > kMaxMass)
+    Fail(where + " <mass value> is " + FormatNumber(mass) + " kg" +
+         (s != 1 ? " after scaling" : "") + ", beyond the 1e9 kg partsim simulates");
+  if (tensor.cwiseAbs().maxCoeff() > kMaxInertia)
+    Fail(where + " <inertia> has an entry of " + FormatNumber(tensor.cwiseAbs().maxCoeff()) +
+         " kg m^2" + (s != 1 ? " after scaling" : "") +
+         ", beyond the 1e21 kg m^2 partsim simulates");
 
   // principal axes; eigenvalues a hair below zero are rounding, clearly negative ones an error
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(tensor);

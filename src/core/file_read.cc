@@ -31,10 +31,20 @@ const char* KindOf(fs::file_type t) {
 
 }  // namespace
 
+std::string NonRegularFileKind(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);  // follows symbolic links
+  if (ec == std::errc::too_many_symbolic_link_levels) return "a symbolic link loop";
+  if (ec || st.type() == fs::file_type::not_found || st.type() == fs::file_type::regular) return "";
+  return KindOf(st.type());
+}
+
 void CheckReadableFile(const std::string& path, const std::string& what, std::uintmax_t max_bytes) {
   const std::string where = what + " " + path;
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);  // follows symbolic links
+  if (ec == std::errc::too_many_symbolic_link_levels)
+    throw Error(where + ": is a symbolic link loop, not a regular file");
   if (ec || st.type() == fs::file_type::not_found)
     throw Error(where + ": the file does not exist" + (ec ? " (" + ec.message() + ")" : ""));
   if (st.type() != fs::file_type::regular)

@@ -13,6 +13,11 @@ constexpr std::uintmax_t kMaxTextFileBytes = 256ull << 20;
 /// Largest texture or mesh file: 1 GB.
 constexpr std::uintmax_t kMaxDataFileBytes = 1ull << 30;
 
+/// What `path` (symbolic links followed) is when it is not a regular file: "a folder", "a
+/// character device", "a block device", "a FIFO (named pipe)", "a socket", "a symbolic link
+/// loop", or "" for a regular file and for a path that does not exist. Opens nothing.
+std::string NonRegularFileKind(const std::string& path);
+
 /// Throws partsim::Error "<what> <path>: ..." unless `path` (symbolic links followed) is a
 /// regular file of at most `max_bytes`; the message says what the path is instead (missing, a
 /// folder, a character device, a FIFO, a socket, too large).

@@ -74,6 +74,10 @@ void Require(bool ok, const std::string& where, const std::string& what) {
 // Largest coordinate or size (m) a description may hold: past it MuJoCo's arithmetic overflows
 // (an origin of 1e308 or a box of 1e300 made every state NaN).
 constexpr double kMaxLength = 1e6;
+// Largest mass (kg) and principal moment of inertia (kg m^2): kMaxMass at kMaxLength from its
+// axis. A mass of 1e308 made every state NaN after one step.
+constexpr double kMaxMass = 1e9;
+constexpr double kMaxInertia = kMaxMass * kMaxLength * kMaxLength;
 
 void CheckPose(const Pose& pose, const std::string& where, const std::string& what) {
   Require(pose.p.allFinite(), where, what + " has a non-finite position " + pose.ToString());
@@ -154,7 +158,14 @@ void CheckBody(const BodyDesc& b, const std::string& where, const std::string& w
   }
   if (b.inertial) {
     CheckPositive(b.inertial->mass, where, what + " mass");
-    for (int k = 0; k < 3; ++k) CheckPositive(b.inertial->inertia[k], where, what + " inertia");
+    Require(b.inertial->mass <= kMaxMass, where,
+            what + " mass must be at most 1e9 kg, got " + FormatNumber(b.inertial->mass));
+    for (int k = 0; k < 3; ++k) {
+      CheckPositive(b.inertial->inertia[k], where, what + " inertia");
+      Require(b.inertial->inertia[k] <= kMaxInertia, where,
+              what + " inertia must be at most 1e21 kg m^2, got " +
+                  FormatNumber(b.inertial->inertia[k]));
+    }
     CheckPose(b.inertial->cmass_local_pose, where, what + " centre-of-mass pose");
   }
 }

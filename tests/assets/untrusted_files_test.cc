@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/file_read.h"
+#include "partsim/assets/mesh.h"
 #include "partsim/assets/scene_file.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/core/error.h"
@@ -75,6 +76,41 @@ TEST_F(UntrustedFilesTest, DevicesFifosAndLinksToThemAreRefusedNamingWhatTheyAre
   Scene scene;
   e = ErrorOf([&] { AddSceneObjects(&scene, Path("scene.json"), Pose(), true); });
   EXPECT_NE(e.find("is a character device"), std::string::npos) << e;
+}
+
+TEST_F(UntrustedFilesTest, MeshPathsThatAreNoFilesSayWhatTheyAreWithoutOpeningThem) {
+  fs::create_symlink("/dev/zero", Path("zero.stl"));
+  ASSERT_EQ(::mkfifo(Path("pipe.stl").c_str(), 0600), 0);  // opening it would block
+  fs::create_symlink(Path("loop_b.stl"), Path("loop_a.stl"));
+  fs::create_symlink(Path("loop_a.stl"), Path("loop_b.stl"));
+  std::string urdf = "<robot name=\"r\"><link name=\"a\">";
+  for (const char* mesh : {"/dev/zero", "zero.stl", "pipe.stl", "loop_a.stl"})
+    urdf += std::string("<visual><geometry><mesh filename=\"") + mesh + "\"/></geometry></visual>";
+  urdf += "</link></robot>";
+  UrdfLoader loader;
+  const std::string e = ErrorOf([&] { loader.Parse(urdf, dir_.string()); });
+  EXPECT_NE(e.find("'/dev/zero' ('/dev/zero') is a character device, not a mesh file"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(
+      e.find("'zero.stl' ('" + Path("zero.stl") + "') is a character device, not a mesh file"),
+      std::string::npos)
+      << e;
+  EXPECT_NE(
+      e.find("'pipe.stl' ('" + Path("pipe.stl") + "') is a FIFO (named pipe), not a mesh file"),
+      std::string::npos)
+      << e;
+  EXPECT_NE(e.find("'loop_a.stl' ('" + Path("loop_a.stl") +
+                   "') is a symbolic link loop, not a mesh file"),
+            std::string::npos)
+      << e;
+  EXPECT_EQ(e.find("not found"), std::string::npos) << e;
+  // the mesh reader itself says the same
+  EXPECT_NE(ErrorOf([&] { LoadMeshFile(Path("loop_a.stl")); }).find("is a symbolic link loop"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { LoadMeshFile(Path("pipe.stl")); }).find("is a FIFO"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { LoadMeshFile("/dev/zero"); }).find("is a character device"),
+            std::string::npos);
 }
 
 TEST_F(UntrustedFilesTest, FilesOverTheSizeBoundAreRefusedBeforeReading) {
@@ -207,6 +243,48 @@ TEST(UntrustedPhysicsTest, HugeOriginsAndSizesAreRefusedNamingTheElement) {
   scene.AddActor(box);
   scene.Step(10);
   EXPECT_TRUE(scene.GetActors()[0].GetPose().p.allFinite());
+}
+
+// A URDF link of mass `mass` and inertia `ixx` about each axis, with a box to land on.
+std::string HeavyLinkUrdf(const std::string& mass, const std::string& ixx) {
+  return "<robot name=\"r\"><link name=\"heavy\"><inertial><mass value=\"" + mass +
+         "\"/><inertia ixx=\"" + ixx + "\" ixy=\"0\" ixz=\"0\" iyy=\"" + ixx +
+         "\" iyz=\"0\" izz=\"" + ixx +
+         "\"/></inertial><collision><geometry><box size=\"1 1 1\"/></geometry></collision>"
+         "</link></robot>";
+}
+
+TEST(UntrustedPhysicsTest, HugeMassesAndInertiasAreRefusedNamingTheElement) {
+  Scene scene;
+  UrdfLoader loader(&scene);
+  std::string e = ErrorOf([&] { loader.LoadFromString(HeavyLinkUrdf("1e308", "1"), "."); });
+  EXPECT_NE(e.find("link 'heavy' <inertial> <mass value> is 1e+308 kg, beyond the 1e9 kg partsim "
+                   "simulates"),
+            std::string::npos)
+      << e;
+  e = ErrorOf([&] { loader.LoadFromString(HeavyLinkUrdf("1", "1e308"), "."); });
+  EXPECT_NE(e.find("link 'heavy' <inertial> <inertia> has an entry of 1e+308 kg m^2, beyond the "
+                   "1e21 kg m^2"),
+            std::string::npos)
+      << e;
+  // a scale that takes a mass past the bound says so
+  loader.scale = 1e3;
+  e = ErrorOf([&] { loader.LoadFromString(HeavyLinkUrdf("10", "1"), "."); });
+  EXPECT_NE(e.find("<mass value> is 10000000000 kg after scaling"), std::string::npos) << e;
+  loader.scale = 1.0;
+  EXPECT_TRUE(scene.GetArticulations().empty());
+  // descriptions built in code meet the same bound
+  ActorDesc box;
+  box.name = "box";
+  box.inertial = Inertial();
+  box.inertial->mass = 1e308;
+  box.inertial->inertia = Eigen::Vector3d::Ones();
+  e = ErrorOf([&] { scene.AddActor(box); });
+  EXPECT_NE(e.find("actor 'box' mass must be at most 1e9 kg, got 1e+308"), std::string::npos) << e;
+  // at the bounds the state stays finite
+  Articulation art = loader.LoadFromString(HeavyLinkUrdf("1e9", "1e9"), ".");
+  scene.Step(10);
+  EXPECT_TRUE(art.GetLinks()[0].GetPose().p.allFinite());
 }
 
 TEST(UntrustedPhysicsTest, MassZeroWithShapesWarnsAndEffortsAreClampedToTheJointsLimit) {
