@@ -165,6 +165,8 @@ struct Viewer::Impl {
   WsServer ws;
   std::thread io_thread;
   std::unique_ptr<boost::asio::steady_timer> status_timer;
+  std::unique_ptr<boost::asio::steady_timer> accept_timer;  // network thread
+  std::atomic<long long> accept_errors{0};
   std::map<Hdl, ClientPtr, std::owner_less<Hdl>> clients;
   struct RateSample {
     Clock::time_point wall;
@@ -969,6 +971,34 @@ struct Viewer::Impl {
             "' (there are /api/scene.json, /api/mesh/K.bin, /api/texture/K.png" + extra + ")\n";
   }
 
+  // ---- accepting ----
+  /// partsim's accept loop (network thread), in place of websocketpp's start_accept, which
+  /// retries a failed accept at once: out of file descriptors that spun a core. A failure waits
+  /// 100 ms (the rosbridge server's loop, src/server/rosbridge.cc).
+  void StartAccept() {
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = ws.get_connection();
+    if (!con) return;
+    ws.async_accept(
+        websocketpp::lib::static_pointer_cast<WsServer::transport_con_type>(con),
+        [this, con](const websocketpp::lib::error_code& e) { OnAccept(con, e); }, ec);
+    if (ec) con->terminate(websocketpp::lib::error_code());
+  }
+  void OnAccept(const WsServer::connection_ptr& con, const websocketpp::lib::error_code& ec) {
+    if (!ec) {
+      con->start();
+      StartAccept();
+      return;
+    }
+    con->terminate(ec);
+    if (ec == websocketpp::error::operation_canceled || !ws.is_listening()) return;
+    ++accept_errors;
+    accept_timer->expires_after(std::chrono::milliseconds(100));
+    accept_timer->async_wait([this](const boost::system::error_code& e) {
+      if (!e && ws.is_listening()) StartAccept();
+    });
+  }
+
   // ---- set-up ----
 
   void InitServer() {
@@ -1047,7 +1077,8 @@ struct Viewer::Impl {
       throw Error("viewer: cannot listen on " + options.address + ":" +
                   std::to_string(options.port) + ": " + why);
     }
-    ws.start_accept(ec);
+    accept_timer = std::make_unique<boost::asio::steady_timer>(ws.get_io_service());
+    StartAccept();
     port = ws.get_local_endpoint(bec).port();
   }
 };
@@ -1115,6 +1146,7 @@ void Viewer::Stop() {
   websocketpp::lib::error_code ec;
   m.ws.stop_listening(ec);
   if (m.status_timer) m.status_timer->cancel();
+  if (m.accept_timer) m.accept_timer->cancel();
   m.ws.stop();
   if (m.io_thread.joinable()) m.io_thread.join();
   m.cv.notify_all();
@@ -1231,6 +1263,7 @@ ViewerStats Viewer::GetStats() const {
   s.http_requests = m.http_requests;
   s.errors = m.errors;
   s.snapshots = m.snapshots;
+  s.accept_errors = m.accept_errors;
   std::lock_guard<std::mutex> lock(m.mutex);
   s.scene_version = m.shared_content ? m.shared_content->version : 0;
   return s;

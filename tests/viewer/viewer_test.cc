@@ -7,6 +7,7 @@
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -772,6 +773,48 @@ TEST_F(ViewerTest, ClientThatNeverReadsStallsNeitherRenderNorOthers) {
   EXPECT_FALSE(
       reader.WaitMessage([](const json& m) { return m.value("topic", "") == "/partsim/poses"; })
           .is_null());
+}
+
+// Out of file descriptors, websocketpp's accept loop retried at once and spun a core; the
+// viewer's waits 100 ms after a failed accept (as the rosbridge server's does), so the process
+// stays idle, and it accepts again once descriptors are free.
+TEST_F(ViewerTest, OutOfFileDescriptorsTheAcceptLoopWaitsInsteadOfSpinning) {
+  Viewer& v = Start();
+  rlimit old{};
+  ASSERT_EQ(getrlimit(RLIMIT_NOFILE, &old), 0);
+  int open_fds = 0;
+  for (const auto& e : fs::directory_iterator("/proc/self/fd")) {
+    (void)e;
+    ++open_fds;
+  }
+  rlimit low = old;
+  low.rlim_cur = static_cast<rlim_t>(open_fds + 16);
+  ASSERT_EQ(setrlimit(RLIMIT_NOFILE, &low), 0);
+  std::vector<int> socks;
+  for (int i = 0; i < 64; ++i) {  // bounded: 64 loopback connections at most
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (fd < 0) break;
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<uint16_t>(v.GetPort()));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a));
+    socks.push_back(fd);
+  }
+  const bool failed = testing::WaitFor([&] { return v.GetStats().accept_errors > 0; });
+  rusage r0{}, r1{};
+  getrusage(RUSAGE_SELF, &r0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  getrusage(RUSAGE_SELF, &r1);
+  for (int fd : socks) ::close(fd);
+  setrlimit(RLIMIT_NOFILE, &old);
+  auto secs = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+  const double cpu = secs(r1.ru_utime) - secs(r0.ru_utime) + secs(r1.ru_stime) - secs(r0.ru_stime);
+  EXPECT_LT(cpu, 0.25) << "CPU seconds in 0.5 s out of descriptors";  // spinning: about 0.5
+  ASSERT_TRUE(failed) << "the descriptors never ran out (" << socks.size() << " sockets)";
+  EXPECT_LT(v.GetStats().accept_errors, 20);
+  TestClient c(v.GetPort());
+  EXPECT_TRUE(c.WaitOpen());
 }
 
 TEST_F(ViewerTest, ServedModeFollowsTheSimServer) {

@@ -48,6 +48,7 @@ struct ViewerStats {
   long long errors = 0;            ///< error statuses sent to clients
   long long snapshots = 0;         ///< pose snapshots taken on the scene's thread
   long long scene_version = 0;     ///< structure snapshots taken (1 after Start)
+  long long accept_errors = 0;     ///< failed accepts (out of file descriptors), each waits 100 ms
 };
 
 /// An HTTP answer of an extra API route (Viewer::AddApiRoute).
