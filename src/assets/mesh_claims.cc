@@ -122,6 +122,7 @@ void CheckPly(const std::string& path, uint64_t size) {
     }
   }
   double needed = 0;
+  bool first = true;
   for (const Element& e : elements) {
     const double each = static_cast<double>(std::max<uint64_t>(e.min_bytes, 1));
     needed += each * static_cast<double>(e.count);
@@ -129,9 +130,10 @@ void CheckPly(const std::string& path, uint64_t size) {
     if (needed > static_cast<double>(body) + (ascii ? 1 : 0)) {
       Refuse(path, "the PLY header claims " + std::to_string(e.count) + " '" + e.name +
                        "' elements (" + (ascii ? "ascii" : "binary") + ", at least " + Str(needed) +
-                       " bytes with the elements before them), but the file holds " +
-                       std::to_string(body) + " bytes after its header");
+                       " bytes" + (first ? "" : " with the elements before it") +
+                       "), but the file holds " + std::to_string(body) + " bytes after its header");
     }
+    first = false;
   }
 }
 
