@@ -343,9 +343,30 @@ std::vector<LoadedMesh> LoadMeshFileWithAssimp(const std::string& path,
   // no points or lines: they are not surfaces
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene =
-      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                  aiProcess_GenNormals | aiProcess_SortByPType);
+  const aiScene* scene = importer.ReadFile(path, 0);
+  if (scene == nullptr || scene->mRootNode == nullptr) {
+    throw Error("mesh file '" + path + "' could not be read: " + importer.GetErrorString());
+  }
+  // faces as read, before the post-processing steps, which abort the process on a face without
+  // indices (a PLY whose face lists lie, found by tests/fuzz/ply_fuzz.cc) or index past the
+  // vertices
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      bool ok = face.mNumIndices > 0 && face.mIndices != nullptr;
+      for (unsigned k = 0; ok && k < face.mNumIndices; ++k)
+        ok = face.mIndices[k] < am->mNumVertices;
+      if (!ok)
+        throw Error("mesh file '" + path + "': face " + std::to_string(f) + " of mesh " +
+                    std::to_string(m) + " has " +
+                    (face.mNumIndices == 0 ? std::string("no vertex indices")
+                                           : "a vertex index past its " +
+                                                 std::to_string(am->mNumVertices) + " vertices"));
+    }
+  }
+  scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                       aiProcess_GenNormals | aiProcess_SortByPType);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw Error("mesh file '" + path + "' could not be read: " + importer.GetErrorString());
   }

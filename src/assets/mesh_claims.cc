@@ -58,44 +58,33 @@ uint32_t Le32(const std::string& b, size_t at) {
 
 // ---- PLY ----
 
-// Bytes of a PLY scalar type in a binary file (1 for an unknown name: the reader refuses it).
+// Bytes of a PLY scalar type in a binary file; 0 for a name that is none.
 int PlyTypeBytes(std::string_view t) {
   static const std::map<std::string_view, int> kBytes = {
       {"char", 1},   {"int8", 1},    {"uchar", 1},  {"uint8", 1},  {"short", 2}, {"int16", 2},
       {"ushort", 2}, {"uint16", 2},  {"int", 4},    {"int32", 4},  {"uint", 4},  {"uint32", 4},
       {"float", 4},  {"float32", 4}, {"double", 8}, {"float64", 8}};
   auto it = kBytes.find(t);
-  return it == kBytes.end() ? 1 : it->second;
+  return it == kBytes.end() ? 0 : it->second;
 }
 
-// PLY: every element needs at least the bytes of its scalar properties and of its lists' counts
-// (binary), or 2 bytes per property, a digit and a separator (ascii).
+// PLY: the header must follow the format's grammar (assimp's reader crashed on headers that did
+// not: no end_header, unknown types), and every element needs at least the bytes of its scalar
+// properties and of its lists' counts (binary), or 2 bytes per property, a digit and a
+// separator (ascii).
 void CheckPly(const std::string& path, uint64_t size) {
   const std::string head = Head(path, kMaxPlyHeaderBytes);
-  size_t end = std::string::npos;
-  for (size_t at = head.find("end_header"); at != std::string::npos;
-       at = head.find("end_header", at + 1)) {
-    if (at == 0 || head[at - 1] == '\n' || head[at - 1] == '\r') {
-      end = head.find('\n', at);
-      break;
-    }
-  }
-  if (end == std::string::npos) {
-    if (head.size() == kMaxPlyHeaderBytes)
-      Refuse(path, "PLY header has no end_header within its first 1 MB");
-    return;  // a truncated header: the reader says so
-  }
-  const uint64_t body = size - (end + 1);
-  bool ascii = false;
+  bool ascii = false, format = false;
   struct Element {
     std::string name;
     uint64_t count = 0;
     uint64_t min_bytes = 0;
   };
   std::vector<Element> elements;
-  size_t at = 0;
-  while (at < end) {
+  size_t at = 0, end = std::string::npos;
+  for (int number = 1; at < head.size() && end == std::string::npos; ++number) {
     size_t nl = head.find('\n', at);
+    if (nl == std::string::npos) break;
     std::string_view line(head.data() + at, nl - at);
     at = nl + 1;
     std::vector<std::string_view> words;
@@ -106,21 +95,48 @@ void CheckPly(const std::string& path, uint64_t size) {
       if (j > i) words.push_back(line.substr(i, j - i));
       i = j;
     }
-    if (words.empty()) continue;
-    if (words[0] == "format" && words.size() > 1) {
+    auto bad = [&] {
+      std::string shown(line.substr(0, 80));
+      for (char& c : shown)
+        if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+      Refuse(path, "the PLY header's line " + std::to_string(number) + " '" + shown +
+                       "' is not a PLY header line");
+    };
+    if (number == 1) {
+      if (words.size() != 1 || words[0] != "ply") bad();
+      continue;
+    }
+    if (words.empty()) bad();
+    const std::string_view key = words[0];
+    if (key == "comment" || key == "obj_info") continue;
+    if (key == "end_header" && words.size() == 1) {
+      end = nl;
+    } else if (key == "format" && words.size() == 3 && !format) {
       ascii = words[1] == "ascii";
-    } else if (words[0] == "element" && words.size() > 2) {
+      if (!ascii && words[1] != "binary_little_endian" && words[1] != "binary_big_endian") bad();
+      format = true;
+    } else if (key == "element" && words.size() == 3 && format) {
       std::optional<uint64_t> n = Count(words[2]);
-      if (!n) continue;  // the reader refuses it
+      if (!n) bad();
       elements.push_back({std::string(words[1]), *n, 0});
-    } else if (words[0] == "property" && !elements.empty() && words.size() > 1) {
-      // a list costs its count; a scalar its bytes
-      const bool list = words[1] == "list";
-      elements.back().min_bytes +=
-          ascii ? 2
-                : (list ? (words.size() > 2 ? PlyTypeBytes(words[2]) : 1) : PlyTypeBytes(words[1]));
+    } else if (key == "property" && !elements.empty() && words.size() == 3 &&
+               PlyTypeBytes(words[1]) > 0) {
+      elements.back().min_bytes += ascii ? 2 : PlyTypeBytes(words[1]);
+    } else if (key == "property" && !elements.empty() && words.size() == 5 && words[1] == "list" &&
+               PlyTypeBytes(words[2]) > 0 && PlyTypeBytes(words[3]) > 0 && words[2] != "float" &&
+               words[2] != "float32" && words[2] != "double" && words[2] != "float64") {
+      // a list costs at least its count
+      elements.back().min_bytes += ascii ? 2 : PlyTypeBytes(words[2]);
+    } else {
+      bad();
     }
   }
+  if (end == std::string::npos) {
+    Refuse(path, head.size() == kMaxPlyHeaderBytes
+                     ? "the PLY header has no end_header line within its first 1 MB"
+                     : "the PLY header has no end_header line");
+  }
+  const uint64_t body = size - (end + 1);
   double needed = 0;
   bool first = true;
   for (const Element& e : elements) {

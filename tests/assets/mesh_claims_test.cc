@@ -162,6 +162,34 @@ TEST_F(MeshClaimsTest, HonestPlyFilesLoadWithinTheSameBound) {
   EXPECT_EQ(LoadMergedMesh(ascii)->faces.size(), 4u);
 }
 
+TEST_F(MeshClaimsTest, PlyFacesWithoutIndicesAreRefusedBeforeAssimpsStepsAbort) {
+  // four faces whose lists hold 0 indices: assimp's triangulation asserted on them (abort)
+  // (found by ply_fuzz)
+  const std::string p = Write("empty_faces.ply", PlyHeader("binary_little_endian", 4, 4) +
+                                                     Floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}) +
+                                                     std::string(4, '\0'));
+  const std::string e = LoadError(p);
+  EXPECT_NE(e.find("mesh file '" + p + "': face 0 of mesh 0 has no vertex indices"),
+            std::string::npos)
+      << e;
+}
+
+TEST_F(MeshClaimsTest, PlyHeadersOutsideTheGrammarAreRefused) {
+  // assimp's reader crashed (SIGSEGV) on a header without its end and on one with a property
+  // of no known type (found by ply_fuzz)
+  std::string header = PlyHeader("binary_little_endian", 4, 4);
+  header.resize(header.find("end_header") + 8);
+  std::string e = LoadError(Write("cut.ply", header + std::string("\0\0\3\0\0\0\0", 7)));
+  EXPECT_NE(e.find("the PLY header has no end_header line"), std::string::npos) << e;
+  header = PlyHeader("binary_little_endian", 4, 4);
+  header.replace(header.find("list uchar"), 10, "tis luchar");
+  e = LoadError(Write("type.ply", header + TetrahedronBinaryBody()));
+  EXPECT_NE(e.find("the PLY header's line 8 'property tis luchar int vertex_indices' is not a PLY "
+                   "header line"),
+            std::string::npos)
+      << e;
+}
+
 TEST_F(MeshClaimsTest, BinaryStlWhoseTriangleCountDisagreesWithItsSizeIsRefused) {
   const std::string bomb =
       Write("bomb.stl", std::string(80, 'x') + Le32(2000000000) + std::string(50, '\0'));
