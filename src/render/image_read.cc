@@ -1,4 +1,5 @@
-// ReadPng: 8-bit PNG files read with libpng's simplified API (partsim/render/image_read.h).
+// ReadPng: 8-bit PNG files read with libpng's simplified API; ReadImageRgba8: PNG or JPEG through
+// the texture loader (partsim/render/image_read.h).
 #include "partsim/render/image_read.h"
 
 #include <png.h>
@@ -7,8 +8,10 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <utility>
 
 #include "partsim/core/error.h"
+#include "render/gl_util.h"
 
 namespace partsim {
 
@@ -56,6 +59,13 @@ std::vector<std::uint8_t> ReadPng(const std::string& path, int channels, int* wi
   *width = static_cast<int>(image.width);
   *height = static_cast<int>(image.height);
   return out;
+}
+
+std::vector<std::uint8_t> ReadImageRgba8(const std::string& path, int* width, int* height) {
+  internal::Image8 image = internal::LoadImageRgba8(path);
+  *width = image.width;
+  *height = image.height;
+  return std::move(image.rgba);
 }
 
 }  // namespace partsim

@@ -29,8 +29,8 @@
 #include "partsim/physics/scene.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/image_read.h"
 #include "partsim/server/sim_server.h"
-#include "render/gl_util.h"
 #include "server/ros_json.h"
 #include "server/web_security.h"
 #include "viewer/http_util.h"
@@ -951,16 +951,18 @@ struct Viewer::Impl {
       const std::string& file = ct->textures[tex];
       std::error_code ec;
       const std::uintmax_t size = fs::file_size(file, ec);
-      internal::Image8 image;
+      std::vector<uint8_t> rgba;
+      int width = 0;
+      int height = 0;
       try {
         if (ec || size > kMaxTextureBytes) throw Error("cannot be read");
-        image = internal::LoadImageRgba8(file);
+        rgba = ReadImageRgba8(file, &width, &height);
       } catch (const Error&) {
         *status = 404;
         *body = "texture " + std::to_string(tex) + " cannot be read as a PNG or JPEG image\n";
         return;
       }
-      *body = internal::EncodePng(image.width, image.height, 4, image.rgba.data());
+      *body = internal::EncodePng(width, height, 4, rgba.data());
       *type = "image/png";
       return;
     }

@@ -1,5 +1,5 @@
 // Pictures read back from files: 8-bit PNG (libpng), as the dataset tools and tests read what
-// WritePng (image_io.h) wrote.
+// WritePng (image_io.h) wrote, and PNG or JPEG as textures are read.
 #pragma once
 
 #include <cstdint>
@@ -20,5 +20,12 @@ constexpr long long kMaxReadPngPixels = 1ll << 26;
 /// kMaxReadPngPixels pixels (checked from its header, before the pixels are allocated), and
 /// for `channels` other than 1, 3 or 4.
 std::vector<std::uint8_t> ReadPng(const std::string& path, int channels, int* width, int* height);
+
+/// Reads a PNG or JPEG file (recognised by its content, not its extension) as RGBA8 the way
+/// textures are read: scaled down to at most 4096 pixels on a side; row-major, top row first,
+/// width x height x 4 bytes; sets *width and *height. Throws Error naming the file when it is
+/// missing, not a regular file, not a PNG or JPEG, or claims more pixels than partsim decodes
+/// (checked from its header before the pixels are allocated).
+std::vector<std::uint8_t> ReadImageRgba8(const std::string& path, int* width, int* height);
 
 }  // namespace partsim
