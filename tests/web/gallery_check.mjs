@@ -99,7 +99,12 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: 1100, heig
       const t0 = Date.now();
       o.poses0 = await ev(() => window.partsimViewer.bodyPoses());
       o.status0 = (await ev(() => window.partsimViewer.stats())).status;
-      await sleep(1500);
+      // three samples 0.75 s apart: the sweep (a cosine, 4 s a cycle) can bring a link back to
+      // where it was after 1.5 s when the two samples straddle the end of its range, but not
+      // after 0.75 s as well
+      await sleep(750);
+      o.poses_mid = await ev(() => window.partsimViewer.bodyPoses());
+      await sleep(750);
       o.poses1 = await ev(() => window.partsimViewer.bodyPoses());
       o.status1 = (await ev(() => window.partsimViewer.stats())).status;
       o.sampled_s = (Date.now() - t0) / 1000;
