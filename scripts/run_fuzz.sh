@@ -23,33 +23,27 @@ cmake --build "$build" -j2 --target urdf_fuzz obj_fuzz json_fuzz ply_fuzz
 
 # run on a scratch copy of the corpus so that new inputs stay out of the repository unless
 # they are copied back on purpose (crash files land in $build/artifacts)
-work="$build/corpus"
-mkdir -p "$work" "$build/artifacts"
-cp -n "$root"/tests/fuzz/corpus/* "$work"/ 2>/dev/null || true
+mkdir -p "$build/artifacts"
 cd "$build"
-ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" "$build/tests/fuzz/urdf_fuzz" "$work" \
-  -max_total_time="$seconds" -max_len=16384 -timeout=10 -rss_limit_mb=4096 \
-  -dict="$root/tests/fuzz/urdf.dict" -artifact_prefix="$build/artifacts/" -print_final_stats=1 "$@"
-
-obj_work="$build/obj_corpus"
-mkdir -p "$obj_work"
-cp -n "$root"/tests/fuzz/obj_corpus/* "$obj_work"/ 2>/dev/null || true
-ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" "$build/tests/fuzz/obj_fuzz" "$obj_work" \
-  -max_total_time="$(((seconds + 1) / 2))" -max_len=16384 -timeout=10 -rss_limit_mb=4096 \
-  -artifact_prefix="$build/artifacts/obj-" -print_final_stats=1 "$@"
-
-json_work="$build/json_corpus"
-mkdir -p "$json_work"
-cp -n "$root"/tests/fuzz/json_corpus/* "$json_work"/ 2>/dev/null || true
-ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" "$build/tests/fuzz/json_fuzz" "$json_work" \
-  -max_total_time="$(((seconds + 1) / 2))" -max_len=262144 -timeout=1 -rss_limit_mb=4096 \
-  -artifact_prefix="$build/artifacts/json-" -print_final_stats=1 "$@"
-
+extra=("$@")
+# fuzz TARGET CORPUS WORK LEAKS SECONDS ARTIFACT_PREFIX [libFuzzer flags...]: TARGET on a
+# scratch copy WORK of tests/fuzz/CORPUS, with leak checking LEAKS (1 or 0) unless ASAN_OPTIONS
+# says otherwise, then the caller's extra flags
+fuzz() {
+  local target="$1" corpus="$2" work="$build/$3" leaks="$4" time="$5" prefix="$6"
+  shift 6
+  mkdir -p "$work"
+  cp -n "$root/tests/fuzz/$corpus"/* "$work"/ 2>/dev/null || true
+  ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=$leaks}" "$build/tests/fuzz/$target" "$work" \
+    -max_total_time="$time" "$@" -artifact_prefix="$build/artifacts/$prefix" \
+    -print_final_stats=1 "${extra[@]}"
+}
+half=$(((seconds + 1) / 2))
+fuzz urdf_fuzz corpus corpus 1 "$seconds" "" -max_len=16384 -timeout=10 -rss_limit_mb=4096 \
+  -dict="$root/tests/fuzz/urdf.dict"
+fuzz obj_fuzz obj_corpus obj_corpus 1 "$half" obj- -max_len=16384 -timeout=10 -rss_limit_mb=4096
+fuzz json_fuzz json_corpus json_corpus 1 "$half" json- -max_len=262144 -timeout=1 \
+  -rss_limit_mb=4096
 # PLY headers through the mesh loader: a count beyond the file would allocate past the RSS limit.
 # No leak check: assimp 5.2.5's PLY reader leaks 1.3 KB on some files it refuses
-ply_work="$build/ply_corpus"
-mkdir -p "$ply_work"
-cp -n "$root"/tests/fuzz/ply_corpus/* "$ply_work"/ 2>/dev/null || true
-ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=0}" "$build/tests/fuzz/ply_fuzz" "$ply_work" \
-  -max_total_time="$(((seconds + 1) / 2))" -max_len=4096 -timeout=10 -rss_limit_mb=2048 \
-  -artifact_prefix="$build/artifacts/ply-" -print_final_stats=1 "$@"
+fuzz ply_fuzz ply_corpus ply_corpus 0 "$half" ply- -max_len=4096 -timeout=10 -rss_limit_mb=2048
