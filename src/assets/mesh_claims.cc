@@ -370,6 +370,14 @@ void CheckMeshClaims(const std::string& path) {
     CheckGltfJson(path, ReadWholeFile(path, "mesh file", kMaxDataFileBytes), size, 0);
   } else if (ext == ".dae" || head.find("<COLLADA") != std::string::npos) {
     CheckCollada(path, size);
+  } else {
+    // assimp reads some forty other formats, among them archives (.zae, .3mf: a zip bomb
+    // unpacks in memory) and formats whose readers size buffers from counts in the file; their
+    // claims are not checked here, so they are not read at all
+    Refuse(path,
+           "partsim reads meshes in OBJ, STL, PLY, COLLADA (.dae), glTF (.gltf, .glb); '" +
+               (ext.empty() ? std::string("(no extension)") : ext) +
+               "' is not one of them (convert the file, for example with Blender or MeshLab)");
   }
 }
 

@@ -309,5 +309,22 @@ TEST_F(MeshClaimsTest, ObjIndicesAndCountsAllocateNothingFromTheFile) {
   EXPECT_NE(e.find("line 4: face refers to vertex 2000000000 of 3"), std::string::npos) << e;
 }
 
+TEST_F(MeshClaimsTest, FormatsWhoseClaimsAreNotCheckedAreRefusedBeforeAssimpReadsThem) {
+  // an OFF file claiming 2e9 vertices and a zipped COLLADA: assimp reads both, unchecked
+  const std::string off = Write("big.off", "OFF\n2000000000 1 0\n0 0 0\n");
+  std::string e = LoadError(off);
+  EXPECT_NE(e.find("mesh file '" + off + "'"), std::string::npos) << e;
+  EXPECT_NE(e.find("'.off' is not one of them"), std::string::npos) << e;
+  EXPECT_NE(e.find("OBJ, STL, PLY, COLLADA (.dae), glTF (.gltf, .glb)"), std::string::npos) << e;
+  e = LoadError(Write("part.ZAE", "PK\3\4"));
+  EXPECT_NE(e.find("'.zae' is not one of them"), std::string::npos) << e;
+  e = LoadError(Write("noext", "solid x\nendsolid x\n"));
+  EXPECT_NE(e.find("'(no extension)' is not one of them"), std::string::npos) << e;
+  // a checked format is told by its first bytes whatever the name
+  std::ifstream in(kMeshDir + "box_yup.dae", std::ios::binary);
+  const std::string dae = Write("copy.xml", std::string(std::istreambuf_iterator<char>(in), {}));
+  EXPECT_EQ(LoadMeshFile(dae).size(), 1u);
+}
+
 }  // namespace
 }  // namespace partsim
