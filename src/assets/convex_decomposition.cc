@@ -15,6 +15,7 @@ extern "C" {
 #include <numeric>
 #include <random>
 #include <set>
+#include <string>
 #include <tuple>
 
 #include "partsim/assets/mesh.h"
@@ -104,8 +105,10 @@ double SignedVolume(const std::vector<Vector3d>& v, const std::vector<Eigen::Vec
 
 // --- convex hulls (qhull) ---
 
-// Convex hull of points, or nullptr when they span no volume.
-std::shared_ptr<MeshData> HullOrNull(const std::vector<Vector3d>& points) {
+// Convex hull of points, or nullptr when they span no volume. With `max_vertices` (at least 4),
+// qhull stops once its hull has that many vertices: the hull of a subset, each vertex added being
+// the point farthest outside some facet of the hull so far.
+std::shared_ptr<MeshData> HullOrNull(const std::vector<Vector3d>& points, int max_vertices = 0) {
   if (points.size() < 4) return nullptr;
   std::vector<double> coords;
   coords.reserve(points.size() * 3);
@@ -114,11 +117,14 @@ std::shared_ptr<MeshData> HullOrNull(const std::vector<Vector3d>& points) {
   qhT qh_storage;
   qhT* qh = &qh_storage;
   qh_zero(qh, stderr);
-  char flags[] = "qhull Qs";
+  // "TA n": stop after adding n vertices to the initial simplex (4 vertices)
+  std::string flags = "qhull Qs";
+  if (max_vertices >= 4 && static_cast<size_t>(max_vertices) < points.size())
+    flags += " TA" + std::to_string(max_vertices - 4);
   // errors (flat or too few points) come back as a non-zero code; keep qhull quiet
   FILE* quiet = fopen("/dev/null", "w");
-  int code = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(), False, flags,
-                          nullptr, quiet ? quiet : stderr);
+  int code = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coords.data(), False,
+                          flags.data(), nullptr, quiet ? quiet : stderr);
   std::shared_ptr<MeshData> out;
   if (code == 0) {
     out = std::make_shared<MeshData>();
@@ -438,13 +444,16 @@ double MeshVolume(const MeshData& mesh) {
   return six_v / 6.0;
 }
 
-std::shared_ptr<MeshData> ConvexHull(const std::vector<Vector3d>& points) {
+std::shared_ptr<MeshData> ConvexHull(const std::vector<Vector3d>& points, int max_vertices) {
+  if (max_vertices != 0 && max_vertices < 4)
+    throw Error("ConvexHull: max_vertices is " + std::to_string(max_vertices) +
+                ", must be 0 (no limit) or at least 4");
   for (size_t i = 0; i < points.size(); ++i) {
     if (!points[i].allFinite()) {
       throw Error("ConvexHull: point " + std::to_string(i) + " is not finite");
     }
   }
-  auto hull = HullOrNull(points);
+  auto hull = HullOrNull(points, max_vertices);
   if (!hull) {
     throw Error("ConvexHull: the " + std::to_string(points.size()) +
                 " points span no volume (fewer than 4, or all on one plane)");

@@ -192,6 +192,40 @@ bool ClosedAndConsistent(const MeshData& mesh) {
   return open <= directed.size() / 50;
 }
 
+// ConvexPieceCheck::simplified for a hull of `points` that qhull may have stopped at
+// kMaxConvexPieceVertices vertices: how far points lie outside it (at most 20000 of them
+// sampled), or "" for a hull that was not cut short.
+std::string Simplified(const MeshData& hull, const std::vector<Eigen::Vector3d>& points) {
+  if (points.size() <= static_cast<size_t>(kMaxConvexPieceVertices)) return "";
+  std::vector<Eigen::Vector3d> normals;
+  std::vector<double> offsets;
+  for (const Eigen::Vector3i& f : hull.faces) {
+    const Eigen::Vector3d a = hull.vertices[f[0]].cast<double>();
+    Eigen::Vector3d n =
+        (hull.vertices[f[1]].cast<double>() - a).cross(hull.vertices[f[2]].cast<double>() - a);
+    if (n.norm() < 1e-300) continue;
+    n.normalize();
+    normals.push_back(n);
+    offsets.push_back(n.dot(a));
+  }
+  double outside = 0.0;
+  const size_t stride = std::max<size_t>(1, points.size() / 20000);
+  for (size_t i = 0; i < points.size(); i += stride) {
+    double d = 0.0;
+    for (size_t k = 0; k < normals.size(); ++k)
+      d = std::max(d, normals[k].dot(points[i]) - offsets[k]);
+    outside = std::max(outside, d);
+  }
+  // qhull's merges can leave fewer vertices than the limit, so a cut-short hull also shows as
+  // points outside it (beyond rounding)
+  if (hull.vertices.size() < static_cast<size_t>(kMaxConvexPieceVertices) && outside < 1e-9)
+    return "";
+  return "has a convex hull of over " + std::to_string(kMaxConvexPieceVertices) + " vertices (" +
+         std::to_string(points.size()) + " distinct points): collides as the hull of " +
+         std::to_string(hull.vertices.size()) + " of them, which leaves points up to " +
+         Short(outside) + " m outside" + (stride > 1 ? " (of a sample)" : "");
+}
+
 }  // namespace
 
 ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh) {
@@ -246,7 +280,7 @@ ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh) {
 
   std::shared_ptr<MeshData> hull;
   try {
-    hull = ConvexHull(points);
+    hull = ConvexHull(points, kMaxConvexPieceVertices);
   } catch (const Error&) {
     // flat, line-like or fewer than 4 points: repaired below
   }
@@ -278,17 +312,26 @@ ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh) {
                                          : "is nearly flat";
     what += " (" + counted + ", " + Short(thin) + " m thick)";
     try {
-      std::shared_ptr<MeshData> thick = ConvexHull(pushed);
+      std::shared_ptr<MeshData> thick = ConvexHull(pushed, kMaxConvexPieceVertices);
       thick->source = mesh->source;
       thick->name = mesh->name;
       out.piece = thick;
       out.thickness = t;
       out.repair = what + ": given a convex hull " + Short(t) + " m thick";
+      out.simplified = Simplified(*thick, pushed);
     } catch (const Error&) {
       out.piece = nullptr;
       out.repair = what + ": dropped";
     }
     return out;
+  }
+
+  // many points: MuJoCo gets the hull's vertices, not all of them
+  out.simplified = Simplified(*hull, points);
+  if (points.size() > static_cast<size_t>(kMaxConvexPieceVertices)) {
+    hull->source = mesh->source;
+    hull->name = mesh->name;
+    out.piece = hull;
   }
 
   // convexity. A closed surface: the volume it encloses against its hull's. An open one: how

@@ -33,6 +33,7 @@ std::shared_ptr<const MeshData> CollidablePiece(std::shared_ptr<const MeshData> 
   const std::string name =
       mesh->source.empty() ? "a collision mesh" : "mesh '" + mesh->source + "'";
   if (!check.repair.empty()) LogWarning(name + ": collision piece " + check.repair);
+  if (!check.simplified.empty()) LogWarning(name + ": collision piece " + check.simplified);
   if (check.non_convex && whole_file) {
     static std::mutex mutex;
     static std::set<std::string> warned;

@@ -304,7 +304,7 @@ std::vector<std::shared_ptr<const MeshData>> Parser::CollisionMeshes(const std::
   // MuJoCo collides each piece as its convex hull and refuses pieces without volume: flat,
   // line-like and tiny pieces are thickened or dropped; the file's first user hears of it, once
   std::vector<std::shared_ptr<const MeshData>> pieces;
-  std::vector<std::string> repairs;
+  std::vector<std::string> repairs, simplified;
   int non_convex = 0;
   const bool several = loaded.size() > 1;
   for (size_t k = 0; k < loaded.size(); ++k) {
@@ -315,6 +315,10 @@ std::vector<std::shared_ptr<const MeshData>> Parser::CollisionMeshes(const std::
     }
     if (check.piece) pieces.push_back(check.piece);
     non_convex += check.non_convex;
+    if (!check.simplified.empty()) {
+      simplified.push_back((several ? "piece " + std::to_string(k) + " " : std::string()) +
+                           check.simplified);
+    }
   }
   const std::string file = "mesh '" + uri + "'";
   if (!repairs.empty()) {
@@ -326,6 +330,13 @@ std::vector<std::shared_ptr<const MeshData>> Parser::CollisionMeshes(const std::
                         " collision pieces are degenerate: "
                   : "collision piece ") +
          list);
+  }
+  // a hull of too many vertices, cut short, is no defect of the file either
+  if (!simplified.empty()) {
+    std::string list;
+    for (size_t k = 0; k < simplified.size() && k < 4; ++k) list += (k ? "; " : "") + simplified[k];
+    if (simplified.size() > 4) list += "; and " + std::to_string(simplified.size() - 4) + " more";
+    report_->Warn(source_, where + " " + file + ": collision piece " + list);
   }
   // a non-convex mesh is no defect of the file, only a limit of hull collision: a warning even
   // when loading strictly

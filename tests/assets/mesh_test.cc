@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -287,6 +289,101 @@ TEST(ConvexPieceTest, ConvexShapesPassAndNonConvexOnesAreFlagged) {
   // a torus is closed and clearly not convex; a thin-walled cup too
   EXPECT_TRUE(CheckConvexPiece(Shared(testing::Torus(0.2, 0.05))).non_convex);
   EXPECT_TRUE(CheckConvexPiece(Shared(testing::Cup(0.05, 0.1, 0.004, 32))).non_convex);
+}
+
+// How far a point lies outside a closed convex mesh (m): its largest signed distance to the planes
+// of the triangles, 0 or less inside.
+double OutsideConvex(const MeshData& hull, const Eigen::Vector3d& p) {
+  double d = -1e30;
+  for (const Eigen::Vector3i& f : hull.faces) {
+    const Eigen::Vector3d a = hull.vertices[f[0]].cast<double>();
+    const Eigen::Vector3d n =
+        (hull.vertices[f[1]].cast<double>() - a).cross(hull.vertices[f[2]].cast<double>() - a);
+    if (n.norm() > 1e-12) d = std::max(d, n.normalized().dot(p - a));
+  }
+  return d;
+}
+
+// A regular polygon of `corners` corners and radius 0.5 m in the plane z = `z`.
+std::vector<Eigen::Vector3f> Polygon(int corners, float z = 0.0f) {
+  std::vector<Eigen::Vector3f> out;
+  for (int i = 0; i < corners; ++i) {
+    const double a = 2 * M_PI * i / corners;
+    out.emplace_back(0.5 * std::cos(a), 0.5 * std::sin(a), z);
+  }
+  return out;
+}
+
+TEST(ConvexPieceTest, FlatFaceOfManyCornersGetsAThinHullOfBoundedSize) {
+  // a flat 10,000-corner face: its thin hull has 20,000 corners, and qhull's merging of the
+  // coplanar facets (partsim's hull, then MuJoCo's when it compiles the piece) grows about as
+  // n^2.5 in them; the piece keeps at most kMaxConvexPieceVertices
+  const std::vector<Eigen::Vector3f> face = Polygon(10000);
+  ConvexPieceCheck c = CheckConvexPiece(Shared(Points(face)));
+  ASSERT_TRUE(c.piece);
+  EXPECT_NE(c.repair.find("flat"), std::string::npos) << c.repair;
+  EXPECT_DOUBLE_EQ(c.thickness, 0.005);
+  EXPECT_LE(c.piece->vertices.size(), static_cast<size_t>(kMaxConvexPieceVertices));
+  EXPECT_NE(c.simplified.find("collides as the hull of"), std::string::npos) << c.simplified;
+  // still the face, 5 mm thick: every corner at most 1 mm (0.1% of its size) outside the piece
+  EXPECT_NEAR(ExtentAlong(*c.piece, Eigen::Vector3d::UnitZ()), 0.005, 1e-6);
+  EXPECT_NEAR(ExtentAlong(*c.piece, Eigen::Vector3d::UnitX()), 1.0, 1e-3);
+  EXPECT_NEAR(ExtentAlong(*c.piece, Eigen::Vector3d::UnitY()), 1.0, 1e-3);
+  double outside = 0;
+  for (const Eigen::Vector3f& v : face)
+    outside = std::max(outside, OutsideConvex(*c.piece, v.cast<double>()));
+  EXPECT_LT(outside, 1e-3);
+  EXPECT_GT(MeshVolume(*c.piece), M_PI * 0.25 * 0.005 * 0.99);
+}
+
+TEST(ConvexPieceTest, SolidOfManyPointsCollidesAsABoundedHull) {
+  // the side of a cylinder of 5,000 segments: 10,000 points on two planes, convex
+  MeshData side;
+  for (float z : {0.0f, 0.3f}) {
+    const std::vector<Eigen::Vector3f> rim = Polygon(5000, z);
+    side.vertices.insert(side.vertices.end(), rim.begin(), rim.end());
+  }
+  for (int i = 0; i < 5000; ++i) {
+    const int j = (i + 1) % 5000;
+    side.faces.emplace_back(i, j, 5000 + j);
+    side.faces.emplace_back(i, 5000 + j, 5000 + i);
+  }
+  ConvexPieceCheck c = CheckConvexPiece(Shared(side));
+  ASSERT_TRUE(c.piece);
+  EXPECT_TRUE(c.repair.empty()) << c.repair;
+  EXPECT_FALSE(c.non_convex);
+  // MuJoCo gets a hull of at most kMaxConvexPieceVertices, not the 10,000 points
+  EXPECT_LE(c.piece->vertices.size(), static_cast<size_t>(kMaxConvexPieceVertices));
+  EXPECT_FALSE(c.simplified.empty());
+  double outside = 0;
+  for (const Eigen::Vector3f& v : side.vertices)
+    outside = std::max(outside, OutsideConvex(*c.piece, v.cast<double>()));
+  EXPECT_LT(outside, 1e-3);
+  // a box of 8 points is kept as it is, and says nothing
+  auto box = Shared(testing::Box());
+  ConvexPieceCheck b = CheckConvexPiece(box);
+  EXPECT_EQ(b.piece, box);
+  EXPECT_TRUE(b.simplified.empty()) << b.simplified;
+}
+
+TEST(ConvexPieceTest, ConvexHullKeepsAtMostMaxVertices) {
+  std::vector<Eigen::Vector3d> prism;
+  for (const Eigen::Vector3f& v : Polygon(3000)) {
+    prism.push_back(v.cast<double>());
+    prism.push_back(v.cast<double>() + Eigen::Vector3d(0, 0, 0.01));
+  }
+  std::shared_ptr<MeshData> capped = ConvexHull(prism, 100);
+  EXPECT_LE(capped->vertices.size(), 100u);
+  EXPECT_GT(MeshVolume(*capped), 0.0);
+  // the limit counts the 4 points of qhull's first simplex
+  EXPECT_THROW(ConvexHull(prism, 3), Error);
+  // no limit: every corner of a 20-sided prism
+  std::vector<Eigen::Vector3d> small;
+  for (const Eigen::Vector3f& v : Polygon(20)) {
+    small.push_back(v.cast<double>());
+    small.push_back(v.cast<double>() + Eigen::Vector3d(0, 0, 0.01));
+  }
+  EXPECT_EQ(ConvexHull(small)->vertices.size(), 40u);
 }
 
 }  // namespace

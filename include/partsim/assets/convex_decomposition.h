@@ -92,7 +92,13 @@ std::vector<std::string> WriteConvexPieces(const ConvexDecompositionResult& resu
 
 /// Convex hull of points (m): closed, triangulated, counter-clockwise seen from outside. Throws
 /// partsim::Error when the points span no volume (fewer than 4, or all on one plane).
-std::shared_ptr<MeshData> ConvexHull(const std::vector<Eigen::Vector3d>& points);
+/// `max_vertices` (0: no limit, else at least 4) bounds the hull's vertices: qhull stops once it
+/// has that many, each added point being the farthest outside a facet of the hull so far, and the
+/// result is the hull of that subset, inside the full hull. qhull merges coplanar facets at a cost
+/// that grows about as n^2.5 in the vertices on one plane (a 4,000-corner prism: 6 s), so callers
+/// that take untrusted points give a limit.
+std::shared_ptr<MeshData> ConvexHull(const std::vector<Eigen::Vector3d>& points,
+                                     int max_vertices = 0);
 
 /// Signed volume enclosed by a closed triangle mesh (m^3): positive when its triangles are
 /// counter-clockwise seen from outside.
