@@ -8,10 +8,11 @@ server. Each measurement has a ceiling (``--cap`` s of waiting, ``--rss-cap`` MB
 past which the attack is stopped and the row says "> cap". Scenarios:
 
 * ``json``: an unauthenticated viewer client sends ``{"op":"x","a":[{},{},...]}`` of 300,000
-  objects (900 KB); then an authenticated client calls ``/partsim/pause`` and the row gives the
-  seconds until its answer (the network thread was parsing meanwhile).
+  objects (900 KB); 1 s later (the server reads connections in turn: a short message sent
+  meanwhile would pass the long one) an authenticated client calls ``/partsim/pause``, and the
+  row gives the seconds until its answer.
 * ``trajectory``: a rosbridge client publishes a JointTrajectory of 200,000 points (12 MB),
-  then a second client calls ``/rosapi/topics``: seconds until the answer.
+  then, 1 s later, a second client calls ``/rosapi/topics``: seconds until the answer.
 * ``plans``: a client asks ``/panda/plan`` four times (RRTstar, 30 s, execute false) and
   disconnects; a second client then asks for a 1 s plan: seconds until its answer.
 * ``camera``: a viewer client sends 3,000 ``/partsim/camera`` calls without waiting; a second
@@ -151,6 +152,7 @@ def json_flood(cli, a):
         other = s.client(viewer=True)
         bad = s.client(viewer=True, auth=False)
         bad.send('{"op":"x","a":[' + ",".join(["{}"] * 300000) + "]}")
+        time.sleep(1)  # until the server has read it all (it reads connections in turn)
         return seconds(call(other, "/partsim/pause", {}, "p", a.cap), a.cap)
 
 
@@ -163,6 +165,7 @@ def trajectory(cli, a):
                                 "topic": "/panda/joint_trajectory_controller/command",
                                 "msg": {"joint_names": [], "points": points}},
                                separators=(",", ":")))
+        time.sleep(1)
         return seconds(call(other, "/rosapi/topics", {}, "t", a.cap), a.cap)
 
 
