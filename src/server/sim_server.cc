@@ -127,15 +127,22 @@ void SimServer::RunCommands(std::unique_lock<std::mutex>& lock) {
   pending.swap(queue_);
   lock.unlock();
   for (Command& c : pending) {
+    // once stopping, what is still queued is dropped: Stop() waits for one command at most
+    if (stop_) break;
     Guarded("command", c);
     ++commands_run_;
   }
+  pending.clear();  // the dropped commands' captures go on this thread, outside the lock
   lock.lock();
 }
 
 void SimServer::Loop() {
   Clock::time_point anchor_wall;
   long long anchor_steps = 0;
+  // when the last paced step was due: a re-anchored clock never starts before the step after
+  // it, so pauses, resumes and option changes cannot make the simulation run ahead of the wall
+  Clock::time_point last_due{};
+  bool paced = false;    // last_due holds the due time of a paced step
   bool stepped = false;  // since the thread last came to rest
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
@@ -162,6 +169,12 @@ void SimServer::Loop() {
     if (!single && !options_.fast) {
       if (resync_) {
         anchor_wall = Clock::now();
+        if (paced) {
+          const Clock::time_point next =
+              last_due + std::chrono::duration_cast<Clock::duration>(
+                             std::chrono::duration<double>(dt_ / options_.realtime_factor));
+          anchor_wall = std::max(anchor_wall, next);
+        }
         anchor_steps = clock_steps_;
         resync_ = false;
       }
@@ -171,14 +184,18 @@ void SimServer::Loop() {
       Clock::time_point now = Clock::now();
       if (now > due + std::chrono::duration<double>(options_.max_lag)) {
         resync_ = true;  // too far behind: drop the lag
+        due = now;
       } else if (due > now) {
         // wake early for commands, pause or stop
         if (cv_.wait_until(lock, due,
                            [this] { return stop_ || !queue_.empty() || paused_.load(); }))
           continue;
       }
+      last_due = due;
+      paced = true;
     } else {
       resync_ = true;
+      paced = false;
     }
     lock.unlock();
     Guarded("step", [this] {

@@ -45,9 +45,12 @@ class SimServer {
 
   /// Starts the thread, running unless `paused`. Throws partsim::Error if already started.
   void Start(bool paused = false);
-  /// Stops and joins the thread (queued commands still run first). Idempotent.
+  /// Stops and joins the thread: a command or step under way finishes, the commands still
+  /// queued are dropped without running (destroyed on the simulation thread). Idempotent.
   void Stop();
   void Pause();
+  /// Resumes stepping; in real time, never ahead of the wall clock: the first step after a
+  /// resume is due no earlier than one step after the last paced step was.
   void Resume();
   bool IsPaused() const { return paused_; }
   /// Most steps one StepN may ask for, and most steps waiting at once.
@@ -100,8 +103,8 @@ class SimServer {
   mutable std::mutex mutex_;
   std::condition_variable cv_;
   std::vector<Command> queue_;
-  bool stop_ = false;
-  bool resync_ = true;  ///< re-anchor the wall clock at the next step
+  std::atomic<bool> stop_{false};  ///< written under mutex_
+  bool resync_ = true;             ///< re-anchor the wall clock at the next step
   std::atomic<bool> paused_{false};
   std::atomic<long long> pending_steps_{0};
   std::atomic<long long> clock_steps_{0};
