@@ -64,6 +64,12 @@ constexpr const char* kContactsTopic = "/partsim/contacts";
 constexpr std::uintmax_t kMaxTextureBytes = 64u << 20;
 // files of the web bundle the viewer sends (bytes)
 constexpr std::uintmax_t kMaxBundleFileBytes = 256u << 20;
+// commands of one client waiting for the scene's thread (set_joint_target, camera, reset):
+// more are refused at once, so that one client's flood delays another's command by this many
+constexpr int kMaxWaitingCommandsPerClient = 64;
+// bytes a message may have before its client has authenticated (the auth op needs a few
+// dozen): the rosbridge server's kMaxUnauthenticatedBytes
+constexpr size_t kMaxUnauthenticatedBytes = 4096;
 
 const char kNoBundlePage[] = R"(<!doctype html>
 <html><head><meta charset="utf-8"><title>partsim viewer</title></head>
@@ -80,6 +86,10 @@ The scene is served meanwhile: <code>/api/scene.json?token=...</code>.</p>
 struct ViewerClient {
   Hdl connection;
   bool authenticated = false;
+  /// commands queued for the scene's thread and not run yet (counted down there)
+  std::shared_ptr<std::atomic<int>> waiting = std::make_shared<std::atomic<int>>(0);
+  /// closes the connection unless it authenticates in time (ViewerOptions::auth_timeout)
+  std::unique_ptr<boost::asio::steady_timer> auth_timer;
   std::set<std::string> topics;
   long long poses_version = -1;  ///< content version of sent_poses; -1: send every body next
   std::vector<double> sent_poses;
@@ -160,6 +170,7 @@ struct Viewer::Impl {
   std::atomic<bool> want_contacts{false};
   std::atomic<bool> started{false};
   std::atomic<bool> publish_scheduled{false};
+  std::atomic<bool> snapshot_requested{false};  ///< a forced snapshot is queued already
 
   // ---- the network thread ----
   WsServer ws;
@@ -168,6 +179,9 @@ struct Viewer::Impl {
   std::unique_ptr<boost::asio::steady_timer> accept_timer;  // network thread
   std::atomic<long long> accept_errors{0};
   std::map<Hdl, ClientPtr, std::owner_less<Hdl>> clients;
+  /// connections that passed the handshake's checks and have not gone: max_clients counts these
+  /// (a burst of handshakes all pass validation before any opens)
+  std::set<Hdl, std::owner_less<Hdl>> slots;
   struct RateSample {
     Clock::time_point wall;
     long long step;
@@ -236,11 +250,20 @@ struct Viewer::Impl {
   // ================= commands from the page =================
 
   /// Runs `fn` on the scene's thread and answers the call `id` of `service` with what it
-  /// returns, or with its error.
+  /// returns, or with its error. Throws partsim::Error when the client has
+  /// kMaxWaitingCommandsPerClient commands waiting already.
   void Enqueue(const ClientPtr& client, const std::string& service, const Json& id,
                std::function<Json(Scene&)> fn) {
+    if (++*client->waiting > kMaxWaitingCommandsPerClient) {
+      --*client->waiting;
+      throw Error("too many commands waiting: at most " +
+                  std::to_string(kMaxWaitingCommandsPerClient) +
+                  " of a client wait for the scene's thread; wait for their answers, then call "
+                  "again");
+    }
     std::weak_ptr<ViewerClient> weak = client;
-    auto run = [this, weak, service, id, fn] {
+    auto run = [this, weak, waiting = client->waiting, service, id, fn] {
+      --*waiting;
       Json reply;
       try {
         if (!scene) throw Error("the viewer has no scene");
@@ -266,14 +289,20 @@ struct Viewer::Impl {
   }
 
   /// A forced snapshot on the scene's thread (a client subscribed; a paused scene takes none).
+  /// One waits at most: requests while it waits are served by it.
   void RequestSnapshot() {
+    if (snapshot_requested.exchange(true)) return;
+    auto take = [this] {
+      snapshot_requested = false;
+      Snapshot(true);
+    };
     if (sim) {
-      sim->Post([this] { Snapshot(true); });
+      sim->Post(take);
       return;
     }
     {
       std::lock_guard<std::mutex> lock(mutex);
-      commands.push_back([this] { Snapshot(true); });
+      commands.push_back(take);
     }
     cv.notify_all();
   }
@@ -568,6 +597,17 @@ struct Viewer::Impl {
   }
 
   void HandleMessage(const ClientPtr& c, const std::string& payload) {
+    // before it has authenticated, a client may send the auth op alone: anything longer is
+    // refused unparsed, so that it costs the viewer no more than its bytes
+    if (!c->authenticated && payload.size() > kMaxUnauthenticatedBytes) {
+      StatusError(c,
+                  "authenticate first: before {\"op\": \"auth\"} succeeds, messages are limited "
+                  "to " +
+                      std::to_string(kMaxUnauthenticatedBytes) + " bytes (got " +
+                      std::to_string(payload.size()) + ")",
+                  nullptr);
+      return;
+    }
     Json j;
     try {
       j = internal::ParseJsonBounded(payload);
@@ -597,6 +637,7 @@ struct Viewer::Impl {
         return;
       }
       c->authenticated = true;
+      if (c->auth_timer) c->auth_timer->cancel();
       SendText(c, Dump(internal::StatusToJson("info", "authenticated", id)), false);
       return;
     }
@@ -1019,10 +1060,12 @@ struct Viewer::Impl {
         con->set_status(websocketpp::http::status_code::forbidden);
         return false;
       }
-      if (clients.size() >= options.max_clients) {
+      // a slot is taken here and given back when the connection fails or closes
+      if (slots.size() >= options.max_clients) {
         con->set_status(websocketpp::http::status_code::service_unavailable);
         return false;
       }
+      slots.insert(h);
       return true;
     });
     ws.set_open_handler([this](Hdl h) {
@@ -1030,8 +1073,29 @@ struct Viewer::Impl {
       c->connection = h;
       clients[h] = c;
       client_count = static_cast<long long>(clients.size());
+      // a client that has not authenticated in time is closed
+      c->auth_timer = std::make_unique<boost::asio::steady_timer>(ws.get_io_service());
+      c->auth_timer->expires_after(std::chrono::duration_cast<Clock::duration>(
+          std::chrono::duration<double>(options.auth_timeout)));
+      std::weak_ptr<ViewerClient> weak = c;
+      c->auth_timer->async_wait([this, weak](const boost::system::error_code& e) {
+        ClientPtr client = weak.lock();
+        if (e || !client || client->authenticated) return;
+        char why[160];
+        std::snprintf(why, sizeof(why),
+                      "auth: no {\"op\": \"auth\"} with the token within %g s; closing the "
+                      "connection",
+                      options.auth_timeout);
+        StatusError(client, why, nullptr);
+        websocketpp::lib::error_code ec;
+        ws.close(client->connection, websocketpp::close::status::policy_violation,
+                 "not authenticated in time", ec);
+      });
     });
     auto gone = [this](Hdl h) {
+      slots.erase(h);
+      if (auto it = clients.find(h); it != clients.end() && it->second->auth_timer)
+        it->second->auth_timer->cancel();
       clients.erase(h);
       client_count = static_cast<long long>(clients.size());
       UpdateWantContacts();
@@ -1089,6 +1153,9 @@ Viewer::Viewer(Scene* scene, const ViewerOptions& options) : impl_(std::make_uni
   if (!(options.max_rate > 0) || !std::isfinite(options.max_rate))
     throw Error("Viewer: max_rate must be a positive number of Hz, got " +
                 std::to_string(options.max_rate));
+  if (!(options.auth_timeout > 0) || options.auth_timeout > 1e6)
+    throw Error("Viewer: auth_timeout must be a positive number of seconds (at most 1e6), got " +
+                std::to_string(options.auth_timeout));
   Impl& m = *impl_;
   m.options = options;
   m.scene = scene;

@@ -817,6 +817,154 @@ TEST_F(ViewerTest, OutOfFileDescriptorsTheAcceptLoopWaitsInsteadOfSpinning) {
   EXPECT_TRUE(c.WaitOpen());
 }
 
+// The commands a client has waiting for the scene's thread are bounded (64): 3,000 camera calls
+// of one client once held another's joint command for a minute. Beyond the bound a call is
+// answered at once with an error naming it, so another client's command waits behind at most
+// 64 of the flooder's.
+TEST_F(ViewerTest, OneClientsFloodOfCommandsDelaysAnothersByAtMostTheBound) {
+  Viewer& v = Start();
+  TestClient flooder(v.GetPort()), other(v.GetPort());
+  ASSERT_TRUE(flooder.WaitOpen());
+  ASSERT_TRUE(other.WaitOpen());
+  flooder.Auth(v.GetToken());
+  other.Auth(v.GetToken());
+  // synchronous mode: nothing runs until Render(), so every call waits; a call of an unknown
+  // service, answered on the network thread, tells when the calls before it were handled
+  const int flood = 300;
+  for (int k = 0; k < flood; ++k)
+    flooder.Send(Call("/partsim/camera", {{"name", "no_such_camera"}}, "f" + std::to_string(k)));
+  flooder.Send(Call("/partsim/no_such_service", json::object(), "flooded"));
+  ASSERT_FALSE(flooder.WaitReply("flooded").is_null());
+  auto refused = [&] {
+    int n = 0;
+    for (const json& m : flooder.Messages())
+      if (m.value("op", "") == "service_response" && m.value("result", true) == false &&
+          m["values"].dump().find("at most 64") != std::string::npos)
+        ++n;
+    return n;
+  };
+  EXPECT_EQ(refused(), flood - 64);
+  const Joint joint = MovableJoint();
+  const double target = 0.5 * (joint.GetLimits()[0] + joint.GetLimits()[1]);
+  other.Send(Call("/partsim/set_joint_target",
+                  {{"articulation", 0}, {"joint", joint.GetName()}, {"position", target}}, "t"));
+  other.Send(Call("/partsim/no_such_service", json::object(), "sent"));
+  ASSERT_FALSE(other.WaitReply("sent").is_null());
+  // one Render() runs what waits: the flooder's 64 calls and the other's command
+  v.Render();
+  const json reply = other.WaitReply("t");
+  ASSERT_FALSE(reply.is_null());
+  EXPECT_TRUE(reply["result"].get<bool>()) << reply;
+  EXPECT_DOUBLE_EQ(joint.GetDriveTarget(), target);
+  ASSERT_TRUE(WaitFor([&] {
+    int answered = 0;
+    for (const json& m : flooder.Messages())
+      if (m["values"].dump().find("no camera 'no_such_camera'") != std::string::npos) ++answered;
+    return answered == 64;
+  }));
+  // answered calls free their places: the flooder may call again
+  flooder.Clear();
+  flooder.Send(Call("/partsim/camera", {{"name", "no_such_camera"}}, "again"));
+  flooder.Send(Call("/partsim/no_such_service", json::object(), "flooded"));
+  ASSERT_FALSE(flooder.WaitReply("flooded").is_null());
+  EXPECT_EQ(refused(), 0);
+}
+
+// Before a client has authenticated, a message longer than 4,096 bytes is refused without
+// being parsed (the rosbridge server's bound): an auth op padded to 8 kB does not log in.
+TEST_F(ViewerTest, UnauthenticatedMessagesOverTheBoundAreRefusedUnparsed) {
+  Viewer& v = Start();
+  TestClient c(v.GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "auth"}, {"mac", v.GetToken()}, {"pad", std::string(8000, 'x')}});
+  const json e = c.WaitMessage([](const json& m) { return m.value("level", "") == "error"; });
+  ASSERT_FALSE(e.is_null());
+  EXPECT_NE(e["msg"].get<std::string>().find("limited to 4096 bytes"), std::string::npos) << e;
+  for (const json& m : c.Messages()) EXPECT_NE(m.value("msg", ""), "authenticated");
+  c.Clear();
+  c.Send(json{{"op", "subscribe"}, {"topic", "/partsim/status"}, {"id", "s"}});
+  EXPECT_NE(c.WaitReply("s").value("msg", "").find("authenticate first"), std::string::npos);
+  c.Auth(v.GetToken());  // a plain auth op still logs in
+  c.Send(std::string(6000, ' ') + R"({"op": "auth", "mac": "x", "id": "long"})");
+  EXPECT_EQ(c.WaitReply("long").value("msg", ""), "authenticated");  // once in, 4 kB is no bound
+}
+
+// max_clients counts connections from their handshake: a burst of handshakes all passed the
+// check before any connection opened (69 of 32 got in under a burst of 400). 64 handshakes
+// written at once, answers read afterwards: at most max_clients get 101.
+TEST_F(ViewerTest, MaxClientsHoldsUnderABurstOfHandshakes) {
+  ViewerOptions o;
+  o.max_clients = 4;
+  Viewer& v = Start(o);
+  std::vector<int> socks;
+  const std::string request =
+      "GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+      "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
+  for (int i = 0; i < 64; ++i) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<uint16_t>(v.GetPort()));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
+    timeval tv{10, 0};
+    ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+    socks.push_back(fd);
+  }
+  for (int fd : socks)
+    ASSERT_EQ(::send(fd, request.data(), request.size(), MSG_NOSIGNAL),
+              static_cast<ssize_t>(request.size()));
+  int upgraded = 0, refused = 0;
+  for (int fd : socks) {
+    std::string head;
+    char ch;
+    while (head.find("\r\n") == std::string::npos && ::recv(fd, &ch, 1, 0) == 1) head += ch;
+    if (head.find(" 101 ") != std::string::npos) ++upgraded;
+    if (head.find(" 503 ") != std::string::npos) ++refused;
+  }
+  EXPECT_LE(upgraded, 4);
+  EXPECT_GE(upgraded, 1);
+  EXPECT_EQ(upgraded + refused, 64);
+  for (int fd : socks) ::close(fd);
+  // the slots are given back as the connections go
+  ASSERT_TRUE(WaitFor([&] { return v.GetStats().clients == 0; }));
+  bool in = false;
+  for (int attempt = 0; attempt < 20 && !in; ++attempt) {
+    TestClient c(v.GetPort());
+    in = c.WaitOpen();
+    if (!in) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_TRUE(in);
+}
+
+// A client that has not authenticated within auth_timeout is closed (code 1008); one that has
+// stays.
+TEST_F(ViewerTest, ClientsThatDoNotAuthenticateInTimeAreClosed) {
+  ViewerOptions o;
+  o.auth_timeout = 2.0;
+  EXPECT_THROW(Viewer(scene_.get(),
+                      [] {
+                        ViewerOptions bad;
+                        bad.auth_timeout = 0;
+                        return bad;
+                      }()),
+               Error);
+  Viewer& v = Start(o);
+  TestClient silent(v.GetPort()), member(v.GetPort());
+  ASSERT_TRUE(silent.WaitOpen());
+  ASSERT_TRUE(member.WaitOpen());
+  member.Auth(v.GetToken());
+  ASSERT_TRUE(WaitFor([&] { return silent.Closed(); }));
+  EXPECT_EQ(silent.CloseCode(), 1008);
+  EXPECT_NE(silent.Messages().at(0).value("msg", "").find("within 2 s"), std::string::npos);
+  // the authenticated client outlived the timeout
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_FALSE(member.Closed());
+  member.Send(json{{"op", "auth"}, {"mac", v.GetToken()}, {"id", "still"}});
+  EXPECT_EQ(member.WaitReply("still").value("msg", ""), "authenticated");
+}
+
 TEST_F(ViewerTest, ServedModeFollowsTheSimServer) {
   SimServerOptions so;
   so.fast = false;

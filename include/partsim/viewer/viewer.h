@@ -33,10 +33,14 @@ struct ViewerOptions {
   /// share/partsim/web beside the installed binary, else the build tree's web/; without one, /
   /// answers a page that says how to build it.
   std::string web_root;
-  double max_rate = 60.0;                 ///< most pose messages per second (Hz), > 0
-  size_t max_clients = 32;                ///< WebSocket connections at once; more get HTTP 503
+  double max_rate = 60.0;  ///< most pose messages per second (Hz), > 0
+  /// WebSocket connections at once, counted from the handshake; more get HTTP 503
+  size_t max_clients = 32;
   size_t max_message_bytes = 1u << 20;    ///< larger incoming messages close with code 1009
   size_t max_client_buffered = 8u << 20;  ///< bytes waiting in a client's socket before drops
+  /// Seconds a WebSocket client has to authenticate ({"op": "auth"}) before it is closed
+  /// (code 1008); > 0.
+  double auth_timeout = 5.0;
 };
 
 /// Counters for tests and benchmarks.
