@@ -4,6 +4,7 @@
 // command topic and the follow_joint_trajectory action, plans through /<robot>/plan and steps
 // a paused simulation. Skipped when partsim is built without ROS 1.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -158,6 +159,54 @@ TEST_F(Ros1ServeTest, RospyAndActionlibClientDrivesTheRobot) {
   EXPECT_LT(r["action_final_error"].get<double>(), 0.02);
   EXPECT_TRUE(r["plan_success"].get<bool>());
   EXPECT_NEAR(r["stepped_seconds"].get<double>(), 0.05, 1e-6);
+}
+
+// A follow_joint_trajectory goal of more points than the rosbridge server accepts
+// (internal::kMaxTrajectoryPoints, 10,000) was converted and executed; it is now rejected
+// before any point is converted, with a message that names the bound.
+TEST_F(Ros1ServeTest, TrajectoryOfTooManyPointsIsRejected) {
+  const std::string script =
+      ::testing::TempDir() + "partsim_ros1_many_points_" + std::to_string(::getpid()) + ".py";
+  std::FILE* f = std::fopen(script.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fputs(R"(import json, sys
+import actionlib, rospy
+from control_msgs.msg import FollowJointTrajectoryAction, FollowJointTrajectoryGoal
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectoryPoint
+rospy.init_node("partsim_many_points", anonymous=True, disable_signals=True)
+arm = ["panda_joint%d" % i for i in range(1, 8)]
+js = rospy.wait_for_message("/joint_states", JointState, timeout=30)
+q = [js.position[list(js.name).index(n)] for n in arm]
+client = actionlib.SimpleActionClient(
+    "/panda/joint_trajectory_controller/follow_joint_trajectory", FollowJointTrajectoryAction)
+assert client.wait_for_server(rospy.Duration(30.0))
+g = FollowJointTrajectoryGoal()
+g.trajectory.joint_names = arm
+g.trajectory.points = [JointTrajectoryPoint(positions=q, time_from_start=rospy.Duration(0.01 * (k + 1)))
+                       for k in range(10001)]
+client.send_goal(g)
+finished = client.wait_for_result(rospy.Duration(30.0))
+r = client.get_result()
+print(json.dumps({"finished": finished, "state": client.get_state(),
+                  "error_code": r.error_code if r else None,
+                  "error_string": r.error_string if r else ""}))
+)",
+             f);
+  std::fclose(f);
+  int code = 0;
+  const std::string out = Run("timeout 120 /usr/bin/python3 '" + script + "'", &code);
+  std::remove(script.c_str());
+  std::string last = out.substr(0, out.find_last_not_of('\n') + 1);
+  last = last.substr(last.rfind('\n') == std::string::npos ? 0 : last.rfind('\n') + 1);
+  const json r = json::parse(last, nullptr, false);
+  ASSERT_FALSE(r.is_discarded()) << out;
+  EXPECT_TRUE(r["finished"].get<bool>()) << out;
+  EXPECT_EQ(r["state"].get<int>(), 5) << out;        // actionlib_msgs/GoalStatus REJECTED
+  EXPECT_EQ(r["error_code"].get<int>(), -1) << out;  // FollowJointTrajectoryResult INVALID_GOAL
+  EXPECT_NE(r["error_string"].get<std::string>().find("10001 points, more than the 10000"),
+            std::string::npos)
+      << out;
 }
 
 TEST(Ros1ServeNoMasterTest, ServeFailsClearly) {

@@ -37,7 +37,17 @@ std::vector<double> ToStd(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
 }
 
-TrajectoryCommand FromMsg(const trajectory_msgs::JointTrajectory& t) {
+/// Most points a trajectory may have: the rosbridge server's internal::kMaxTrajectoryPoints
+/// (src/server/ros_json.h, outside this library's include path).
+constexpr size_t kMaxTrajectoryPoints = 10000;
+
+/// The command of a trajectory message (`what` names it in errors); throws partsim::Error for
+/// more than kMaxTrajectoryPoints points, before any is converted (the rosbridge
+/// server's bound).
+TrajectoryCommand FromMsg(const trajectory_msgs::JointTrajectory& t, const std::string& what) {
+  if (t.points.size() > kMaxTrajectoryPoints)
+    throw Error(what + ": " + std::to_string(t.points.size()) + " points, more than the " +
+                std::to_string(kMaxTrajectoryPoints) + " a trajectory may have");
   TrajectoryCommand c;
   c.joint_names = t.joint_names;
   bool all_vel = !t.points.empty();
@@ -247,9 +257,11 @@ struct Ros1Bridge::Impl {
   void OnTrajectory(const std::string& topic,
                     const trajectory_msgs::JointTrajectory::ConstPtr& msg) {
     try {
-      robot->CommandTrajectory(FromMsg(*msg), topic, [](TrajectoryOutcome o, const std::string& m) {
-        if (o == TrajectoryOutcome::kInvalidGoal) ROS_ERROR_STREAM("partsim: " << m);
-      });
+      robot->CommandTrajectory(FromMsg(*msg, topic), topic,
+                               [](TrajectoryOutcome o, const std::string& m) {
+                                 if (o == TrajectoryOutcome::kInvalidGoal)
+                                   ROS_ERROR_STREAM("partsim: " << m);
+                               });
     } catch (const std::exception& e) {
       ROS_ERROR_STREAM("partsim: " << e.what());
     }
@@ -257,19 +269,23 @@ struct Ros1Bridge::Impl {
 
   void OnGoal(GoalHandle gh) {
     const control_msgs::FollowJointTrajectoryGoal& goal = *gh.getGoal();
-    TrajectoryCommand c = FromMsg(goal.trajectory);
-    for (const control_msgs::JointTolerance& t : goal.path_tolerance)
-      c.path_tolerance.emplace_back(t.name, t.position);
-    for (const control_msgs::JointTolerance& t : goal.goal_tolerance)
-      c.goal_tolerance.emplace_back(t.name, t.position);
-    c.goal_time_tolerance = goal.goal_time_tolerance.toSec();
     const std::string what = "follow_joint_trajectory goal";
+    TrajectoryCommand c;
     control_msgs::FollowJointTrajectoryResult result;
     try {
+      c = FromMsg(goal.trajectory, what);
+      for (const control_msgs::JointTolerance& t : goal.path_tolerance)
+        c.path_tolerance.emplace_back(t.name, t.position);
+      for (const control_msgs::JointTolerance& t : goal.goal_tolerance)
+        c.goal_tolerance.emplace_back(t.name, t.position);
+      c.goal_time_tolerance = goal.goal_time_tolerance.toSec();
       robot->CheckTrajectory(c, what);
     } catch (const std::exception& e) {
-      const bool joints = std::string(e.what()).find("joint") != std::string::npos &&
-                          std::string(e.what()).find("joint_names") == std::string::npos;
+      // the joints at fault, or the goal (the words after the prefix that names the goal)
+      std::string why = e.what();
+      if (why.rfind(what, 0) == 0) why = why.substr(what.size());
+      const bool joints =
+          why.find("joint") != std::string::npos && why.find("joint_names") == std::string::npos;
       result.error_code = joints ? result.INVALID_JOINTS : result.INVALID_GOAL;
       result.error_string = e.what();
       gh.setRejected(result, e.what());
