@@ -75,9 +75,17 @@ struct ServedRobot::Impl {
   std::thread worker;
   std::mutex jobs_mutex;
   std::condition_variable jobs_cv;
-  std::deque<std::function<void()>> jobs;
+  /// A plan waiting for the worker, or running.
+  struct PlanJob {
+    const void* owner = nullptr;
+    std::shared_ptr<std::atomic<bool>> cancel;  ///< the plan's own cancel flag
+    std::function<void()> run;
+    std::function<void()> report_cancelled;  ///< on_result with "cancelled", for a dropped plan
+  };
+  std::deque<PlanJob> jobs;                           // jobs_mutex
+  const void* running_owner = nullptr;                // jobs_mutex
+  std::shared_ptr<std::atomic<bool>> running_cancel;  // jobs_mutex; null when none runs
   bool stopping = false;
-  std::atomic<bool> cancel_planning{false};
 
   /// Runs `apply` on the simulation thread between steps, counting the latency.
   void Post(std::function<void()> apply, ErrorSink on_error) {
@@ -225,20 +233,26 @@ struct ServedRobot::Impl {
 
   void WorkerLoop() {
     for (;;) {
-      std::function<void()> job;
+      PlanJob job;
       {
         std::unique_lock<std::mutex> lock(jobs_mutex);
         jobs_cv.wait(lock, [this] { return stopping || !jobs.empty(); });
         if (stopping) return;
         job = std::move(jobs.front());
         jobs.pop_front();
+        running_owner = job.owner;
+        running_cancel = job.cancel;
       }
-      job();
+      job.run();
+      std::lock_guard<std::mutex> lock(jobs_mutex);
+      running_owner = nullptr;
+      running_cancel.reset();
     }
   }
 
-  /// Runs `f` on the simulation thread and waits for it; false if stopping first.
-  bool OnSimThread(const std::function<void()>& f) {
+  /// Runs `f` on the simulation thread and waits for it; false if stopping or `cancel` turns
+  /// true first.
+  bool OnSimThread(const std::function<void()>& f, const std::atomic<bool>* cancel = nullptr) {
     auto done = std::make_shared<std::promise<void>>();
     std::future<void> fut = done->get_future();
     sim->Post([f, done] {
@@ -250,6 +264,7 @@ struct ServedRobot::Impl {
       }
     });
     while (fut.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready) {
+      if (cancel && *cancel) return false;
       std::lock_guard<std::mutex> lock(jobs_mutex);
       if (stopping) return false;
     }
@@ -307,8 +322,8 @@ void ServedRobot::Close() {
   {
     std::lock_guard<std::mutex> lock(impl_->jobs_mutex);
     impl_->stopping = true;
+    if (impl_->running_cancel) *impl_->running_cancel = true;  // stops within milliseconds
   }
-  impl_->cancel_planning = true;  // a plan under way stops within milliseconds
   impl_->jobs_cv.notify_all();
   if (impl_->worker.joinable()) impl_->worker.join();
 }
@@ -435,8 +450,9 @@ void ServedRobot::Plan(const PlanRequest& request, PlanCallback on_result, DoneC
     throw Error("plan: pose_goal must be finite with a unit quaternion");
   PlannerOptions opt = request.options;
   opt.use_last_snapshot = true;
-  opt.cancel = &m->cancel_planning;
-  try {  // now, so that a bad request fails on the caller's thread
+  auto cancel = std::make_shared<std::atomic<bool>>(false);
+  opt.cancel = cancel.get();  // the job holds `cancel`
+  try {                       // now, so that a bad request fails on the caller's thread
     CheckPlannerOptions(opt);
   } catch (const Error& e) {
     throw Error(std::string("plan: ") + e.what());
@@ -446,41 +462,90 @@ void ServedRobot::Plan(const PlanRequest& request, PlanCallback on_result, DoneC
     throw Error("plan: time_limit must be at most " +
                 std::to_string(static_cast<int>(kMaxPlanSeconds)) + " s, got " +
                 FormatNumber(opt.time_limit));
-  {
-    std::lock_guard<std::mutex> lock(m->jobs_mutex);
-    if (m->stopping) throw Error("plan: the server is shutting down");
-    m->jobs.push_back([this, m, request, opt, on_result, on_done] {
-      PlanResult r;
-      try {
-        if (!m->OnSimThread([m] { m->planner->UpdateSnapshot(); })) return;
+  Impl::PlanJob job;
+  job.owner = request.owner;
+  job.cancel = cancel;
+  job.report_cancelled = [on_result] {
+    PlanResult r;
+    r.success = false;
+    r.message = "cancelled";
+    if (on_result) on_result(r);
+  };
+  job.run = [this, m, request, opt, cancel, on_result, on_done] {
+    PlanResult r;
+    try {
+      if (!m->OnSimThread([m] { m->planner->UpdateSnapshot(); }, cancel.get())) {
+        if (!*cancel) return;  // shutting down: dropped
+        r.success = false;
+        r.message = "cancelled";
+      } else {
         r = request.joint_goal.empty()
                 ? m->planner->PlanToPose(m->ee_link, options_.tcp_in_ee, request.pose_goal, opt)
                 : m->planner->PlanToJoints(ToVector(request.joint_goal), opt);
-      } catch (const std::exception& e) {
-        r.success = false;
-        r.message = e.what();
       }
-      if (on_result) on_result(r);
-      if (!r.success || !request.execute) return;
-      TrajectoryCommand c;
-      c.joint_names = m->planner->GetJointNames();
-      const JointTrajectory& t = r.trajectory;
-      for (size_t k = 0; k < t.times.size(); ++k) {
-        c.times.push_back(t.times[k]);
-        c.positions.emplace_back(t.positions[k].data(),
-                                 t.positions[k].data() + t.positions[k].size());
-        if (!t.velocities.empty())
-          c.velocities.emplace_back(t.velocities[k].data(),
-                                    t.velocities[k].data() + t.velocities[k].size());
-      }
-      try {
-        CommandTrajectory(c, "plan", on_done);
-      } catch (const std::exception& e) {
-        if (on_done) on_done(TrajectoryOutcome::kInvalidGoal, e.what());
-      }
-    });
+    } catch (const std::exception& e) {
+      r.success = false;
+      r.message = e.what();
+    }
+    if (on_result) on_result(r);
+    // a plan cancelled after it was found is not executed: its client has gone
+    if (!r.success || !request.execute || *cancel) return;
+    TrajectoryCommand c;
+    c.joint_names = m->planner->GetJointNames();
+    const JointTrajectory& t = r.trajectory;
+    for (size_t k = 0; k < t.times.size(); ++k) {
+      c.times.push_back(t.times[k]);
+      c.positions.emplace_back(t.positions[k].data(),
+                               t.positions[k].data() + t.positions[k].size());
+      if (!t.velocities.empty())
+        c.velocities.emplace_back(t.velocities[k].data(),
+                                  t.velocities[k].data() + t.velocities[k].size());
+    }
+    try {
+      CommandTrajectory(c, "plan", on_done);
+    } catch (const std::exception& e) {
+      if (on_done) on_done(TrajectoryOutcome::kInvalidGoal, e.what());
+    }
+  };
+  {
+    std::lock_guard<std::mutex> lock(m->jobs_mutex);
+    if (m->stopping) throw Error("plan: the server is shutting down");
+    // one worker plans for every client: bounded per client and in all, so that nobody's
+    // plan waits behind minutes of others'
+    const size_t all = m->jobs.size() + (m->running_cancel ? 1 : 0);
+    if (all >= kMaxPlans)
+      throw Error("plan: " + std::to_string(all) + " plans are waiting or running (at most " +
+                  std::to_string(kMaxPlans) + " in all); try again later");
+    if (request.owner) {
+      size_t mine = m->running_cancel && m->running_owner == request.owner ? 1 : 0;
+      for (const Impl::PlanJob& j : m->jobs) mine += j.owner == request.owner;
+      if (mine >= kMaxPlansPerOwner)
+        throw Error("plan: this client has " + std::to_string(mine) +
+                    " plans waiting or running (at most " + std::to_string(kMaxPlansPerOwner) +
+                    "); wait for their answers");
+    }
+    m->jobs.push_back(std::move(job));
   }
   m->jobs_cv.notify_all();
+}
+
+void ServedRobot::CancelPlans(const void* owner) {
+  if (!owner) return;
+  Impl* m = impl_.get();
+  std::vector<Impl::PlanJob> dropped;
+  {
+    std::lock_guard<std::mutex> lock(m->jobs_mutex);
+    for (auto it = m->jobs.begin(); it != m->jobs.end();) {
+      if (it->owner == owner) {
+        dropped.push_back(std::move(*it));
+        it = m->jobs.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    if (m->running_cancel && m->running_owner == owner) *m->running_cancel = true;
+  }
+  for (Impl::PlanJob& j : dropped) j.report_cancelled();
 }
 
 CommandStats ServedRobot::GetCommandStats() const {

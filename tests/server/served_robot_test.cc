@@ -613,6 +613,94 @@ TEST(ServedRobotTest, CloseCancelsAPlanUnderWay) {
   EXPECT_EQ(result.result.message, "cancelled");
 }
 
+/// A plan request for the Panda that RRT* works on for its whole `seconds`, owned by `owner`.
+PlanRequest LongPlan(World& w, const void* owner, double seconds = 25.0) {
+  PlanRequest req;
+  const VectorXd q = w.Qpos();
+  req.joint_goal = std::vector<double>(q.data(), q.data() + q.size());
+  req.joint_goal[w.Index("panda_joint1")] += 0.5;
+  req.options.algorithm = "RRTstar";
+  req.options.time_limit = seconds;
+  req.execute = false;
+  req.owner = owner;
+  return req;
+}
+
+// Four 30 s plans of one client and a disconnect once held another client's 1 s plan for two
+// minutes: plans are bounded per owner and in all, and refused beyond with the bound named.
+TEST(ServedRobotTest, PlansAreBoundedPerOwnerAndInAll) {
+  World w({/*panda=*/true, /*camera=*/false, /*paused=*/false});
+  int owners[5];
+  std::vector<std::unique_ptr<PlanRecorder>> results;
+  auto plan = [&](const void* owner) {
+    results.push_back(std::make_unique<PlanRecorder>());
+    w.served->Plan(LongPlan(w, owner), results.back()->Callback(w.sim.get()));
+  };
+  plan(&owners[0]);
+  plan(&owners[0]);
+  ExpectError([&] { plan(&owners[0]); }, "at most " + std::to_string(kMaxPlansPerOwner));
+  for (int k = 1; k < 4; ++k)
+    for (size_t n = 0; n < kMaxPlansPerOwner; ++n) plan(&owners[k]);
+  ASSERT_EQ(kMaxPlans, 4 * kMaxPlansPerOwner);
+  ExpectError([&] { plan(&owners[4]); }, "at most " + std::to_string(kMaxPlans) + " in all");
+  ExpectError([&] { plan(nullptr); }, "at most " + std::to_string(kMaxPlans) + " in all");
+  // cancelled, every plan answers "cancelled" at once, and a place is free again
+  for (int k = 0; k < 4; ++k) w.served->CancelPlans(&owners[k]);
+  size_t answered = 0;
+  ASSERT_TRUE(WaitFor([&] {
+    answered = 0;
+    for (auto& r : results) answered += r->Got();
+    return answered == 4 * kMaxPlansPerOwner;
+  })) << answered;
+  for (auto& r : results) {
+    if (!r->Got()) continue;  // refused: never answers
+    std::lock_guard<std::mutex> lock(r->mutex);
+    EXPECT_FALSE(r->result.success);
+    EXPECT_EQ(r->result.message, "cancelled");
+  }
+  PlanRecorder later;
+  PlanRequest quick = LongPlan(w, &owners[4], 2.0);
+  quick.options.algorithm = "RRTConnect";
+  w.served->Plan(quick, later.Callback(w.sim.get()));
+  ASSERT_TRUE(WaitFor([&] { return later.Got(); }));
+  std::lock_guard<std::mutex> lock(later.mutex);
+  EXPECT_TRUE(later.result.success) << later.result.message;
+}
+
+// A client's plans are cancelled when it leaves: the one running stops (its own cancel flag, not
+// the server's), the one waiting is dropped, both answer "cancelled", none executes, and another
+// owner's plan waiting behind them runs at once instead of after 50 s.
+TEST(ServedRobotTest, CancelPlansStopsAnOwnersPlansAndTheNextOwnerPlansAtOnce) {
+  World w({/*panda=*/true, /*camera=*/false, /*paused=*/false});
+  int gone = 0, other = 0, nobody = 0;
+  PlanRecorder running, waiting, next;
+  DoneRecorder running_done;
+  PlanRequest long_req = LongPlan(w, &gone);
+  long_req.execute = true;
+  w.served->Plan(long_req, running.Callback(w.sim.get()), running_done.Callback());
+  w.served->Plan(LongPlan(w, &gone), waiting.Callback(w.sim.get()));
+  PlanRequest quick = LongPlan(w, &other, 2.0);
+  quick.options.algorithm = "RRTConnect";
+  w.served->Plan(quick, next.Callback(w.sim.get()));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the first is under way
+  w.served->CancelPlans(&nobody);  // an owner with no plans: nothing happens
+  EXPECT_FALSE(running.Got());
+  w.served->CancelPlans(&gone);
+  for (PlanRecorder* r : {&running, &waiting}) {
+    ASSERT_TRUE(WaitFor([&] { return r->Got(); }));
+    std::lock_guard<std::mutex> lock(r->mutex);
+    EXPECT_FALSE(r->result.success);
+    EXPECT_EQ(r->result.message, "cancelled");
+  }
+  // WaitFor's 10 s: the two RRT* plans would take 50 s
+  ASSERT_TRUE(WaitFor([&] { return next.Got(); }));
+  {
+    std::lock_guard<std::mutex> lock(next.mutex);
+    EXPECT_TRUE(next.result.success) << next.result.message;
+  }
+  EXPECT_FALSE(running_done.Done());  // nothing executed
+}
+
 // ---- readings ----
 
 TEST(ServedRobotTest, FramesHoldEveryLinkAndTheCameraOpticalFrame) {

@@ -60,6 +60,12 @@ struct CameraSensor {
 /// Longest planning time_limit (s) a served robot accepts.
 constexpr double kMaxPlanSeconds = 30.0;
 
+/// Plans one owner (a network client) may have waiting or running at once.
+constexpr size_t kMaxPlansPerOwner = 2;
+
+/// Plans waiting or running at once, all owners together.
+constexpr size_t kMaxPlans = 8;
+
 /// Latest time_from_start (s) a trajectory point may have: a day.
 constexpr double kMaxTrajectorySeconds = 86400.0;
 
@@ -99,7 +105,11 @@ struct PlanRequest {
   std::vector<double> joint_goal;  ///< one per commanded joint; empty: use `pose_goal`
   Pose pose_goal;
   bool execute = true;  ///< run the plan through the trajectory controller when found
+  /// PlannerOptions::cancel is ignored: each plan has a cancel flag of its own (CancelPlans).
   PlannerOptions options;
+  /// Who asks (a front-end's client), for the per-owner bound and CancelPlans; never
+  /// dereferenced. Null: bounded only by kMaxPlans.
+  const void* owner = nullptr;
 };
 
 /// Counters of the commands applied, for the front-ends' statistics.
@@ -157,8 +167,13 @@ class ServedRobot {
   /// Plans from the current state (snapshot taken on the simulation thread, planning on a
   /// worker thread, so the simulation keeps its pace) and, if asked and found, executes the
   /// trajectory as a goal. `on_result` runs on the worker thread. Throws for a malformed
-  /// request (wrong number of joints, non-finite values, bad options).
+  /// request (wrong number of joints, non-finite values, bad options), and when the owner
+  /// already has kMaxPlansPerOwner plans waiting or running, or kMaxPlans are in all.
   void Plan(const PlanRequest& request, PlanCallback on_result, DoneCallback on_done = {});
+  /// Cancels the plans of `owner` (a client that left): those waiting are dropped, the one
+  /// running stops within milliseconds; each one's `on_result` reports success = false with
+  /// the message "cancelled" (the dropped ones' on this thread), and none executes.
+  void CancelPlans(const void* owner);
   /// Stops the planning worker: a plan in progress finishes (its callbacks run), plans not yet
   /// started are dropped. Call after stopping the SimServer and before destroying the
   /// front-ends whose callbacks plans hold. Idempotent; the destructor calls it.
