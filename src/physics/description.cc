@@ -79,36 +79,42 @@ constexpr double kMaxLength = 1e6;
 constexpr double kMaxMass = 1e9;
 constexpr double kMaxInertia = kMaxMass * kMaxLength * kMaxLength;
 
+// The checks below format their messages only on failure: Validate runs them for every link of
+// an articulation, and formatting a pose for each took half the load time of a wide URDF.
 void CheckPose(const Pose& pose, const std::string& where, const std::string& what) {
-  Require(pose.p.allFinite(), where, what + " has a non-finite position " + pose.ToString());
-  Require(pose.p.cwiseAbs().maxCoeff() <= kMaxLength, where,
-          what + " has a position beyond 1e6 m " + pose.ToString());
-  Require(pose.q.coeffs().allFinite() && pose.q.norm() > 1e-6, where,
-          what + " has an invalid rotation " + pose.ToString());
+  if (!pose.p.allFinite())
+    throw Error(Prefix(where) + what + " has a non-finite position " + pose.ToString());
+  if (!(pose.p.cwiseAbs().maxCoeff() <= kMaxLength))
+    throw Error(Prefix(where) + what + " has a position beyond 1e6 m " + pose.ToString());
+  if (!(pose.q.coeffs().allFinite() && pose.q.norm() > 1e-6))
+    throw Error(Prefix(where) + what + " has an invalid rotation " + pose.ToString());
 }
 
 void CheckNonNegative(double v, const std::string& where, const std::string& what) {
-  Require(std::isfinite(v) && v >= 0.0, where,
-          what + " must be finite and >= 0, got " + FormatNumber(v));
+  if (!(std::isfinite(v) && v >= 0.0))
+    throw Error(Prefix(where) + what + " must be finite and >= 0, got " + FormatNumber(v));
 }
 
 void CheckPositive(double v, const std::string& where, const std::string& what) {
-  Require(std::isfinite(v) && v > 0.0, where,
-          what + " must be finite and > 0, got " + FormatNumber(v));
+  if (!(std::isfinite(v) && v > 0.0))
+    throw Error(Prefix(where) + what + " must be finite and > 0, got " + FormatNumber(v));
 }
 
 // A shape's size: > 0 (or >= 0) and at most kMaxLength.
 void CheckLength(double v, bool allow_zero, const std::string& where, const std::string& what) {
-  Require(std::isfinite(v) && (allow_zero ? v >= 0.0 : v > 0.0) && v <= kMaxLength, where,
-          what + " must be " + (allow_zero ? ">= 0" : "> 0") + " and at most 1e6 m, got " +
-              FormatNumber(v));
+  if (!(std::isfinite(v) && (allow_zero ? v >= 0.0 : v > 0.0) && v <= kMaxLength)) {
+    throw Error(Prefix(where) + what + " must be " + (allow_zero ? ">= 0" : "> 0") +
+                " and at most 1e6 m, got " + FormatNumber(v));
+  }
 }
 
 void CheckMaterial(const PhysicalMaterial& m, const std::string& where, const std::string& what) {
   CheckNonNegative(m.static_friction, where, what + " static_friction");
   CheckNonNegative(m.dynamic_friction, where, what + " dynamic_friction");
-  Require(std::isfinite(m.restitution) && m.restitution >= 0 && m.restitution <= 1, where,
-          what + " restitution must be in [0, 1], got " + FormatNumber(m.restitution));
+  if (!(std::isfinite(m.restitution) && m.restitution >= 0 && m.restitution <= 1)) {
+    throw Error(Prefix(where) + what + " restitution must be in [0, 1], got " +
+                FormatNumber(m.restitution));
+  }
 }
 
 void CheckBody(const BodyDesc& b, const std::string& where, const std::string& what) {
@@ -144,8 +150,9 @@ void CheckBody(const BodyDesc& b, const std::string& where, const std::string& w
             w + src + " needs at least 4 vertices, has " + std::to_string(s.mesh->vertices.size()));
         Eigen::Vector3f lo = s.mesh->vertices[0], hi = lo;
         for (const auto& v : s.mesh->vertices) {
-          Require(v.allFinite() && v.cwiseAbs().maxCoeff() <= static_cast<float>(kMaxLength), where,
-                  w + src + " has a vertex that is not finite or lies beyond 1e6 m");
+          if (!(v.allFinite() && v.cwiseAbs().maxCoeff() <= static_cast<float>(kMaxLength)))
+            throw Error(Prefix(where) + w + src +
+                        " has a vertex that is not finite or lies beyond 1e6 m");
           lo = lo.cwiseMin(v);
           hi = hi.cwiseMax(v);
         }
@@ -158,13 +165,16 @@ void CheckBody(const BodyDesc& b, const std::string& where, const std::string& w
   }
   if (b.inertial) {
     CheckPositive(b.inertial->mass, where, what + " mass");
-    Require(b.inertial->mass <= kMaxMass, where,
-            what + " mass must be at most 1e9 kg, got " + FormatNumber(b.inertial->mass));
+    if (!(b.inertial->mass <= kMaxMass)) {
+      throw Error(Prefix(where) + what + " mass must be at most 1e9 kg, got " +
+                  FormatNumber(b.inertial->mass));
+    }
     for (int k = 0; k < 3; ++k) {
       CheckPositive(b.inertial->inertia[k], where, what + " inertia");
-      Require(b.inertial->inertia[k] <= kMaxInertia, where,
-              what + " inertia must be at most 1e21 kg m^2, got " +
-                  FormatNumber(b.inertial->inertia[k]));
+      if (!(b.inertial->inertia[k] <= kMaxInertia)) {
+        throw Error(Prefix(where) + what + " inertia must be at most 1e21 kg m^2, got " +
+                    FormatNumber(b.inertial->inertia[k]));
+      }
     }
     CheckPose(b.inertial->cmass_local_pose, where, what + " centre-of-mass pose");
   }
@@ -213,15 +223,18 @@ void Validate(const ArticulationDesc& art, const std::string& where) {
     CheckPose(j.pose_in_parent, where, jw + " pose_in_parent");
     CheckPose(j.pose_in_child, where, jw + " pose_in_child");
     Require(!std::isnan(j.lower) && !std::isnan(j.upper), where, jw + " has a NaN limit");
-    Require(j.lower <= j.upper, where,
-            jw + " has lower limit " + FormatNumber(j.lower) + " above upper limit " +
-                FormatNumber(j.upper));
+    if (!(j.lower <= j.upper)) {
+      throw Error(Prefix(where) + jw + " has lower limit " + FormatNumber(j.lower) +
+                  " above upper limit " + FormatNumber(j.upper));
+    }
     CheckNonNegative(j.friction, where, jw + " friction");
     CheckNonNegative(j.damping, where, jw + " damping");
     CheckNonNegative(j.armature, where, jw + " armature");
     Require(std::isfinite(j.pitch), where, jw + " pitch must be finite");
-    Require(j.effort_limit > 0, where,
-            jw + " effort_limit must be > 0 (inf for none), got " + FormatNumber(j.effort_limit));
+    if (!(j.effort_limit > 0)) {
+      throw Error(Prefix(where) + jw + " effort_limit must be > 0 (inf for none), got " +
+                  FormatNumber(j.effort_limit));
+    }
     CheckNonNegative(j.drive.stiffness, where, jw + " drive stiffness");
     CheckNonNegative(j.drive.damping, where, jw + " drive damping");
     Require(!std::isnan(j.drive.force_limit) && j.drive.force_limit > 0, where,
