@@ -764,6 +764,13 @@ ArticulationDesc Parser::Run(const std::string& text) {
     link_names.push_back(name);
   }
   if (link_names.empty()) Fail("robot has no <link>");
+  // before any link is read: MuJoCo's compile grows as the square of the bodies in a scene
+  if (link_names.size() > static_cast<size_t>(kMaxUrdfLinks)) {
+    Fail("robot has " + std::to_string(link_names.size()) + " links, more than the " +
+         std::to_string(kMaxUrdfLinks) +
+         " partsim loads as one articulation (its compile time and memory grow as the square "
+         "of the joints); split it into several robots");
+  }
 
   // joints: names unique, parent and child exist, one parent per link
   std::vector<RawJoint> joints;
@@ -838,6 +845,22 @@ ArticulationDesc Parser::Run(const std::string& text) {
       if (!reached[i]) {
         Fail("link '" + link_names[i] + "' is on a cycle of joints (through joint '" +
              joints[joint_of_child[i]].name + "')");
+      }
+    }
+  }
+
+  // chains no deeper than MuJoCo compiles (it refuses bodies about 1023 below the world)
+  {
+    std::vector<int> depth(link_names.size(), 0);
+    for (int i : order) {
+      for (int j : child_joints[i]) {
+        const int child = link_index[joints[j].child];
+        depth[child] = depth[i] + 1;
+        if (depth[child] > kMaxUrdfChainDepth) {
+          Fail("link '" + joints[j].child + "' lies " + std::to_string(depth[child]) +
+               " joints below the root link, deeper than the " +
+               std::to_string(kMaxUrdfChainDepth) + " partsim loads");
+        }
       }
     }
   }

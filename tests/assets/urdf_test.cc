@@ -1201,5 +1201,52 @@ TEST(UrdfSceneTest, ErrorsLeaveTheSceneUsable) {
   EXPECT_EQ(scene.GetArticulations().size(), 1u);
 }
 
+// ---------------------------------------------------------------------------------------------
+// size bounds
+
+// A robot of `joints` revolute links below a root link "root": all on the root (wide), or in one
+// chain (deep). Links without geometry; with `missing_mesh` the first has a visual mesh file that
+// does not exist.
+std::string GeneratedRobot(int joints, bool deep, bool missing_mesh = true) {
+  std::string body = "<link name=\"root\"/>\n";
+  for (int i = 0; i < joints; ++i) {
+    const std::string name = "l" + std::to_string(i);
+    body += i == 0 && missing_mesh
+                ? "<link name=\"l0\"><visual><geometry><mesh filename=\"missing.obj\"/>"
+                  "</geometry></visual></link>\n"
+                : "<link name=\"" + name + "\"/>\n";
+    body += Joint("j" + std::to_string(i), "revolute",
+                  deep && i > 0 ? "l" + std::to_string(i - 1) : "root", name,
+                  "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\"/>");
+  }
+  return Robot(body);
+}
+
+TEST(UrdfBoundsTest, RobotOfTooManyLinksIsRefusedBeforeItsLinksAreRead) {
+  // kMaxUrdfLinks + 1 links: refused by count, not for the missing mesh of its first link
+  ExpectParseError(GeneratedRobot(kMaxUrdfLinks, false),
+                   {"robot has " + std::to_string(kMaxUrdfLinks + 1) + " links",
+                    "more than the " + std::to_string(kMaxUrdfLinks), "split it"});
+  // at the limit the file is read (and its missing mesh reported)
+  ExpectParseError(GeneratedRobot(kMaxUrdfLinks - 1, false), {"missing.obj"});
+}
+
+TEST(UrdfBoundsTest, ChainDeeperThanTheLimitIsRefusedNamingItsLink) {
+  const std::string last = "l" + std::to_string(kMaxUrdfChainDepth);
+  ExpectParseError(GeneratedRobot(kMaxUrdfChainDepth + 1, true),
+                   {"link '" + last + "'", std::to_string(kMaxUrdfChainDepth + 1) + " joints below",
+                    "deeper than the " + std::to_string(kMaxUrdfChainDepth)});
+  ExpectParseError(GeneratedRobot(kMaxUrdfChainDepth, true), {"missing.obj"});
+}
+
+TEST(UrdfBoundsTest, ChainAtTheDepthLimitCompiles) {
+  // MuJoCo refuses bodies about 1023 below the world: the limit leaves room for a world link
+  Scene scene;
+  UrdfLoader loader = scene.CreateUrdfLoader();
+  loader.fix_root_link = false;
+  Articulation chain = loader.LoadFromString(GeneratedRobot(kMaxUrdfChainDepth, true, false));
+  EXPECT_EQ(chain.Dof(), kMaxUrdfChainDepth);
+}
+
 }  // namespace
 }  // namespace partsim

@@ -11,6 +11,16 @@
 
 namespace partsim {
 
+/// Most links a URDF may have: MuJoCo's compile of a scene grows as the square of its bodies and
+/// joints (revolute joints on one root: 2000 load in 0.6 s and 74 MB, 4000 in 2.2 s and 220 MB,
+/// 8000 in 7 s and 650 MB; see bench/README.md). A file with more is refused before its links are
+/// read.
+constexpr int kMaxUrdfLinks = 5000;
+/// Most joints between a URDF's root link and any of its links: MuJoCo refuses bodies about 1023
+/// below the world ("depth limit exceeded"), and a chain of 1000 takes 5 s to load and 0.12 s a
+/// step. A deeper file is refused before its links are read.
+constexpr int kMaxUrdfChainDepth = 1000;
+
 /// Per-link overrides of the loader's defaults.
 struct UrdfLinkOverride {
   std::optional<double> density;  ///< kg/m^3 for the link's collision shapes
