@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <thread>
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
@@ -45,7 +47,11 @@ struct RosbridgeServer::Impl : internal::RosbridgeTransport {
   int port = 0;
   std::atomic<bool> started{false};
   std::atomic<long long> next_fragment{0};
-  std::atomic<long long> sent{0}, dropped{0}, refused{0};
+  std::atomic<long long> sent{0}, dropped{0}, refused{0}, peak_buffered{0};
+  /// Connections whose handshake was accepted and that have not gone (network thread): the
+  /// slots max_clients counts. Handshakes accepted at once would all see the clients opened
+  /// before them, not each other.
+  std::set<std::weak_ptr<void>, std::owner_less<std::weak_ptr<void>>> slots;
 
   // ---- accepting ----
   /// partsim's accept loop (network thread), in place of websocketpp's, which retries a failed
@@ -114,7 +120,11 @@ struct RosbridgeServer::Impl : internal::RosbridgeTransport {
     ws.close(c->connection, websocketpp::close::status::policy_violation, reason, ec);
   }
 
-  /// Network thread: hands queued messages to the socket unless its queue is full.
+  /// Network thread: hands queued messages to the socket unless its queue is full. A message
+  /// goes whole (all its fragments) or not at all: a client cannot use part of one. The queue
+  /// thus holds at most max_client_buffered plus one message, whose fragments add their framing
+  /// (about 100 bytes each, fragments being at least kMinFragmentSize characters) and the
+  /// escaping of the quotes in their data.
   void Flush(const ClientPtr& c) {
     std::deque<Outgoing> pending;
     {
@@ -138,6 +148,10 @@ struct RosbridgeServer::Impl : internal::RosbridgeTransport {
         if (ec) return;
       }
       ++sent;
+    }
+    const long long buffered = static_cast<long long>(con->get_buffered_amount());
+    long long peak = peak_buffered;
+    while (buffered > peak && !peak_buffered.compare_exchange_weak(peak, buffered)) {
     }
   }
   /// rosbridge fragments: pieces of at most fragment_size characters of the JSON text, sent
@@ -171,6 +185,7 @@ struct RosbridgeServer::Impl : internal::RosbridgeTransport {
     s.errors = protocol->Errors();
     s.refused = refused;
     s.accept_errors = accept_errors;
+    s.peak_buffered_bytes = peak_buffered;
     return s;
   }
 };
@@ -178,6 +193,8 @@ struct RosbridgeServer::Impl : internal::RosbridgeTransport {
 RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& options)
     : impl_(std::make_unique<Impl>()) {
   if (!robot) throw Error("RosbridgeServer: robot is null");
+  if (!(options.auth_timeout >= 0) || !std::isfinite(options.auth_timeout))
+    throw Error("RosbridgeServer: auth_timeout must be finite and >= 0 (0: no limit)");
   Impl& m = *impl_;
   m.robot = robot;
   m.options = options;
@@ -207,11 +224,13 @@ RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& opt
       con->set_status(websocketpp::http::status_code::forbidden);
       return false;
     }
-    if (im.protocol->ClientCount() >= im.options.max_clients) {
+    // a slot is taken here and given back when the connection goes (close or fail)
+    if (im.slots.size() >= im.options.max_clients) {
       ++im.refused;
       con->set_status(websocketpp::http::status_code::service_unavailable);
       return false;
     }
+    im.slots.insert(h);
     return true;
   });
   // with log_clients, a line per client that comes or goes: its address and the count after
@@ -227,8 +246,22 @@ RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& opt
     WsServer::connection_ptr con = impl_->ws.get_con_from_hdl(h, ec);
     c->address = !ec && con ? con->get_remote_endpoint() : "(unknown address)";
     log_client(*c, "connected", impl_->protocol->AddClient(c));
+    // with a token, a client that stays silent would hold its slot for ever: it has
+    // auth_timeout seconds to authenticate
+    const double limit = impl_->options.auth_timeout;
+    if (impl_->options.auth_token.empty() || limit <= 0) return;
+    std::weak_ptr<internal::RosbridgeClient> weak = c;
+    impl_->ws.set_timer(static_cast<long>(std::min(limit, 1e6) * 1000),
+                        [this, weak, limit](const websocketpp::lib::error_code& e) {
+                          ClientPtr cp = weak.lock();
+                          if (e || !cp || cp->authenticated) return;
+                          char why[80];
+                          std::snprintf(why, sizeof(why), "not authenticated within %g s", limit);
+                          impl_->Close(cp, why);
+                        });
   });
   auto gone = [this, log_client](Hdl h) {
+    impl_->slots.erase(h);
     size_t count = 0;
     if (ClientPtr c = impl_->protocol->RemoveClient(h, &count))
       log_client(*c, "disconnected", count);

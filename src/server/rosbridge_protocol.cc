@@ -22,13 +22,23 @@ constexpr size_t kMaxPartialMessages = 16;
 constexpr size_t kMaxPendingCalls = 100;
 constexpr std::chrono::seconds kCallTimeout{60};
 
-// Open subscribe requests (distinct ids) of one client on one topic.
+// Open subscribe requests (distinct ids) of one client on one topic, and on all its topics.
 constexpr size_t kMaxRequestsPerTopic = 64;
+constexpr size_t kMaxRequestsPerClient = 1024;
+
+/// Throws unless `value` (field `key` of op `op`) is at most kMaxNameBytes long.
+void CheckNameLength(const std::string& value, const std::string& key, const std::string& op) {
+  if (value.size() > kMaxNameBytes)
+    throw Error("op '" + op + "': '" + key + "' is " + std::to_string(value.size()) +
+                " bytes long (at most " + std::to_string(kMaxNameBytes) + ")");
+}
 
 std::string Str(const Json& j, const char* key, const std::string& op) {
   if (!j.contains(key) || !j[key].is_string())
     throw Error("op '" + op + "' needs a string '" + key + "'");
-  return j[key].get<std::string>();
+  std::string s = j[key].get<std::string>();
+  CheckNameLength(s, key, op);
+  return s;
 }
 
 /// A topic or service name; ROS resolves "rosapi/topics" to "/rosapi/topics" at the root.
@@ -97,21 +107,26 @@ size_t RosbridgeProtocol::AddClient(const ClientPtr& client) {
 }
 
 ClientPtr RosbridgeProtocol::RemoveClient(const std::weak_ptr<void>& connection, size_t* count) {
-  std::lock_guard<std::mutex> lock(clients_mutex_);
-  *count = clients_.size();
-  auto it = clients_.find(connection);
-  if (it == clients_.end()) return nullptr;
-  ClientPtr c = it->second;
-  clients_.erase(it);
-  *count = clients_.size();
-  // its calls are forgotten, and the callers of the services it provided told
-  for (auto call = pending_calls_.begin(); call != pending_calls_.end();) {
-    if (call->second.caller.lock() == c)
-      call = pending_calls_.erase(call);
-    else
-      ++call;
+  ClientPtr c;
+  {
+    std::lock_guard<std::mutex> lock(clients_mutex_);
+    *count = clients_.size();
+    auto it = clients_.find(connection);
+    if (it == clients_.end()) return nullptr;
+    c = it->second;
+    clients_.erase(it);
+    *count = clients_.size();
+    // its calls are forgotten, and the callers of the services it provided told
+    for (auto call = pending_calls_.begin(); call != pending_calls_.end();) {
+      if (call->second.caller.lock() == c)
+        call = pending_calls_.erase(call);
+      else
+        ++call;
+    }
+    AbandonCalls(c, "", "the provider disconnected");
   }
-  AbandonCalls(c, "", "the provider disconnected");
+  // its plans are dropped, the one running stopped: nobody waits for the answers
+  robot_->CancelPlans(c.get());
   return c;
 }
 
@@ -169,6 +184,17 @@ void RosbridgeProtocol::HandleText(const ClientPtr& c, const std::string& payloa
     return;
   }
   Json id = j.is_object() && j.contains("id") ? j["id"] : Json();
+  // ids are stored and echoed: a long one is refused, and not echoed
+  if (!id.is_null()) {
+    const size_t id_bytes =
+        id.is_string() ? id.get_ref<const std::string&>().size() : DumpJson(id).size();
+    if (id_bytes > kMaxIdBytes) {
+      Status(c, "error",
+             "'id' is " + std::to_string(id_bytes) + " bytes long (at most " +
+                 std::to_string(kMaxIdBytes) + ")");
+      return;
+    }
+  }
   if (!c->authenticated) {
     // with a token set, nothing but the auth op until it has come right
     const bool auth = j.is_object() && j.contains("op") && j["op"] == "auth";
@@ -201,6 +227,9 @@ void RosbridgeProtocol::HandleText(const ClientPtr& c, const std::string& payloa
     if (!j.is_object() || !j.contains("op") || !j["op"].is_string())
       throw Error("message has no 'op' string");
     const std::string& op = j["op"].get_ref<const std::string&>();
+    if (op.size() > kMaxNameBytes)
+      throw Error("'op' is " + std::to_string(op.size()) + " bytes long (at most " +
+                  std::to_string(kMaxNameBytes) + ")");
     auto handler = ops_.find(op);
     if (handler == ops_.end()) throw Error("unknown op '" + op + "'");
     (this->*handler->second)(c, j, id);
@@ -270,12 +299,12 @@ bool RosbridgeProtocol::Reassemble(const ClientPtr& c, const Json& j, std::strin
 void RosbridgeProtocol::OpSubscribe(const ClientPtr& c, const Json& j, const Json& id) {
   const std::string op = "subscribe", topic = Name(j, "topic", op);
   if (j.contains("type") && j["type"].is_string()) {
+    const std::string type = Str(j, "type", op);
     std::lock_guard<std::mutex> lock(clients_mutex_);
     auto all = AllTopics();
     auto it = all.find(topic);
-    if (it != all.end() && it->second != j["type"].get<std::string>())
-      throw Error("subscribe " + topic + ": type is " + it->second + ", not " +
-                  j["type"].get<std::string>());
+    if (it != all.end() && it->second != type)
+      throw Error("subscribe " + topic + ": type is " + it->second + ", not " + type);
   }
   // the request's settings; out-of-range values are ignored, as rosbridge does
   SubscribeRequest s;
@@ -287,9 +316,10 @@ void RosbridgeProtocol::OpSubscribe(const ClientPtr& c, const Json& j, const Jso
     s.queue_length = static_cast<size_t>(j["queue_length"].get<long long>());
   if (j.contains("fragment_size") && j["fragment_size"].is_number_integer() &&
       j["fragment_size"].get<long long>() > 0)
-    s.fragment_size = static_cast<size_t>(j["fragment_size"].get<long long>());
+    s.fragment_size =
+        std::max(kMinFragmentSize, static_cast<size_t>(j["fragment_size"].get<long long>()));
   if (j.contains("compression") && j["compression"].is_string()) {
-    const std::string comp = j["compression"].get<std::string>();
+    const std::string comp = Str(j, "compression", op);
     if (comp == "cbor")
       s.cbor = true;
     else if (comp != "none" && comp != "")
@@ -302,8 +332,18 @@ void RosbridgeProtocol::OpSubscribe(const ClientPtr& c, const Json& j, const Jso
     throw Error("subscribe " + topic + ": this client already subscribes to " +
                 std::to_string(c->subs.size()) + " topics (at most " +
                 std::to_string(options_.max_subscriptions) + ")");
+  auto existing = c->subs.find(topic);
+  const bool new_request = existing == c->subs.end() || !existing->second.requests.count(sub_id);
+  if (new_request) {
+    size_t open = 0;
+    for (const auto& [t, other] : c->subs) open += other.requests.size();
+    if (open >= kMaxRequestsPerClient)
+      throw Error("subscribe " + topic + ": " + std::to_string(open) +
+                  " subscribe requests of this client are open (at most " +
+                  std::to_string(kMaxRequestsPerClient) + " on all its topics)");
+  }
   Subscription& sub = c->subs[topic];
-  if (!sub.requests.count(sub_id) && sub.requests.size() >= kMaxRequestsPerTopic)
+  if (new_request && sub.requests.size() >= kMaxRequestsPerTopic)
     throw Error("subscribe " + topic + ": " + std::to_string(sub.requests.size()) +
                 " subscribe requests of this client are open on it (at most " +
                 std::to_string(kMaxRequestsPerTopic) + ")");
@@ -505,6 +545,7 @@ void RosbridgeProtocol::AddServices() {
                      {"commands", s.commands},
                      {"mean_latency_steps", s.mean_latency_steps},
                      {"max_latency_steps", s.max_latency_steps},
+                     {"peak_buffered_bytes", s.peak_buffered_bytes},
                      {"clock_steps", sim_->GetClockSteps()},
                      {"timestep", sim_->GetTimestep()}};
        }},
@@ -523,7 +564,8 @@ const RosbridgeProtocol::ServiceHandler* RosbridgeProtocol::FindService(
 /// /<robot>/plan: answers once planned, from the planning worker.
 std::optional<Json> RosbridgeProtocol::CallPlan(const ClientPtr& c, const std::string& service,
                                                 const Json& args, const Json& id) {
-  const PlanRequest req = PlanRequestFromJson(args, service);
+  PlanRequest req = PlanRequestFromJson(args, service);
+  req.owner = c.get();  // bounded per client, cancelled when it leaves (RemoveClient)
   std::weak_ptr<RosbridgeClient> weak = c;
   robot_->Plan(req, [this, weak, service, id](const PlanResult& r) {
     if (ClientPtr cp = weak.lock())

@@ -62,6 +62,19 @@ struct Partial {
   size_t bytes = 0;
 };
 
+/// Longest topic, type, service and op name, in bytes (ROS names are rarely over 100): longer
+/// ones are refused with an error naming the field, before they are stored or echoed.
+constexpr size_t kMaxNameBytes = 256;
+
+/// Longest message id, in bytes (as text, for ids that are not strings): ids are stored with
+/// subscribe requests and calls, and echoed in replies.
+constexpr size_t kMaxIdBytes = 1024;
+
+/// Smallest fragment_size of a subscription, in characters; smaller requests are raised to it.
+/// Each fragment costs a frame of about 100 bytes beside its data (and a WebSocket message on
+/// the network thread): one-character pieces multiplied a message a hundredfold.
+constexpr size_t kMinFragmentSize = 1024;
+
 /// Bytes a message may have before its client has authenticated (with a token set): the auth
 /// op needs a few dozen; longer messages are refused before they are parsed.
 constexpr size_t kMaxUnauthenticatedBytes = 4096;

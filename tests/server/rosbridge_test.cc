@@ -743,38 +743,206 @@ TEST_F(RosbridgeGuardedTest, ConnectionsBeyondTheCapAreRefused) {
   EXPECT_TRUE(d.WaitOpen());
 }
 
-TEST_F(RosbridgeTest, SubscriptionWithFragmentSizeGetsPiecesThatRebuildTheMessage) {
+/// `n` WebSocket handshakes sent at once on raw sockets (loopback), then their answers read:
+/// the number answered 101 (switching protocols). The sockets stay open in `fds`.
+int BurstOfHandshakes(int port, int n, std::vector<int>* fds) {
+  for (int i = 0; i < n; ++i) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (fd < 0) break;
+    timeval timeout{10, 0};  // a server that never answers fails the test instead of hanging
+    ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<uint16_t>(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
+      ::close(fd);
+      break;
+    }
+    fds->push_back(fd);
+  }
+  const std::string req = RawSocket::Handshake();
+  for (int fd : *fds) ::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+  int accepted = 0;
+  for (int fd : *fds) {
+    std::string resp;
+    char ch;
+    while (resp.find("\r\n\r\n") == std::string::npos && ::read(fd, &ch, 1) == 1) resp += ch;
+    accepted += resp.find(" 101 ") != std::string::npos;
+  }
+  return accepted;
+}
+
+/// A server with room for four clients.
+class RosbridgeCappedTest : public RosbridgeTest {
+ protected:
+  RosbridgeOptions Options() const override {
+    RosbridgeOptions o;
+    o.max_clients = 4;
+    return o;
+  }
+};
+
+// Under a burst of handshakes the cap once let 34 clients in for 32: it counted clients opened,
+// and handshakes accepted together did not see each other. It counts accepted handshakes now.
+TEST_F(RosbridgeCappedTest, ABurstOfHandshakesNeverGetsPastTheCap) {
+  for (int round = 0; round < 3; ++round) {
+    std::vector<int> fds;
+    const int accepted = BurstOfHandshakes(port_, 40, &fds);
+    EXPECT_EQ(fds.size(), 40u);
+    EXPECT_GE(accepted, 1) << "round " << round;
+    EXPECT_LE(accepted, 4) << "round " << round;
+    EXPECT_TRUE(WaitFor([&] { return bridge_->GetStats().clients == accepted; }))
+        << bridge_->GetStats().clients << " clients, round " << round;
+    for (int fd : fds) ::close(fd);
+    // the slots come back with the connections
+    ASSERT_TRUE(WaitFor([&] { return bridge_->GetStats().clients == 0; })) << "round " << round;
+  }
+  EXPECT_GE(bridge_->GetStats().refused, 90);  // 36 a round, unless a handshake failed
+  auto c = ClockWatcher();
+  EXPECT_TRUE(ClockAdvances(*c, 0.05));
+}
+
+/// A server with a token, room for one client, and two seconds to authenticate.
+class RosbridgeAuthTimeoutTest : public RosbridgeTest {
+ protected:
+  RosbridgeOptions Options() const override {
+    RosbridgeOptions o;
+    o.auth_token = "s3cret";
+    o.max_clients = 1;
+    o.auth_timeout = 2.0;
+    return o;
+  }
+};
+
+// A socket that never authenticates held its slot for ever and locked the token holder out.
+TEST_F(RosbridgeAuthTimeoutTest, ASilentClientIsClosedAndTheTokenHolderGetsIn) {
+  TestClient silent(port_);
+  ASSERT_TRUE(silent.WaitOpen());
+  {
+    TestClient locked_out(port_);
+    EXPECT_FALSE(locked_out.WaitOpen());  // HTTP 503: the one slot is taken
+  }
+  ASSERT_TRUE(WaitFor([&] { return silent.Closed(); }));
+  EXPECT_EQ(silent.CloseCode(), 1008);  // policy violation
+  ASSERT_TRUE(WaitFor([&] { return bridge_->GetStats().clients == 0; }));
+  TestClient holder(port_);
+  ASSERT_TRUE(holder.WaitOpen());
+  holder.Send(json{{"op", "auth"}, {"mac", "s3cret"}, {"id", "a"}});
+  json ok = holder.WaitMessage([](const json& m) { return m.value("id", "") == "a"; });
+  EXPECT_EQ(ok.value("level", ""), "info") << ok.dump();
+  holder.Send(json{{"op", "subscribe"}, {"topic", "/clock"}});
+  // authenticated, it stays past the time limit
+  std::this_thread::sleep_for(3s);
+  EXPECT_FALSE(holder.Closed());
+  EXPECT_TRUE(ClockAdvances(holder, 0.05));
+}
+
+// Names and ids were unbounded: 100 subscriptions with 8 MB topic names held 818 MB.
+TEST_F(RosbridgeTest, LongNamesAndIdsAreRefusedNamingTheFieldAndTheBound) {
   TestClient c(port_);
   ASSERT_TRUE(c.WaitOpen());
-  c.Send(json{{"op", "subscribe"},
-              {"topic", "/joint_states"},
-              {"fragment_size", 64},
-              {"throttle_rate", 200}});
-  // the pieces of one message: same id, num 0..total-1, each at most 64 characters
-  json first = c.WaitMessage([](const json& m) { return m.value("op", "") == "fragment"; });
-  ASSERT_FALSE(first.is_null());
-  const std::string id = first["id"];
-  const size_t total = first["total"];
-  ASSERT_GT(total, 1u);
-  std::vector<std::string> pieces(total);
-  ASSERT_TRUE(WaitFor([&] {
-    size_t got = 0;
-    for (const json& m : c.Messages())
-      if (m.value("op", "") == "fragment" && m["id"] == id) {
-        pieces[m["num"].get<size_t>()] = m["data"];
-        ++got;
-      }
-    return got == total;
-  }));
-  std::string text;
-  for (const std::string& p : pieces) {
-    EXPECT_LE(p.size(), 64u);
-    text += p;
+  const std::string long_name = "/" + std::string(300, 'n');
+  const std::string longest = "/" + std::string(255, 'k');  // 256 bytes: accepted
+  c.Send(json{{"op", "subscribe"}, {"topic", long_name}, {"id", "t"}});
+  c.Send(json{{"op", "advertise"}, {"topic", "/ok"}, {"type", long_name}, {"id", "y"}});
+  c.Send(json{{"op", "advertise_service"}, {"service", long_name}, {"type", "x/Y"}, {"id", "s"}});
+  c.Send(json{{"op", "call_service"}, {"service", long_name}, {"id", "c"}});
+  c.Send(json{{"op", "subscribe"}, {"topic", "/clock"}, {"compression", long_name}, {"id", "z"}});
+  c.Send(json{{"op", std::string(300, 'o')}, {"id", "o"}});
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"t", "'topic' is 301 bytes long (at most 256)"},
+      {"y", "'type' is 301 bytes long (at most 256)"},
+      {"s", "'service' is 301 bytes long (at most 256)"},
+      {"c", "'service' is 301 bytes long (at most 256)"},
+      {"z", "'compression' is 301 bytes long (at most 256)"},
+      {"o", "'op' is 300 bytes long (at most 256)"}};
+  for (const auto& [id, part] : cases) {
+    json e = c.WaitMessage([&](const json& m) { return m.value("id", "") == id; });
+    ASSERT_TRUE(IsError(e)) << id << ": " << e.dump();
+    EXPECT_NE(e["msg"].get<std::string>().find(part), std::string::npos) << e["msg"];
   }
-  json whole = json::parse(text, nullptr, false);
-  ASSERT_FALSE(whole.is_discarded()) << text;
-  EXPECT_EQ(whole["topic"], "/joint_states");
-  EXPECT_EQ(whole["msg"]["name"].size(), static_cast<size_t>(robot_.Dof()));
+  // a long id is refused, and not echoed
+  c.Send(json{{"op", "subscribe"}, {"topic", "/clock"}, {"id", std::string(2000, 'i')}});
+  c.Send(json{
+      {"op", "subscribe"}, {"topic", "/clock"}, {"id", json::array({std::string(1100, 'j')})}});
+  for (const char* part :
+       {"'id' is 2000 bytes long (at most 1024)", "'id' is 1104 bytes long (at most 1024)"}) {
+    json e = c.WaitMessage([&](const json& m) {
+      return IsError(m) && m["msg"].get<std::string>().find(part) != std::string::npos;
+    });
+    ASSERT_FALSE(e.is_null()) << part;
+    EXPECT_FALSE(e.contains("id"));
+  }
+  // nothing of the refused names was kept; a name of 256 bytes is fine
+  c.Send(json{{"op", "advertise"}, {"topic", longest}, {"type", "std_msgs/String"}, {"id", "k"}});
+  c.Send(json{{"op", "call_service"}, {"service", "/rosapi/topics"}, {"id", "list"}});
+  json topics = c.WaitMessage([](const json& m) { return m.value("id", "") == "list"; });
+  ASSERT_FALSE(topics.is_null());
+  const std::string listed = topics["values"]["topics"].dump();
+  EXPECT_NE(listed.find(longest), std::string::npos);
+  EXPECT_EQ(listed.find(long_name), std::string::npos);
+  EXPECT_EQ(listed.find("/ok"), std::string::npos);
+  for (const json& m : c.Messages()) EXPECT_NE(m.value("id", ""), "k") << m.dump();
+}
+
+TEST_F(RosbridgeTest, ASubscriberCapsItsRequestsOnAllTopicsTogether) {
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  for (int t = 0; t < 16; ++t)
+    for (int k = 0; k < 64; ++k)
+      c.Send(json{{"op", "subscribe"},
+                  {"topic", "/u" + std::to_string(t)},
+                  {"id", "r" + std::to_string(k)}});
+  c.Send(json{{"op", "subscribe"}, {"topic", "/u16"}, {"id", "over"}});
+  json e = c.WaitMessage([](const json& m) { return m.value("id", "") == "over"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("at most 1024 on all its topics"), std::string::npos)
+      << e["msg"];
+  // a request already open may be renewed
+  c.Send(json{{"op", "subscribe"}, {"topic", "/u3"}, {"id", "r7"}, {"throttle_rate", 10}});
+  c.Send(json{{"op", "call_service"}, {"service", "/rosapi/services"}, {"id", "after"}});
+  ASSERT_FALSE(c.WaitMessage([](const json& m) { return m.value("id", "") == "after"; }).is_null());
+  for (const json& m : c.Messages()) EXPECT_NE(m.value("id", ""), "r7") << m.dump();
+}
+
+// Four 30 s RRT* plans and a disconnect once held another client's 1 s plan for two minutes.
+TEST_F(RosbridgeTest, PlansAreBoundedPerClientAndCancelledWhenItLeaves) {
+  const std::string plan = "/" + robot_.GetName() + "/plan";
+  auto greedy = std::make_unique<TestClient>(port_);
+  ASSERT_TRUE(greedy->WaitOpen());
+  greedy->KeepJointStates();
+  greedy->Send(json{{"op", "subscribe"}, {"topic", "/joint_states"}, {"queue_length", 1}});
+  json first =
+      greedy->WaitMessage([](const json& m) { return m.value("topic", "") == "/joint_states"; });
+  ASSERT_FALSE(first.is_null());
+  std::vector<double> goal = first["msg"]["position"].get<std::vector<double>>();
+  goal[IndexOf(first["msg"]["name"], "x")] += 0.2;
+  for (const char* id : {"p1", "p2", "p3"})
+    greedy->Send(json{{"op", "call_service"},
+                      {"service", plan},
+                      {"args",
+                       {{"joint_goal", goal},
+                        {"algorithm", "RRTstar"},
+                        {"time_limit", 25.0},
+                        {"execute", false}}},
+                      {"id", id}});
+  json e = greedy->WaitMessage([](const json& m) { return m.value("id", "") == "p3"; });
+  ASSERT_TRUE(IsError(e)) << e.dump();
+  EXPECT_NE(e["msg"].get<std::string>().find("at most 2"), std::string::npos) << e["msg"];
+  greedy->Close();
+  greedy.reset();
+  // the leaver's plans are cancelled: another client's plan answers within WaitMessage's 10 s,
+  // not after 50 s of RRT*
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "call_service"},
+              {"service", plan},
+              {"args", {{"joint_goal", goal}, {"time_limit", 1.0}, {"execute", false}}},
+              {"id", "quick"}});
+  json r = c.WaitMessage([](const json& m) { return m.value("id", "") == "quick"; });
+  ASSERT_FALSE(r.is_null()) << "the plan waited behind a departed client's";
+  EXPECT_TRUE(r["values"]["success"].get<bool>()) << r.dump();
 }
 
 TEST_F(RosbridgeTest, SubscribeRequestsByIdAreUnsubscribedOneByOne) {
@@ -1026,10 +1194,16 @@ std::vector<uint8_t> DecodeBase64(const std::string& s) {
   return out;
 }
 
+/// Whether `c` sees the clock advance by at least `seconds` of simulated time.
+bool ClockMoves(TestClient& c, double seconds) {
+  const double t0 = c.LastClock();
+  return WaitFor([&] { return c.LastClock() > t0 + seconds; });
+}
+
 /// A flying gripper in front of a camera, with an IMU on its hand, behind a rosbridge server.
 class RosbridgeSensorTest : public ::testing::Test {
  protected:
-  void Start(int width, int height, double camera_rate) {
+  void Start(int width, int height, double camera_rate, RosbridgeOptions o = RosbridgeOptions()) {
     scene_ = std::make_unique<Scene>();
     scene_->AddGround(0);
     RobotModel m = BuildFlyingGripper();
@@ -1046,7 +1220,6 @@ class RosbridgeSensorTest : public ::testing::Test {
     so.imu_link = m.ee_link;
     served_ = std::make_unique<ServedRobot>(sim_.get(), scene_.get(), loop_.get(), robot_,
                                             robot_.GetName(), so);
-    RosbridgeOptions o;
     o.port = 0;
     bridge_ = std::make_unique<RosbridgeServer>(served_.get(), o);
     bridge_->Start();
@@ -1136,6 +1309,93 @@ TEST_F(RosbridgeSensorTest, ImageCameraInfoAndPoints) {
       ++in_front;  // optical frame: z forward
   }
   EXPECT_GT(in_front, 1000u);
+}
+
+// fragment_size below kMinFragmentSize (1024) is raised to it: pieces of one character once
+// made a point cloud a hundred times its size.
+TEST_F(RosbridgeSensorTest, SmallFragmentSizesAreRaisedAndThePiecesRebuildTheMessage) {
+  Start(32, 24, 10);
+  TestClient c(port_);
+  ASSERT_TRUE(c.WaitOpen());
+  c.Send(json{{"op", "subscribe"}, {"topic", "/cam/image_raw"}, {"fragment_size", 64}});
+  // the pieces of one message: same id, num 0..total-1, all but the last 1024 characters
+  json first = c.WaitMessage([](const json& m) { return m.value("op", "") == "fragment"; });
+  ASSERT_FALSE(first.is_null());
+  const std::string id = first["id"];
+  const size_t total = first["total"];
+  ASSERT_GT(total, 1u);
+  std::vector<std::string> pieces(total);
+  ASSERT_TRUE(WaitFor([&] {
+    size_t got = 0;
+    for (const json& m : c.Messages())
+      if (m.value("op", "") == "fragment" && m["id"] == id) {
+        pieces[m["num"].get<size_t>()] = m["data"];
+        ++got;
+      }
+    return got == total;
+  }));
+  std::string text;
+  for (size_t i = 0; i < total; ++i) {
+    if (i + 1 < total) EXPECT_EQ(pieces[i].size(), 1024u) << i;
+    EXPECT_LE(pieces[i].size(), 1024u) << i;
+    text += pieces[i];
+  }
+  json whole = json::parse(text, nullptr, false);
+  ASSERT_FALSE(whole.is_discarded()) << text;
+  EXPECT_EQ(whole["topic"], "/cam/image_raw");
+  EXPECT_EQ(DecodeBase64(whole["msg"]["data"].get<std::string>()).size(), 32u * 24u * 3u);
+}
+
+/// Options with a small byte bound per client, so that a client that never reads reaches it
+/// within a second.
+RosbridgeOptions SmallClientBuffer() {
+  RosbridgeOptions o;
+  o.max_client_buffered = 256u << 10;
+  return o;
+}
+
+// A subscriber asking for a point cloud in one-character pieces and reading nothing once queued
+// 3.65 GB: a message's fragments went to the socket whatever their number. Now the pieces are
+// at least 1024 characters and a message goes whole only while the queue is within its bound.
+TEST_F(RosbridgeSensorTest, FragmentsForAClientThatNeverReadsStayWithinItsByteBound) {
+  const RosbridgeOptions o = SmallClientBuffer();
+  Start(160, 120, 50, o);
+  RawSocket sleeper(port_);
+  ASSERT_TRUE(sleeper.Ok());
+  sleeper.SendText(
+      json{{"op", "subscribe"}, {"topic", "/cam/points"}, {"fragment_size", 1}}.dump());
+  TestClient watcher(port_);
+  ASSERT_TRUE(watcher.WaitOpen());
+  watcher.Send(json{{"op", "subscribe"}, {"topic", "/clock"}});
+  EXPECT_TRUE(WaitFor([&] { return bridge_->GetStats().messages_dropped > 0; }));
+  EXPECT_TRUE(ClockMoves(watcher, 1.0));
+  const RosbridgeStats s = bridge_->GetStats();
+  // a cloud of 160x120 points is at most 307 kB of base64 (410 kB with its fragments' framing)
+  EXPECT_GT(s.peak_buffered_bytes, 0);
+  EXPECT_LE(s.peak_buffered_bytes, static_cast<long long>(o.max_client_buffered + (1u << 20)));
+}
+
+// One client subscribed to every topic, images in small pieces, point clouds whole, reading
+// nothing: its queue stays within its bound plus a message, and another client's clock flows.
+TEST_F(RosbridgeSensorTest, ClientSubscribedToEverythingThatNeverReadsStaysWithinItsBound) {
+  const RosbridgeOptions o = SmallClientBuffer();
+  Start(160, 120, 50, o);
+  RawSocket sleeper(port_);
+  ASSERT_TRUE(sleeper.Ok());
+  for (const char* t : {"/clock", "/joint_states", "/tf", "/imu", "/cam/camera_info"})
+    sleeper.SendText(json{{"op", "subscribe"}, {"topic", t}}.dump());
+  sleeper.SendText(
+      json{{"op", "subscribe"}, {"topic", "/cam/image_raw"}, {"fragment_size", 1}}.dump());
+  sleeper.SendText(json{{"op", "subscribe"}, {"topic", "/cam/points"}}.dump());
+  TestClient watcher(port_);
+  ASSERT_TRUE(watcher.WaitOpen());
+  watcher.Send(json{{"op", "subscribe"}, {"topic", "/clock"}});
+  ASSERT_TRUE(WaitFor([&] { return watcher.LastClock() >= 0; }));
+  EXPECT_TRUE(WaitFor([&] { return bridge_->GetStats().messages_dropped > 0; }));
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(ClockMoves(watcher, 0.5)) << k;
+  const RosbridgeStats s = bridge_->GetStats();
+  EXPECT_GT(s.peak_buffered_bytes, 0);
+  EXPECT_LE(s.peak_buffered_bytes, static_cast<long long>(o.max_client_buffered + (1u << 20)));
 }
 
 TEST_F(RosbridgeSensorTest, CborSubscriptionsCarryBytesNotBase64) {

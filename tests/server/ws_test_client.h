@@ -100,11 +100,7 @@ class RawSocket {
     ok_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0;
     int small = 4096;  // a small receive buffer so that the server's writes back up
     ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
-    std::string req =
-        "GET " + path +
-        " HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-        "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
-    Write(req);
+    Write(Handshake(path));
     // read the handshake response only
     std::string resp;
     char ch;
@@ -112,6 +108,12 @@ class RawSocket {
     ok_ = ok_ && resp.find(" 101 ") != std::string::npos;
   }
   ~RawSocket() { Close(); }
+  /// The HTTP request that opens a WebSocket at `path`.
+  static std::string Handshake(const std::string& path = "/") {
+    return "GET " + path +
+           " HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+           "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
+  }
   bool Ok() const { return ok_; }
   void Write(const std::string& bytes) {
     size_t off = 0;

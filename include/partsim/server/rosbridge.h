@@ -31,13 +31,20 @@ struct RosbridgeOptions {
   /// auth op, with a shared token in place of rosauth's digest); every other op is refused
   /// until then, and a wrong token closes the connection.
   std::string auth_token;
-  size_t max_clients = 100;        ///< connections at once; more get HTTP 503
+  /// With a token set: seconds a client has to authenticate before its connection is closed
+  /// (WebSocket code 1008), so that sockets left silent do not hold the connection slots; 0:
+  /// never closed.
+  double auth_timeout = 5.0;
+  /// Connections at once, counted from the accepted handshake; more get HTTP 503.
+  size_t max_clients = 100;
   size_t max_subscriptions = 256;  ///< topics a client may subscribe to, and advertise
   size_t max_services = 64;        ///< services a client may advertise
   /// Incoming messages larger than this close the connection with WebSocket code 1009.
   size_t max_message_bytes = 16u << 20;
-  size_t max_client_queue = 200;          ///< messages waiting per client before drops
-  size_t max_client_buffered = 4u << 20;  ///< bytes in a client's socket queue before drops
+  size_t max_client_queue = 200;  ///< messages waiting per client before drops
+  /// Bytes in a client's socket queue beyond which its messages are dropped: a message (all
+  /// its fragments) is handed to the socket only while the queue holds at most this many.
+  size_t max_client_buffered = 4u << 20;
   /// Writes a line on stderr when a client connects or leaves: its address and port, and the
   /// number of clients then connected.
   bool log_clients = false;
@@ -55,6 +62,9 @@ struct RosbridgeStats {
   long long refused = 0;  ///< handshakes refused (origin, connection cap)
   long long accept_errors =
       0;  ///< failed accepts (out of file descriptors), each then waits 100 ms
+  /// Most bytes seen waiting in one client's socket queue (after a message was handed to it):
+  /// at most max_client_buffered plus one message with its fragments' framing.
+  long long peak_buffered_bytes = 0;
 };
 
 class RosbridgeServer {
