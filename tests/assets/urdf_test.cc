@@ -11,6 +11,7 @@
 #include <string>
 
 #include "partsim/assets/generator.h"
+#include "partsim/assets/mesh.h"
 #include "partsim/core/error.h"
 #include "partsim/core/log.h"
 
@@ -1246,6 +1247,34 @@ TEST(UrdfBoundsTest, ChainAtTheDepthLimitCompiles) {
   loader.fix_root_link = false;
   Articulation chain = loader.LoadFromString(GeneratedRobot(kMaxUrdfChainDepth, true, false));
   EXPECT_EQ(chain.Dof(), kMaxUrdfChainDepth);
+}
+
+TEST(UrdfBoundsTest, CylinderOfManySegmentsLoadsAsABoundedHullWithAWarning) {
+  // the side of a 5,000-segment cylinder (10,000 points on two planes): qhull's merging of them
+  // took 10 s; the piece keeps kMaxConvexPieceVertices, which a strict load only warns about
+  TempDir dir("many_segments");
+  std::vector<Eigen::Vector3d> v;
+  std::vector<Eigen::Vector3i> f;
+  const int n = 5000;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    v.emplace_back(0.5 * std::cos(a), 0.5 * std::sin(a), 0.0);
+    v.emplace_back(0.5 * std::cos(a), 0.5 * std::sin(a), 0.3);
+  }
+  for (int i = 0; i < n; ++i) {
+    const int a = 2 * i, b = 2 * ((i + 1) % n);
+    f.emplace_back(a, b, b + 1);
+    f.emplace_back(a, b + 1, a + 1);
+  }
+  WriteObj(dir / "drum.obj", v, f);
+  UrdfLoader loader;
+  loader.strict = true;
+  ArticulationDesc d = loader.Parse(Robot(MeshLink("drum", "drum.obj")), dir.str(), "drum.urdf");
+  ASSERT_EQ(d.links[0].collisions.size(), 1u);
+  EXPECT_LE(d.links[0].collisions[0].mesh->vertices.size(),
+            static_cast<size_t>(kMaxConvexPieceVertices));
+  EXPECT_EQ(
+      CountWarnings(loader.LastReport(), {"drum.obj", "collides as the hull of", "m outside"}), 1);
 }
 
 }  // namespace
