@@ -276,6 +276,7 @@ class SpecWriter {
     // the vertices alone: MuJoCo collides with their convex hull
     mjs_setFloat(m->uservert, mesh.vertices.empty() ? nullptr : mesh.vertices[0].data(),
                  static_cast<int>(3 * mesh.vertices.size()));
+    m->maxhullvert = kMaxHullVertices;
     return name;
   }
 

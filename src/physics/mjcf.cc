@@ -446,6 +446,11 @@ MjcfModel LoadMjcf(Scene& scene, const std::string& path, const Pose& pose) {
                                internal::MjSpecDeleter());
   if (!spec) throw Error("load_mjcf: " + path + ": " + err);
   NameUnnamed(spec.get());
+  for (mjsElement* e = mjs_firstElement(spec.get(), mjOBJ_MESH); e;
+       e = mjs_nextElement(spec.get(), e)) {
+    mjsMesh* mesh = mjs_asMesh(e);
+    if (mesh->maxhullvert < 0) mesh->maxhullvert = internal::kMaxHullVertices;
+  }
   SceneImpl::MjcfEntry entry;
   entry.id = s.next_mjcf_id;
   entry.path = std::filesystem::absolute(path).lexically_normal().string();

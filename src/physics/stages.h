@@ -39,6 +39,12 @@ using MjModelPtr = std::unique_ptr<mjModel, MjModelDeleter>;
 using MjSpecPtr = std::unique_ptr<mjSpec, MjSpecDeleter>;
 using MjDataPtr = std::unique_ptr<mjData, MjDataDeleter>;
 
+/// Hull vertices MuJoCo keeps of a mesh it collides with (its maxhullvert), for meshes the
+/// assets layer has not bounded (kMaxConvexPieceVertices, the same number): shapes put in a
+/// description directly and an MJCF file's meshes that set no bound of their own. Qhull costs
+/// about n^2.5 in the points on one plane; a flat 10,000-corner piece compiled for a minute.
+constexpr int kMaxHullVertices = 2000;
+
 /// Where a MuJoCo geom came from.
 struct GeomOwner {
   int actor_id = -1;         ///< owning actor, or -1

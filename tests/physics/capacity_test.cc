@@ -2,10 +2,16 @@
 // not one per actor), MuJoCo's arena grows when a step fills it, and
 // what MuJoCo refuses or cannot allocate gives an error that leaves the scene as it was.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
 #include <string>
 
 #include "partsim/core/error.h"
+#include "partsim/physics/mjcf.h"
 #include "partsim/physics/scene.h"
 #include "physics/scene_internal.h"
 
@@ -155,6 +161,66 @@ TEST(CapacityTest, AnActorMuJoCoRefusesIsLeftOutAndTheOthersStay) {
   EXPECT_EQ(names, (std::vector<std::string>{"ground", "good1", "good2"}));
   scene.Step(10);
   EXPECT_LT(scene.GetActors()[1].GetPose().p.z(), 0.5);  // falling
+}
+
+// A thin disc of `corners` corners (a prism 1 cm thick): every point on one of two planes, what
+// cost qhull about n^2.5.
+std::vector<Eigen::Vector3f> ThinDisc(int corners) {
+  std::vector<Eigen::Vector3f> v;
+  for (float z : {0.0f, 0.01f})
+    for (int k = 0; k < corners; ++k) {
+      const double a = 2 * M_PI * k / corners;
+      v.emplace_back(static_cast<float>(0.1 * std::cos(a)), static_cast<float>(0.1 * std::sin(a)),
+                     z);
+    }
+  return v;
+}
+
+// Hull vertices MuJoCo keeps of the scene's only mesh.
+int HullVertices(Scene& scene) {
+  scene.impl().EnsureCompiled();
+  const mjModel* m = scene.impl().m();
+  EXPECT_EQ(m->nmesh, 1);
+  return m->mesh_graphadr[0] < 0 ? m->mesh_vertnum[0] : m->mesh_graph[m->mesh_graphadr[0]];
+}
+
+// Meshes that reach MuJoCo without the assets layer's bound (a shape put in a description, an
+// MJCF file's mesh) keep at most 2000 hull vertices: a 10,000-corner disc compiled for a minute.
+TEST(CapacityTest, MeshesOfManyCoplanarPointsKeepABoundedHull) {
+  Scene scene;
+  scene.AddGround(0.0);
+  auto mesh = std::make_shared<MeshData>();
+  mesh->vertices = ThinDisc(10000);
+  ActorDesc d;
+  d.name = "disc";
+  d.pose = Pose(Eigen::Vector3d(0, 0, 0.05));
+  CollisionShape shape;
+  shape.type = ShapeType::kConvexMesh;
+  shape.mesh = mesh;
+  d.collisions.push_back(shape);
+  Actor disc = scene.AddActor(d);
+  EXPECT_LE(HullVertices(scene), 2000);
+  scene.Step(500);
+  EXPECT_NEAR(disc.GetPose().p.z(), 0.0, 3e-3);  // rests on its face
+
+  // an MJCF mesh: bounded unless the file sets maxhullvert itself
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("partsim_hull_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::string vertices;
+  for (const Eigen::Vector3f& p : ThinDisc(10000))
+    vertices +=
+        std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + " ";
+  for (const std::string bound : {"", " maxhullvert=\"100\""}) {
+    std::ofstream(dir / "disc.xml")
+        << "<mujoco><asset><mesh name=\"disc\" vertex=\"" << vertices << "\"" << bound
+        << "/></asset><worldbody><body><freejoint/><geom type=\"mesh\" "
+           "mesh=\"disc\"/></body></worldbody></mujoco>\n";
+    Scene from_file;
+    LoadMjcf(from_file, (dir / "disc.xml").string());
+    EXPECT_LE(HullVertices(from_file), bound.empty() ? 2000 : 100) << bound;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
