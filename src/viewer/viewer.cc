@@ -249,11 +249,10 @@ struct Viewer::Impl {
 
   // ================= commands from the page =================
 
-  /// Runs `fn` on the scene's thread and answers the call `id` of `service` with what it
-  /// returns, or with its error. Throws partsim::Error when the client has
-  /// kMaxWaitingCommandsPerClient commands waiting already.
-  void Enqueue(const ClientPtr& client, const std::string& service, const Json& id,
-               std::function<Json(Scene&)> fn) {
+  /// Counts a call of `client` that waits for its answer (a command for the scene's thread, a
+  /// call of an extension's service); throws partsim::Error when kMaxWaitingCommandsPerClient
+  /// wait already. The answer gives the place back (--*client->waiting).
+  static void TakeWaitingPlace(const ClientPtr& client) {
     if (++*client->waiting > kMaxWaitingCommandsPerClient) {
       --*client->waiting;
       throw Error("too many commands waiting: at most " +
@@ -261,6 +260,14 @@ struct Viewer::Impl {
                   " of a client wait for the scene's thread; wait for their answers, then call "
                   "again");
     }
+  }
+
+  /// Runs `fn` on the scene's thread and answers the call `id` of `service` with what it
+  /// returns, or with its error. Throws partsim::Error when the client has
+  /// kMaxWaitingCommandsPerClient commands waiting already.
+  void Enqueue(const ClientPtr& client, const std::string& service, const Json& id,
+               std::function<Json(Scene&)> fn) {
+    TakeWaitingPlace(client);
     std::weak_ptr<ViewerClient> weak = client;
     auto run = [this, weak, waiting = client->waiting, service, id, fn] {
       --*waiting;
@@ -805,13 +812,18 @@ struct Viewer::Impl {
     }
   }
 
-  /// A call of an extension's service: its answer comes back from any thread.
+  /// A call of an extension's service: its answer comes back from any thread. Until then it
+  /// counts among the client's waiting commands (the gallery's /partsim/open loads an object on
+  /// the scene's thread).
   void CallExtraService(const ClientPtr& c, const std::string& service,
                         const ViewerService& handler, const Json& args, const Json& id) {
+    TakeWaitingPlace(c);
     std::weak_ptr<ViewerClient> weak = c;
     auto once = std::make_shared<std::atomic<bool>>(false);
-    ViewerServiceReply reply = [this, weak, service, id, once](bool ok, const std::string& text) {
+    ViewerServiceReply reply = [this, weak, waiting = c->waiting, service, id, once](
+                                   bool ok, const std::string& text) {
       if (once->exchange(true)) return;
+      --*waiting;
       Json answer;
       if (ok) {
         try {
@@ -828,7 +840,12 @@ struct Viewer::Impl {
       if (!ok) ++errors;
       PostReply(weak, Dump(answer));
     };
-    handler(Dump(args.is_null() ? Json::object() : args), reply);
+    try {
+      handler(Dump(args.is_null() ? Json::object() : args), reply);
+    } catch (...) {
+      if (!once->exchange(true)) --*c->waiting;  // answered with the error by the caller
+      throw;
+    }
   }
 
   // ---- HTTP ----

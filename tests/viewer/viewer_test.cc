@@ -872,6 +872,52 @@ TEST_F(ViewerTest, OneClientsFloodOfCommandsDelaysAnothersByAtMostTheBound) {
   EXPECT_EQ(refused(), 0);
 }
 
+// Calls of an extension's service (the gallery's /partsim/open loads an object on the scene's
+// thread) count among a client's waiting commands until answered.
+TEST_F(ViewerTest, CallsOfExtraServicesWaitingForAnswersShareTheBound) {
+  std::mutex held_mutex;
+  std::vector<ViewerServiceReply> held;
+  viewer_ = std::make_unique<Viewer>(scene_.get());
+  viewer_->AddService("/test/hold", [&](const std::string&, ViewerServiceReply reply) {
+    std::lock_guard<std::mutex> lock(held_mutex);
+    held.push_back(reply);
+  });
+  viewer_->AddService("/test/throw",
+                      [](const std::string&, ViewerServiceReply) { throw Error("thrown"); });
+  Viewer& v = *viewer_;
+  v.Start();
+  TestClient c(v.GetPort());
+  ASSERT_TRUE(c.WaitOpen());
+  c.Auth(v.GetToken());
+  // a service that throws gives its place back
+  for (int k = 0; k < 100; ++k)
+    c.Send(Call("/test/throw", json::object(), "t" + std::to_string(k)));
+  for (int k = 0; k < 70; ++k) c.Send(Call("/test/hold", json::object(), "h" + std::to_string(k)));
+  c.Send(Call("/partsim/camera", {{"name", "front"}}, "camera"));
+  c.Send(Call("/partsim/no_such_service", json::object(), "sent"));
+  ASSERT_FALSE(c.WaitReply("sent").is_null());
+  auto refused = [&] {
+    int n = 0;
+    for (const json& m : c.Messages())
+      if (m.value("op", "") == "service_response" && m.value("result", true) == false &&
+          m["values"].dump().find("at most 64") != std::string::npos)
+        ++n;
+    return n;
+  };
+  EXPECT_EQ(refused(), 70 - 64 + 1);  // six holds and the camera call
+  {
+    std::lock_guard<std::mutex> lock(held_mutex);
+    ASSERT_EQ(held.size(), 64u);
+    for (ViewerServiceReply& r : held) r(true, "{}");
+    held[0](true, "{}");  // a second answer neither sends nor gives back a place
+  }
+  c.Clear();
+  for (int k = 0; k < 64; ++k) c.Send(Call("/test/hold", json::object(), "a" + std::to_string(k)));
+  c.Send(Call("/test/hold", json::object(), "over"));
+  EXPECT_NE(c.WaitReply("over")["values"].dump().find("at most 64"), std::string::npos);
+  EXPECT_EQ(refused(), 1);
+}
+
 // Before a client has authenticated, a message longer than 4,096 bytes is refused without
 // being parsed (the rosbridge server's bound): an auth op padded to 8 kB does not log in.
 TEST_F(ViewerTest, UnauthenticatedMessagesOverTheBoundAreRefusedUnparsed) {
