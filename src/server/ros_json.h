@@ -77,9 +77,6 @@ Json ImuToJson(const ImuReading& r, double t, const std::string& frame);
 // ---- commands ----
 /// The data of a std_msgs/Float64MultiArray sent to `topic`.
 std::vector<double> Float64MultiArrayFromJson(const Json& msg, const std::string& topic);
-/// Most points a trajectory_msgs/JointTrajectory from a client may have (a minute at 100 Hz is
-/// 6,000); more are refused before any is converted.
-constexpr size_t kMaxTrajectoryPoints = 10000;
 /// trajectory_msgs/JointTrajectory {joint_names, points: [{positions, velocities,
 /// time_from_start}]}: velocities are kept only when every point has them; from 1 to
 /// kMaxTrajectoryPoints points.

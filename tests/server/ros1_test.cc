@@ -162,7 +162,7 @@ TEST_F(Ros1ServeTest, RospyAndActionlibClientDrivesTheRobot) {
 }
 
 // A follow_joint_trajectory goal of more points than the rosbridge server accepts
-// (internal::kMaxTrajectoryPoints, 10,000) was converted and executed; it is now rejected
+// (kMaxTrajectoryPoints, 10,000) was converted and executed; it is now rejected
 // before any point is converted, with a message that names the bound.
 TEST_F(Ros1ServeTest, TrajectoryOfTooManyPointsIsRejected) {
   const std::string script =

@@ -57,6 +57,10 @@ struct CameraSensor {
   std::string frame;  ///< <name>_optical_frame
 };
 
+/// Most points a trajectory command from the network may have (a minute at 100 Hz is 6,000):
+/// the rosbridge server and the ROS 1 bridge refuse more before converting any.
+constexpr size_t kMaxTrajectoryPoints = 10000;
+
 /// Longest planning time_limit (s) a served robot accepts.
 constexpr double kMaxPlanSeconds = 30.0;
 

@@ -37,10 +37,6 @@ std::vector<double> ToStd(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
 }
 
-/// Most points a trajectory may have: the rosbridge server's internal::kMaxTrajectoryPoints
-/// (src/server/ros_json.h, outside this library's include path).
-constexpr size_t kMaxTrajectoryPoints = 10000;
-
 /// The command of a trajectory message (`what` names it in errors); throws partsim::Error for
 /// more than kMaxTrajectoryPoints points, before any is converted (the rosbridge
 /// server's bound).
