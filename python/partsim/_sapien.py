@@ -786,6 +786,71 @@ _alias_property(_p.Articulation, "joints", lambda self: self.get_joints())
 _alias_property(_p.Articulation, "links", lambda self: self.get_links())
 _add(_p.Articulation, "get_root")(lambda self: self.get_links()[0])
 _alias_property(_p.Articulation, "root", lambda self: self.get_links()[0])
+_alias_property(_p.Articulation, "root_pose", lambda self: self.get_root_pose(),
+                lambda self, p: self.set_root_pose(p), doc="Root link's pose (SAPIEN 3).")
+
+
+# SAPIEN 3's components name their entity's pose entity_pose (component.pose is deprecated
+# there): an actor or a link is its own entity here
+def _set_link_entity_pose(self, pose):
+    raise _p.PartsimError(f"set_entity_pose: link '{self.name}' is placed by its articulation: "
+                          "set the articulation's root_pose and qpos")
+
+
+for _cls, _setter in ((_p.Actor, lambda self, p: self.set_pose(p)),
+                      (_p.Link, _set_link_entity_pose)):
+    _alias_property(_cls, "entity_pose", lambda self: self.get_pose(), _setter,
+                    doc="World pose of the entity (SAPIEN 3).")
+    _add(_cls, "get_entity_pose")(lambda self: self.get_pose())
+    _add(_cls, "set_entity_pose")(_setter)
+
+
+class UnsupportedError(_p.PartsimError, AttributeError):
+    """A SAPIEN name partsim does not provide (docs/sapien_compatibility.md, status "no"): a
+    PartsimError that says what to use instead, and an AttributeError, so that hasattr() is
+    False as for any missing name."""
+
+
+# SAPIEN names marked "no" in docs/sapien_compatibility.md, by class: reading one raises
+# UnsupportedError with the reason and what to use instead
+UNSUPPORTED = {
+    _p.Scene: {
+        "create_drive": "partsim has no actor-to-actor drive: join the two with an articulation "
+                        "joint and drive it",
+        "physx_system": "partsim has no entity-component system: the scene itself is the "
+                        "physics system (set_timestep, get_contacts, step)",
+        "render_system": "partsim has no entity-component system: cameras and lights belong to "
+                         "the scene (add_camera, add_point_light)",
+        "add_entity": "partsim has no entity-component system: build actors with "
+                      "create_actor_builder() and articulations with create_urdf_loader() or "
+                      "create_articulation_builder()",
+    },
+    _p.Actor: {
+        "hide_visual": "visuals cannot be hidden one by one: leave them out of the builder",
+        "get_visual_bodies": "visual bodies are not exposed: read the actor's description "
+                             "(get_desc().visuals)",
+        "get_collision_visual_bodies": "collision shapes are not drawn as visuals: read "
+                                       "get_desc().collisions",
+    },
+    _p.Camera: {
+        "get_dl_tensor": "no GPU tensor sharing: get_picture() gives numpy arrays",
+    },
+    _p.UrdfLoader: {
+        "load_file_as_articulation_builder": "use loader.parse_file(path) (an ArticulationDesc) "
+                                             "and scene.add_articulation(desc)",
+    },
+}
+
+
+def _unsupported_property(cls, name, why):
+    def get(self):
+        raise UnsupportedError(f"{cls.__name__}.{name}: not supported by partsim: {why}")
+    setattr(cls, name, property(get, doc=f"Not supported by partsim: {why}."))
+
+
+for _cls, _names in UNSUPPORTED.items():
+    for _n, _why in _names.items():
+        _unsupported_property(_cls, _n, _why)
 
 
 @_add(_p.Articulation)

@@ -3,6 +3,7 @@ partsim cannot do is refused with an error that says what to use instead."""
 
 import math
 import os
+import re
 
 import numpy as np
 import pytest
@@ -467,3 +468,57 @@ def test_mounted_camera_in_sapien_2_0_form_and_spot_light_fovs():
     assert cam.near == pytest.approx(0.05)
     with pytest.raises(partsim.PartsimError, match="skew"):
         cam.set_perspective_parameters(0.05, 20, 40, 40, 32, 24, 0.1)
+
+
+# ------------------------------------------------------------------------------ SAPIEN 3 names
+
+def test_root_pose_and_entity_pose():
+    scene = sapien.Scene()
+    a = build_two_links(scene, "revolute", [[-1.0, 1.0]])
+    a.root_pose = sapien.Pose([0.5, 0, 1])
+    np.testing.assert_allclose(a.root_pose.p, [0.5, 0, 1])
+    np.testing.assert_allclose(a.get_root_pose().p, [0.5, 0, 1])
+    child = a.links[1]
+    np.testing.assert_allclose(child.entity_pose.p, child.get_pose().p)
+    np.testing.assert_allclose(child.get_entity_pose().q, child.get_pose().q)
+    with pytest.raises(partsim.PartsimError, match="set the articulation's root_pose and qpos"):
+        child.entity_pose = sapien.Pose([0, 0, 3])
+    _, box = box_scene()
+    box.entity_pose = sapien.Pose([0, 1, 2])
+    np.testing.assert_allclose(box.get_pose().p, [0, 1, 2])
+    box.set_entity_pose(sapien.Pose([0, 0, 1]))
+    np.testing.assert_allclose(box.get_entity_pose().p, [0, 0, 1])
+
+
+def unsupported_names_in_the_docs():
+    """The names of docs/sapien_compatibility.md's rows marked "no" (calls, not arguments)."""
+    doc = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "docs",
+                       "sapien_compatibility.md")
+    names = set()
+    for line in open(doc, encoding="utf-8"):
+        cells = [c.strip() for c in line.split("|")]
+        if len(cells) > 3 and cells[2] == "no":
+            for token in re.findall(r"`([^`]+)`", cells[1]):
+                if "=" not in token:
+                    names.add(token.rstrip("()").split(".")[-1])
+    return names
+
+
+def test_every_call_the_table_marks_unsupported_raises_partsim_error():
+    from partsim._sapien import UNSUPPORTED, UnsupportedError
+    # refused by functions of their own, tested above
+    elsewhere = {"KuafuRenderer", "create_window", "create_pinocchio_model",
+                 "add_nonconvex_collision_from_file"}
+    listed = {n for names in UNSUPPORTED.values() for n in names}
+    documented = unsupported_names_in_the_docs()
+    assert documented - elsewhere == listed, "docs/sapien_compatibility.md and UNSUPPORTED differ"
+    scene, box = box_scene()
+    objects = {partsim.Scene: scene, partsim.Actor: box,
+               partsim.Camera: scene.add_camera("c", 32, 32, 1.0, 0.1, 10),
+               partsim.UrdfLoader: scene.create_urdf_loader()}
+    for cls, names in UNSUPPORTED.items():
+        for name, why in names.items():
+            with pytest.raises(partsim.PartsimError, match=re.escape(why)) as e:
+                getattr(objects[cls], name)
+            assert isinstance(e.value, (AttributeError, UnsupportedError))
+            assert not hasattr(objects[cls], name)  # as SAPIEN scripts test for a feature

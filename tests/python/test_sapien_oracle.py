@@ -79,12 +79,11 @@ def link_poses(sp, path, qpos_list):
     loader = scene.create_urdf_loader()
     loader.fix_root_link = True
     robot = loader.load(path)
+    robot.root_pose = sp.Pose([0.1, -0.2, 0.3], [math.cos(0.3), 0, 0, math.sin(0.3)])
     out = []
     for q in qpos_list:
         robot.set_qpos(np.asarray(q, dtype=np.float32 if sp is sapien else np.float64))
-        # SAPIEN 3 names a link's pose entity_pose (pose is deprecated there); partsim's layer
-        # does not have that name yet
-        poses = {l.name: l.entity_pose if sp is sapien else l.pose for l in robot.links}
+        poses = {l.name: l.entity_pose for l in robot.links}
         out.append({name: (np.array(p.p), np.array(p.q)) for name, p in poses.items()})
     return robot.dof, out
 
