@@ -75,10 +75,6 @@ constexpr size_t kMaxIdBytes = 1024;
 /// the network thread): one-character pieces multiplied a message a hundredfold.
 constexpr size_t kMinFragmentSize = 1024;
 
-/// Bytes a message may have before its client has authenticated (with a token set): the auth
-/// op needs a few dozen; longer messages are refused before they are parsed.
-constexpr size_t kMaxUnauthenticatedBytes = 4096;
-
 /// A connected client.
 struct RosbridgeClient {
   std::weak_ptr<void> connection;  ///< the transport's handle of the connection

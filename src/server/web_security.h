@@ -1,7 +1,9 @@
 // Checks shared by partsim's network services (the rosbridge server, the browser viewer): which
-// web pages may connect (the handshake's Origin), comparing tokens, and making one.
+// web pages may connect (the handshake's Origin), comparing tokens, making one, and what an
+// unauthenticated client may send.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -19,5 +21,9 @@ bool SameToken(const std::string& given, const std::string& token);
 
 /// A random token of 32 hexadecimal digits (128 bits from std::random_device).
 std::string RandomToken();
+
+/// Bytes a message may have before its client has authenticated (with a token set): the auth
+/// op needs a few dozen; longer messages are refused before they are parsed.
+constexpr size_t kMaxUnauthenticatedBytes = 4096;
 
 }  // namespace partsim::internal

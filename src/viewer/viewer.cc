@@ -67,9 +67,6 @@ constexpr std::uintmax_t kMaxBundleFileBytes = 256u << 20;
 // commands of one client waiting for the scene's thread (set_joint_target, camera, reset):
 // more are refused at once, so that one client's flood delays another's command by this many
 constexpr int kMaxWaitingCommandsPerClient = 64;
-// bytes a message may have before its client has authenticated (the auth op needs a few
-// dozen): the rosbridge server's kMaxUnauthenticatedBytes
-constexpr size_t kMaxUnauthenticatedBytes = 4096;
 
 const char kNoBundlePage[] = R"(<!doctype html>
 <html><head><meta charset="utf-8"><title>partsim viewer</title></head>
@@ -606,11 +603,11 @@ struct Viewer::Impl {
   void HandleMessage(const ClientPtr& c, const std::string& payload) {
     // before it has authenticated, a client may send the auth op alone: anything longer is
     // refused unparsed, so that it costs the viewer no more than its bytes
-    if (!c->authenticated && payload.size() > kMaxUnauthenticatedBytes) {
+    if (!c->authenticated && payload.size() > internal::kMaxUnauthenticatedBytes) {
       StatusError(c,
                   "authenticate first: before {\"op\": \"auth\"} succeeds, messages are limited "
                   "to " +
-                      std::to_string(kMaxUnauthenticatedBytes) + " bytes (got " +
+                      std::to_string(internal::kMaxUnauthenticatedBytes) + " bytes (got " +
                       std::to_string(payload.size()) + ")",
                   nullptr);
       return;
