@@ -1,10 +1,11 @@
 """MuJoCo's Python bindings (`mujoco`). URDFs are read by MuJoCo's own URDF reader (a copy with
 the <mujoco><compiler .../></mujoco> element MuJoCo asks for: no path stripping, visuals
-discarded), then edited through mjSpec: the ground plane, partsim's options (implicit integrator,
-50 iterations; MuJoCo's defaults otherwise: Newton, pyramidal cones, tolerance 1e-8), one
-position actuator per driven joint (kp, kv), every geom's friction, and collision bits that keep
-a URDF's own geoms from colliding with each other (the SRDF's pairs) while they still meet the
-ground. The boxes are written as MJCF (free joints, box geoms). mj_step one step at a time."""
+discarded), then edited through mjSpec: the ground plane, partsim's options (its default
+integrator, implicitfast, and 50 iterations; MuJoCo's defaults otherwise: Newton, pyramidal
+cones, tolerance 1e-8), one position actuator per driven joint (kp, kv), every geom's friction,
+and collision bits that keep a URDF's own geoms from colliding with each other (the SRDF's
+pairs) while they still meet the ground. The boxes are written as MJCF (free joints, box
+geoms). mj_step one step at a time."""
 
 import os
 import re
@@ -71,7 +72,7 @@ def build(scene_name, assets, dt, sleep=False):
         spec = _boxes_spec()
     spec.option.timestep = dt
     spec.option.gravity = scenes.GRAVITY
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICIT
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # partsim's default
     spec.option.iterations = 50
     spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0, 0, 1])
     for g in spec.geoms:

@@ -12,7 +12,7 @@ URDF files that every engine loads.
   error max |q - ROBOT_POSE|.
 
 The URDFs the engines load are copies made here: without <visual> (SAPIEN 3 makes render
-components for visuals, and its renderer needs a Vulkan device this machine lacks; the others
+components for visuals, and its renderer needs a Vulkan device the build VM lacks; the others
 never draw in this bench), without partsim's own <partsim:...> elements (foreign to the peers),
 and without the joints' <dynamics> (friction and damping mean different things in each engine:
 PhysX takes URDF damping as its drive's damping and friction as a coefficient); all damping
@@ -35,7 +35,7 @@ KUKA_URDF = os.path.join(REALDATA, "kuka_iiwa", "model.urdf")
 
 SCENES = ("drawer", "boxes", "robot")
 # default steps per measurement (each scene runs at least a second in the slowest engine here)
-DEFAULT_STEPS = {"drawer": 4000, "boxes": 500, "robot": 10000}
+DEFAULT_STEPS = {"drawer": 150000, "boxes": 500, "robot": 150000}
 
 GRAVITY = (0.0, 0.0, -9.81)
 FRICTION = 0.5  # every contact's Coulomb coefficient (static = dynamic), restitution 0
