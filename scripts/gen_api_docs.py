@@ -5,9 +5,8 @@ extension's docstrings and signatures and from python/partsim/envs.py and vision
 One page per subsystem: a class, enum, exception or function goes on the page of the binding
 file that registers it (src/python/<file>_py.cc, see PAGES), so new bindings land on the right
 page without editing this script; the Python modules partsim.envs and partsim.vision (whose
-names may be bindings of an extension submodule) have a page each (MODULE_PAGES). The
-SAPIEN compatibility layer (python/partsim/_sapien.py) is not documented here: see
-docs/sapien_compatibility.md. Where it replaces a binding, the binding is what is documented.
+names may be bindings of an extension submodule) have a page each (MODULE_PAGES). The SAPIEN
+adapter (python/partsim/sapien/) is not documented here: see docs/sapien_compatibility.md.
 
 Usage:
     /usr/bin/python3 scripts/gen_api_docs.py [--python-dir build/python] [--out docs/api] [--check]
@@ -169,21 +168,14 @@ def is_enum(cls):
 
 
 def own_members(cls, sapien):
-    """[(name, attribute)] of a class's own public members, in name order, with what the SAPIEN
-    layer replaced restored and what it added left out."""
+    """[(name, attribute)] of a class's own public members, in name order."""
     out = []
     for name, attr in sorted(cls.__dict__.items()):
         if name.startswith("_") and name != "__init__":
             continue
         if is_enum(cls) and (name in cls.__members__ or name in ("name", "value", "__init__")):
             continue
-        if isinstance(attr, property) and inspect.isfunction(attr.fget) and \
-                attr.fget.__module__ == sapien.__name__:
-            attr = sapien._replaced_properties.get((cls, name))
-        elif inspect.isfunction(attr) and attr.__module__ == sapien.__name__:
-            attr = getattr(attr, "__wrapped__", None)
-        if attr is not None:
-            out.append((name, attr))
+        out.append((name, attr))
     return out
 
 
@@ -274,7 +266,7 @@ def generate(python_dir):
     """{file name: text} of the reference."""
     sys.path.insert(0, python_dir)
     ext = importlib.import_module(MODULE)
-    sapien = importlib.import_module("partsim._sapien")
+    sapien = None  # the SAPIEN adapter (partsim.sapien) is documented in sapien_compatibility.md
     package = importlib.import_module("partsim")
     where = registrations()
 

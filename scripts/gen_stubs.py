@@ -22,7 +22,6 @@ REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 STUB = os.path.join(REPO, "python", "partsim", "_partsim.pyi")
 MODULE = "partsim._partsim"
 
-SAPIEN_REPLACED_PROPERTIES = {}  # (class, name) -> binding property the SAPIEN layer replaced
 PYBIND_FUNC = type(len)  # builtin_function_or_method, what pybind11 functions look like
 INSTANCE_METHOD = "instancemethod"
 
@@ -202,13 +201,7 @@ def fmt_class(cls, indent=""):
         for member in cls.__members__:
             out.append("%s%s: typing.ClassVar[%s]" % (inner, member, cls.__name__))
     for name, attr in sorted(cls.__dict__.items()):
-        # the SAPIEN layer (partsim/_sapien.py) adds Python functions and properties to the
-        # classes: a binding it replaced is stubbed, what it added is not
-        if not isinstance(attr, staticmethod):
-            attr = getattr(attr, "__wrapped__", attr)
-        if isinstance(attr, property) and inspect.isfunction(attr.fget):
-            attr = SAPIEN_REPLACED_PROPERTIES.get((cls, name))
-        if attr is None or inspect.isfunction(attr):
+        if inspect.isfunction(attr):
             continue
         if name in ("__doc__", "__module__", "__members__", "__entries") or \
                 (name.startswith("__") and not isinstance(attr, (PYBIND_FUNC, staticmethod)) and
@@ -261,8 +254,6 @@ def main():
     opts = parser.parse_args()
     sys.path.insert(0, opts.python_dir)
     module = importlib.import_module(MODULE)
-    global SAPIEN_REPLACED_PROPERTIES
-    SAPIEN_REPLACED_PROPERTIES = importlib.import_module("partsim._sapien")._replaced_properties
     text = generate(module)
     if opts.check:
         with open(opts.output) as f:

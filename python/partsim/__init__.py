@@ -1,14 +1,14 @@
 """partsim: simulation of robots interacting with articulated objects, on MuJoCo.
 
 The compiled extension `partsim._partsim` holds the bindings; everything public in it is
-re-exported here, so `import partsim; partsim.Scene()` works. SAPIEN's names are added beside
-partsim's own (see partsim._sapien and docs/sapien_compatibility.md), so that SAPIEN 2.2 and 3.x
-scripts run with `import partsim as sapien` (or `import partsim.core as sapien` for SAPIEN 2's
-`import sapien.core as sapien`). Where Gymnasium is installed, the environments of partsim.envs are
+re-exported here, so `import partsim; partsim.Scene()` works. SAPIEN's API is an adapter beside
+partsim's own, imported on request: `import partsim.sapien as sapien` for SAPIEN 3 scripts,
+`import partsim.core as sapien` for SAPIEN 2's `import sapien.core as sapien` (see
+docs/sapien_compatibility.md); importing partsim changes none of partsim's classes. Where
+Gymnasium is installed, the environments of partsim.envs are
 registered with it (`gymnasium.make("partsim/OpenCabinetDrawer-v0")`).
 """
 
-import sys as _sys
 
 # The Debian 12 packages of the shared libraries the compiled module and the command line link
 # (a wheel carries MuJoCo but not these): a missing one is named with the command that installs
@@ -58,16 +58,8 @@ except ImportError as _e:
     raise ImportError(_missing_library_message(_e)) from _e
 from ._partsim import PartsimError, PartsimIndexError  # noqa: F401  (explicit for readers)
 from ._partsim import __version__  # noqa: F401  (the project's version, set by CMake)
-from ._sapien import (  # noqa: F401
-    Engine, KuafuRenderer, RenderBodyComponent, RenderMaterial, SapienContact, SapienRenderer,
-    SceneConfig, Viewer, VulkanRenderer, physx, render, set_log_level, utils)
 from . import vision  # noqa: F401  (partsim.vision: COCO masks, the perception evaluators)
 from ._cli import find_cli  # noqa: F401  (the command line that goes with this package)
-
-
-# SAPIEN 2 scripts say `import sapien.core as sapien`: partsim.core is partsim itself
-core = _sys.modules[__name__]
-_sys.modules[__name__ + ".core"] = core
 
 
 def _register_gymnasium_envs():

@@ -10,9 +10,8 @@ What is not required, and why:
 - dunder and other `_`-prefixed names (pybind11 writes `__init__`, `__repr__`, ... itself);
 - enum values and pybind11's enum helpers `name` and `value` (the enum class documents them);
 - plain data attributes (class constants such as `metadata`, which cannot carry a docstring);
-- SAPIEN compatibility (python/partsim/_sapien.py): the modules `partsim.core`, `physx`,
-  `render`, `utils`, the names `_sapien` defines, and the methods and properties it adds to the
-  extension's classes. Where it replaces a binding, the binding it replaced is checked.
+- the SAPIEN adapter (partsim.sapien, partsim.core): SAPIEN's names, documented by SAPIEN and by
+  docs/sapien_compatibility.md;
 - names re-exported from other packages (e.g. gymnasium's spaces in partsim.envs).
 """
 
@@ -24,7 +23,6 @@ import sys
 
 import partsim
 import partsim._partsim as ext
-import partsim._sapien as _sapien
 import partsim.envs as envs
 import partsim.vision as vision
 from conftest import PYTHON_DIR, REPO
@@ -68,21 +66,6 @@ def is_documented(doc):
     return all(re.search(r"[A-Za-z]{3,}", t) for t in own_texts(doc))
 
 
-def is_sapien(obj):
-    return getattr(obj, "__module__", None) == _sapien.__name__ or (
-        inspect.ismodule(obj) and obj.__name__ not in (envs.__name__, vision.__name__))
-
-
-def binding_behind(cls, name, attr):
-    """What to check for class attribute `name`: the binding the SAPIEN layer replaced, None for
-    what the SAPIEN layer added, the attribute itself otherwise."""
-    if isinstance(attr, property) and inspect.isfunction(attr.fget) and is_sapien(attr.fget):
-        return _sapien._replaced_properties.get((cls, name))
-    if inspect.isfunction(attr) and is_sapien(attr):
-        return getattr(attr, "__wrapped__", None)
-    return attr
-
-
 def walk_class(cls, qualname, out):
     out.append((qualname, cls.__doc__))
     is_enum = hasattr(cls, "__members__")
@@ -92,9 +75,6 @@ def walk_class(cls, qualname, out):
             continue
         if isinstance(attr, (staticmethod, classmethod)):
             attr = attr.__func__
-        attr = binding_behind(cls, name, attr)
-        if attr is None:
-            continue
         if inspect.isclass(attr):
             walk_class(attr, qualname + "." + name, out)
         elif isinstance(attr, property) or callable(attr):
@@ -112,11 +92,6 @@ def public_members():
             if name.startswith("_"):
                 continue
             obj = getattr(module, name)
-            if is_sapien(obj):
-                # SAPIEN's versions of an extension's name: the extension's own is checked
-                obj = getattr(ext, name, None) if module is partsim else None
-                if obj is None:
-                    continue
             if inspect.ismodule(obj):
                 continue  # a submodule: walked on its own
             if getattr(obj, "__module__", None) not in OWN_MODULES and not (
@@ -138,7 +113,7 @@ def test_walk_finds_the_api():
                      "partsim.envs.OpenCabinetEnv.step", "partsim.vision.evaluate_detection",
                      "partsim.vision.DetectionEvaluation.map"):
         assert expected in names, expected
-    assert not any(n.startswith(("partsim.core", "partsim.physx", "partsim.Engine"))
+    assert not any(n.startswith(("partsim.core", "partsim.sapien", "partsim.Engine"))
                    for n in names)
     assert len(names) > 600
 

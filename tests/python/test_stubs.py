@@ -6,7 +6,6 @@ import inspect
 import os
 
 import partsim._partsim as ext
-import partsim._sapien as _sapien
 from conftest import REPO
 
 STUB = os.path.join(REPO, "python", "partsim", "_partsim.pyi")
@@ -41,12 +40,7 @@ def module_names():
         if issubclass(cls, BaseException):
             return
         for name, attr in cls.__dict__.items():
-            # what the SAPIEN layer added is not the extension's; what it replaced still is
-            if not isinstance(attr, staticmethod):
-                attr = getattr(attr, "__wrapped__", attr)
-            if isinstance(attr, property) and inspect.isfunction(attr.fget):
-                attr = _sapien._replaced_properties.get((cls, name))
-            if attr is None or inspect.isfunction(attr):
+            if inspect.isfunction(attr):
                 continue
             # dunders count when the bindings define them (pybind11 functions)
             if name.startswith("_") and type(attr).__name__ != "instancemethod":
@@ -81,13 +75,7 @@ def test_stub_names_nothing_that_is_gone():
 def test_package_exports_the_module():
     import partsim
     for name in dir(ext):
-        if name in _sapien.EXPORT_OVERRIDES:
-            # the SAPIEN-aware versions: subclasses or wrappers of the extension's
-            ours = getattr(partsim, name)
-            assert ours is not getattr(ext, name)
-            assert (issubclass(ours, getattr(ext, name)) if isinstance(ours, type) else
-                    callable(ours))
-        elif not name.startswith("_"):
+        if not name.startswith("_"):
             assert getattr(partsim, name) is getattr(ext, name)
 
 

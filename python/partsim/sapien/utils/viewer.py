@@ -1,0 +1,3 @@
+"""SAPIEN 2's `sapien.utils.viewer`: the browser viewer."""
+
+from . import Viewer  # noqa: F401
