@@ -1,4 +1,4 @@
-"""SAPIEN 3's hello world on partsim: `import sapien` becomes `import partsim as sapien`.
+"""SAPIEN 3's hello world on partsim: `import sapien` becomes `import partsim.sapien as sapien`.
 
 SAPIEN 3 has no Engine: scenes are made directly, actors are entities with a `pose`, visuals
 take `material=`. The viewer runs in a web browser: scene.create_viewer() prints the URL to
@@ -14,7 +14,7 @@ import numpy as np
 from PIL import Image
 from transforms3d.euler import euler2quat
 
-import partsim as sapien  # SAPIEN 3: import sapien
+import partsim.sapien as sapien  # SAPIEN 3: import sapien
 
 
 def main(out_png):

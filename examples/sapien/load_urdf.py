@@ -1,7 +1,7 @@
 """Loads a URDF robot and a PartNet-Mobility object with SAPIEN's URDF loader, as SAPIEN's
 loading tutorial does, and moves a part of the object.
 
-Written against SAPIEN 3's API (`import sapien` becomes `import partsim as sapien`). A
+Written against SAPIEN 3's API (`import sapien` becomes `import partsim.sapien as sapien`). A
 PartNet-Mobility object is loaded from its mobility.urdf, like any URDF. With no argument it
 loads partsim's Panda and a StorageFurniture object made by `partsim assets generate` (into a
 temporary folder); give a robot URDF and a PartNet-Mobility folder (e.g. the dataset's 179/) to
@@ -17,7 +17,7 @@ import tempfile
 
 import numpy as np
 
-import partsim as sapien  # SAPIEN 3: import sapien
+import partsim.sapien as sapien  # SAPIEN 3: import sapien
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.join(HERE, "..", "..")

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import partsim
-import partsim as sapien
+import partsim.sapien as sapien
 from conftest import CABINET_URDF
 
 G = 9.81
@@ -31,7 +31,7 @@ def box_scene(dt=1 / 100.0):
 
 def test_sapien2_and_sapien3_entry_points():
     import partsim.core as core
-    assert core is partsim
+    assert core is sapien
     engine = sapien.Engine()
     renderer = sapien.SapienRenderer()
     engine.set_renderer(renderer)
@@ -43,7 +43,8 @@ def test_sapien2_and_sapien3_entry_points():
     config.default_restitution = 0.2
     config.enable_pcm = False  # PhysX-only, kept
     scene = engine.create_scene(config)
-    assert isinstance(scene, partsim.Scene)
+    assert isinstance(scene, sapien.Scene)
+    assert isinstance(sapien.partsim_object(scene), partsim.Scene)
     np.testing.assert_allclose(scene.get_gravity(), [0, 0, -5])
     m = scene.default_physical_material
     assert (m.static_friction, m.dynamic_friction, m.restitution) == pytest.approx((0.9, 0.7, 0.2))
@@ -83,7 +84,7 @@ def test_physx_defaults_apply_to_later_scenes():
         with pytest.raises(partsim.PartsimError, match="unknown field 'gravvity'"):
             sapien.physx.set_scene_config(gravvity=[0, 0, 0])
     finally:
-        sapien._sapien._physx_defaults.clear()
+        sapien.physx._defaults.clear()
     assert sapien.Scene().get_gravity()[2] == pytest.approx(-9.81)
 
 
@@ -168,8 +169,12 @@ def test_build_kinds_and_static_actors_can_be_placed():
         b.set_physx_body_type(kind)
         a = b.build(name=kind)
         assert a.type == expected and a.name == kind
-        comp = a.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent)
-        assert (comp is a) == (kind != "static")
+        dynamic = a.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent)
+        static = a.find_component_by_type(sapien.physx.PhysxRigidStaticComponent)
+        assert (dynamic is not None, static is not None) == (kind != "static", kind == "static")
+        assert a.find_component_by_type(sapien.render.RenderBodyComponent) is not None
+        if dynamic is not None:
+            assert dynamic.kinematic == (kind == "kinematic") and dynamic.entity is a
     b = scene.create_actor_builder()
     b.add_box_collision(half_size=[0.1] * 3)
     wall = b.build_static(name="wall")
@@ -239,7 +244,9 @@ def test_contacts_with_links_name_the_link():
     names = {(c.actor0.name, c.actor1.name) for c in scene.get_contacts()}
     assert ("base", "ground") in names
     link = [c.actor0 for c in scene.get_contacts() if c.actor0.name == "base"][0]
-    assert isinstance(link, partsim.Link)
+    assert isinstance(link, sapien.physx.PhysxArticulationLinkComponent)
+    assert isinstance(sapien.partsim_object(link), partsim.Link)
+    assert link.entity.find_component_by_type(sapien.physx.PhysxArticulationLinkComponent) == link
 
 
 # ------------------------------------------------------------------------------ articulations
@@ -276,7 +283,9 @@ def test_joint_properties_and_limits_in_sapien_shapes():
     assert fixed and fixed[0].get_limits().shape == (0, 2)
 
     free = build_two_links(sapien.Scene(), "revolute", [[-np.inf, np.inf]])
-    assert free.get_active_joints()[0].type == partsim.JointType.CONTINUOUS
+    joint = free.get_active_joints()[0]
+    assert joint.type == "revolute"  # SAPIEN's name for a revolute joint with or without limits
+    assert sapien.partsim_object(joint).type == partsim.JointType.CONTINUOUS
     assert build_two_links(sapien.Scene(), "prismatic", [[0, 0.4]]).dof == 1
     with pytest.raises(partsim.PartsimError, match="unknown joint type 'spherical'"):
         build_two_links(sapien.Scene(), "spherical", [])
@@ -504,18 +513,60 @@ def unsupported_names_in_the_docs():
     return names
 
 
+# constructors and functions the table marks "no" that refuse by raising when called
+REFUSED_CALLS = {
+    "KuafuRenderer": lambda: sapien.KuafuRenderer(),
+    "create_window": lambda: sapien.SapienRenderer().create_window(),
+    "create_pinocchio_model": lambda: build_two_links(sapien.Scene(), "revolute",
+                                                      [[-1, 1]]).create_pinocchio_model(),
+    "add_nonconvex_collision_from_file":
+        lambda: sapien.Scene().create_actor_builder().add_nonconvex_collision_from_file("m.obj"),
+    "add_plane_collision": lambda: sapien.Scene().create_actor_builder().add_plane_collision(),
+    "PhysxCollisionShapePlane": lambda: sapien.physx.PhysxCollisionShapePlane(None),
+    "PhysxCollisionShapeTriangleMesh":
+        lambda: sapien.physx.PhysxCollisionShapeTriangleMesh("m.obj", [1, 1, 1], None),
+    "PhysxGpuSystem": lambda: sapien.physx.PhysxGpuSystem(),
+    "enable_gpu": lambda: sapien.physx.enable_gpu(),
+    "PhysxDriveComponent": lambda: sapien.physx.PhysxDriveComponent(None),
+    "PhysxDistanceJointComponent": lambda: sapien.physx.PhysxDistanceJointComponent(None),
+    "PhysxGearComponent": lambda: sapien.physx.PhysxGearComponent(None),
+    "set_locked_motion_axes":
+        lambda: sapien.physx.PhysxRigidDynamicComponent().set_locked_motion_axes([1] * 6),
+    "set_disable_gravity":
+        lambda: sapien.physx.PhysxRigidDynamicComponent().set_disable_gravity(True),
+    "RenderShapePlane": lambda: sapien.render.RenderShapePlane([1, 1, 1], None),
+    "RenderTexturedLightComponent": lambda: sapien.render.RenderTexturedLightComponent(),
+    "RenderParallelogramLightComponent":
+        lambda: sapien.render.RenderParallelogramLightComponent(),
+    "set_cubemap": lambda: sapien.Scene().render_system.set_cubemap(None),
+    "set_visibility": lambda: sapien.render.RenderBodyComponent().set_visibility(0.5),
+    "disable_render_id": lambda: sapien.render.RenderBodyComponent().disable_render_id(),
+    "raycast": lambda: sapien.Scene().physx_system.raycast([0, 0, 1], [0, 0, -1], 10),
+    "get_link_incoming_joint_forces": lambda: build_two_links(
+        sapien.Scene(), "revolute", [[-1, 1]]).get_link_incoming_joint_forces(),
+}
+
+
 def test_every_call_the_table_marks_unsupported_raises_partsim_error():
-    from partsim._sapien import UNSUPPORTED, UnsupportedError
-    # refused by functions of their own, tested above
-    elsewhere = {"KuafuRenderer", "create_window", "create_pinocchio_model",
-                 "add_nonconvex_collision_from_file"}
+    from partsim.sapien import UNSUPPORTED, UnsupportedError
     listed = {n for names in UNSUPPORTED.values() for n in names}
     documented = unsupported_names_in_the_docs()
-    assert documented - elsewhere == listed, "docs/sapien_compatibility.md and UNSUPPORTED differ"
+    assert documented == listed | set(REFUSED_CALLS), \
+        "docs/sapien_compatibility.md's 'no' rows and the adapter differ"
+    for name, call in REFUSED_CALLS.items():
+        with pytest.raises(partsim.PartsimError, match=".{20}"):
+            call()
     scene, box = box_scene()
-    objects = {partsim.Scene: scene, partsim.Actor: box,
-               partsim.Camera: scene.add_camera("c", 32, 32, 1.0, 0.1, 10),
-               partsim.UrdfLoader: scene.create_urdf_loader()}
+    art = build_two_links(scene, "revolute", [[-1, 1]])
+    objects = {sapien.Scene: scene, sapien.Entity: box,
+               sapien.render.RenderCameraComponent: scene.add_camera("c", 32, 32, 1.0, 0.1, 10),
+               sapien.URDFLoader: scene.create_urdf_loader(),
+               sapien.physx.PhysxRigidBaseComponent:
+                   box.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent),
+               sapien.physx.PhysxArticulation: art,
+               sapien.render.RenderBodyComponent:
+                   box.find_component_by_type(sapien.render.RenderBodyComponent)}
+    assert set(UNSUPPORTED) <= set(objects)
     for cls, names in UNSUPPORTED.items():
         for name, why in names.items():
             with pytest.raises(partsim.PartsimError, match=re.escape(why)) as e:

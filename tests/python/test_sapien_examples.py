@@ -1,7 +1,8 @@
 """The SAPIEN-style example scripts (examples/sapien/) run to the end with partsim standing in for
 SAPIEN, and print what they check: the box rests and the contact force equals its weight with
 SAPIEN's sign, a box set down on a box is held by its contacts from the first step, the car drives straight on the ground at dt = 0.01 s, the PID arm reaches its
-target, the camera's point cloud lies on the objects."""
+target, the camera's point cloud lies on the objects; the entity-component tutorials build a
+scene from components and run components of their own."""
 
 import os
 import subprocess
@@ -96,3 +97,21 @@ def test_load_urdf_real_partnet_mobility_object(tmp_path):
     panda = os.path.join(REPO, "tests", "data", "arm", "arm_description", "urdf", "panda.urdf")
     out = run_example("load_urdf.py", panda, real, cwd=tmp_path)
     assert "load urdf: ok" in out
+
+
+def test_ecs_hello_world_builds_the_scene_from_components(tmp_path):
+    out = run_example("ecs_hello_world.py", str(tmp_path / "box.png"), cwd=tmp_path)
+    assert "ecs hello world: ok" in out
+    assert value_after(out, "mass") == pytest.approx(12.0)
+    assert value_after(out, "box rests at z =") == pytest.approx(0.1, abs=2e-3)
+    assert value_after(out, "contact impulse") == pytest.approx(value_after(out, "m g dt ="),
+                                                                rel=0.01)
+    assert value_after(out, "cx") == pytest.approx(80.0)  # SAPIEN's principal point: width / 2
+    assert (tmp_path / "box.png").stat().st_size > 1000
+
+
+def test_ecs_components_of_the_scripts_own_drive_and_count(tmp_path):
+    out = run_example("ecs_components.py", cwd=tmp_path)
+    assert "ecs components: ok" in out
+    assert value_after(out, "box pushed") == pytest.approx(0.57, abs=0.02)
+    assert value_after(out, "touched in") > 100

@@ -31,7 +31,7 @@ except ImportError as e:
     pytest.skip(f"SAPIEN 3 is not installed ({e})", allow_module_level=True)
 
 import partsim  # noqa: E402
-import partsim as psapien  # noqa: E402  partsim's SAPIEN layer (import partsim as sapien)
+import partsim.sapien as psapien  # noqa: E402  partsim's SAPIEN adapter
 
 REALDATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared",
                         "realdata")
@@ -138,16 +138,14 @@ def box_on_box(sp):
         scene.step()
     points, impulse = 0, np.zeros(3)
     for c in scene.get_contacts():
-        names = {b.entity.name if sp is sapien else b.name for b in c.bodies}
+        names = {b.entity.name for b in c.bodies}
         if names != {"base", "top"}:
             continue
-        sign = 1.0 if (c.bodies[0].entity.name if sp is sapien else c.bodies[0].name) == "top" \
-            else -1.0
+        sign = 1.0 if c.bodies[0].entity.name == "top" else -1.0
         for p in c.points:
             points += 1
             impulse += sign * np.asarray(p.impulse)
-    mass = top.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent).mass \
-        if sp is sapien else top.mass
+    mass = top.find_component_by_type(sp.physx.PhysxRigidDynamicComponent).mass
     return points, impulse, float(top.pose.p[2]), mass
 
 
@@ -224,3 +222,119 @@ def test_joint_limits_hold_a_drive_that_pulls_past_them():
     assert real[-1] == pytest.approx(0.5, abs=0.02)
     assert ours[-1] == pytest.approx(0.5, abs=0.02)
     assert ours.max() < 0.55 and real.max() < 0.55
+
+
+# ------------------------------------------------------------------------------ entities
+
+def ecs_body(sp):
+    """A body of a box and a denser sphere built from components (SAPIEN 3's entity-component
+    form) and dropped on the ground: its mass properties before and after it joins the scene,
+    its rest pose, and its default damping."""
+    scene = new_scene(sp)
+    add_ground(sp, scene)
+    material = sp.physx.PhysxMaterial(0.5, 0.5, 0.0)
+    box = sp.physx.PhysxCollisionShapeBox([0.1, 0.05, 0.02], material)
+    ball = sp.physx.PhysxCollisionShapeSphere(0.03, material)
+    ball.set_local_pose(sp.Pose([0.08, 0.0, 0.05]))
+    ball.set_density(3000)
+    body = sp.physx.PhysxRigidDynamicComponent()
+    body.attach(box)
+    body.attach(ball)
+
+    def props():
+        m = body.cmass_local_pose.to_transformation_matrix()
+        rot = m[:3, :3]
+        return body.mass, rot @ np.diag(body.inertia) @ rot.T, m[:3, 3].copy()
+
+    before = props()
+    entity = sp.Entity()
+    entity.set_name("body")
+    entity.add_component(body)
+    entity.set_pose(sp.Pose([0, 0, 0.3]))
+    scene.add_entity(entity)
+    after = props()
+    for _ in range(1000):
+        scene.step()
+    same = entity.find_component_by_type(sp.physx.PhysxRigidDynamicComponent) is body
+    return before, after, entity.pose, same, body.angular_damping, body.linear_damping
+
+
+def test_a_body_built_from_components_has_physx_mass_properties_and_rests_alike():
+    real, ours = both(ecs_body)
+    for (m_s, i_s, c_s), (m_p, i_p, c_p) in ((real[0], ours[0]), (real[1], ours[1])):
+        # computed from the shapes as PhysX does, before and after joining the scene (float32
+        # in PhysX): the inertia tensor about the centre of mass, in the body's frame
+        assert m_p == pytest.approx(m_s, rel=1e-5)
+        np.testing.assert_allclose(i_p, i_s, rtol=1e-4, atol=1e-9)
+        np.testing.assert_allclose(c_p, c_s, atol=1e-6)
+    assert real[3] and ours[3]
+    # SAPIEN's default damping of a dynamic body: 0.05 angular, none linear
+    assert (ours[4], ours[5]) == pytest.approx((real[4], real[5]), abs=1e-7)
+    # it lies flat on the box's bottom face in both
+    assert ours[2].p[2] == pytest.approx(real[2].p[2], abs=2e-3)
+    assert same_rotation(ours[2].q, real[2].q, 1e-3)
+
+
+# ------------------------------------------------------------------------------ cameras
+
+LOOK = [math.cos(0.2), 0.0, math.sin(0.2), 0.0]  # pitched down by 0.4 rad about y
+
+
+def camera_on_entity(sp, entity_pose, **parameters):
+    """A 128 x 96 camera on an entity of its own (SAPIEN 3's camera component). SAPIEN computes
+    the matrices without a render device, so they can be compared here."""
+    cam = sp.render.RenderCameraComponent(128, 96)
+    cam.set_fovy(0.9)
+    cam.near, cam.far = 0.05, 20.0
+    if parameters:
+        cam.set_perspective_parameters(**parameters)
+    entity = sp.Entity()
+    entity.add_component(cam)
+    entity.set_pose(entity_pose)
+    return cam, entity
+
+
+def camera_matrices(cam):
+    return (np.asarray(cam.get_intrinsic_matrix(), float),
+            np.asarray(cam.get_extrinsic_matrix(), float),
+            np.asarray(cam.get_model_matrix(), float))
+
+
+@pytest.mark.parametrize("parameters", [
+    {}, dict(near=0.05, far=20.0, fx=70.0, fy=72.0, cx=60.0, cy=50.0, skew=0.0)])
+def test_camera_intrinsics_and_extrinsics_are_sapiens(parameters):
+    real_cam, real_entity = camera_on_entity(sapien, sapien.Pose([-1.0, 0.2, 0.8], LOOK),
+                                             **parameters)
+    real = camera_matrices(real_cam)  # (SAPIEN's component lives as long as its entity)
+    cam, entity = camera_on_entity(psapien, psapien.Pose([-1.0, 0.2, 0.8], LOOK), **parameters)
+    before = camera_matrices(cam)
+    scene = psapien.Scene()
+    scene.add_entity(entity)
+    after = camera_matrices(cam)  # now partsim's camera's, read through the adapter
+    for ours in (before, after):
+        np.testing.assert_allclose(ours[0], real[0], atol=1e-4)  # K: principal point w/2, h/2
+        np.testing.assert_allclose(ours[1], real[1], atol=1e-5)  # world to OpenCV camera
+        np.testing.assert_allclose(ours[2], real[2], atol=1e-5)  # OpenGL camera in the world
+
+
+def test_a_world_point_lands_on_the_pixel_sapiens_matrices_give():
+    point = np.array([0.3, -0.1, 0.1])
+    real_cam, real_entity = camera_on_entity(sapien, sapien.Pose([-1.0, 0.2, 0.8], LOOK))
+    k, ext, _ = camera_matrices(real_cam)
+    u, v, w = k @ (ext @ np.append(point, 1.0))
+    u, v = u / w, v / w  # SAPIEN: pixel (i, j) covers [j, j + 1) x [i, i + 1)
+    cam, entity = camera_on_entity(psapien, psapien.Pose([-1.0, 0.2, 0.8], LOOK))
+    scene = psapien.Scene()
+    scene.set_ambient_light([1, 1, 1])
+    scene.add_entity(entity)
+    dot = scene.create_actor_builder()
+    dot.add_sphere_visual(radius=0.03, material=[1, 0, 0])
+    dot.build_static(name="dot").set_pose(psapien.Pose(point))
+    scene.update_render()
+    cam.take_picture()
+    seg = cam.get_picture("Segmentation")[..., 1]
+    rows, cols = np.nonzero(seg == scene.find_actor_by_name("dot").per_scene_id)
+    assert len(rows) >= 4
+    # the dot's pixels centre on the point: within a quarter pixel of SAPIEN's projection
+    assert cols.mean() + 0.5 == pytest.approx(u, abs=0.25)
+    assert rows.mean() + 0.5 == pytest.approx(v, abs=0.25)
