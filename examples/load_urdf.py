@@ -72,7 +72,7 @@ def main():
                  "parent": joint.get_parent_link().get_name(),
                  "child": joint.get_child_link().get_name()}
         if joint.get_dof() > 0:
-            lower, upper = joint.get_limits()[0]
+            lower, upper = joint.get_limits()
             line += f", limits [{lower:.3f}, {upper:.3f}], dof index {joint.get_dof_index()}"
             entry.update(lower=finite(lower), upper=finite(upper), dof_index=joint.get_dof_index())
         print(line)

@@ -19,12 +19,23 @@ def scene(root: str) -> None:
     s.add_ground(0.0)
     b = s.create_actor_builder()
     b.add_box_collision(half_size=[0.1, 0.1, 0.1])
-    box = b.build(name="box")
+    b.set_name("box")
+    box = b.build()
     box.set_pose(partsim.Pose([0, 0, 0.5]))
     s.step(1000)
     z = box.get_pose().p[2]
     assert abs(z - 0.1) < 0.01, z
     print(f"import partsim: {partsim.__file__} - box at rest at z = {z:.3f} m")
+    # the SAPIEN adapter is installed beside it (a subpackage) and builds from components
+    import partsim.sapien as sapien
+    scene = sapien.Scene()
+    body = sapien.physx.PhysxRigidDynamicComponent()
+    body.attach(sapien.physx.PhysxCollisionShapeSphere(0.05))
+    ball = sapien.Entity()
+    ball.add_component(body)
+    scene.add_entity(ball)
+    assert ball.scene is scene and body.mass > 0
+    print(f"import partsim.sapien: {sapien.__file__}")
 
 
 def viewer(web: str) -> None:

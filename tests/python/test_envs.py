@@ -208,7 +208,7 @@ def test_terminated_on_success():
     e = make(init_on_handle=True, max_episode_steps=80)
     obs, info = e.reset(seed=SEED)
     assert info["touching"] and not info["success"]
-    lo, hi = e.task.target_joint.get_limits()[0]
+    lo, hi = e.task.target_joint.get_limits()
     opening = 1.0 if abs(lo) <= abs(hi) else -1.0  # opens towards the far limit
     action = np.zeros(7, dtype=np.float32)
     action[:3] = 0.5 * opening * obs[3:6]  # mobility obs: the joint axis direction

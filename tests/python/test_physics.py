@@ -177,7 +177,7 @@ def test_articulation_builder(scene):
     joint = art.get_active_joints()[0]
     assert joint.type == partsim.JointType.REVOLUTE
     assert joint.get_dof() == 1 and joint.get_dof_index() == 0
-    np.testing.assert_allclose(joint.get_limits(), [[-1, 1]])  # (dof, 2) as SAPIEN's
+    np.testing.assert_allclose(joint.get_limits(), [-1, 1])  # (lower, upper)
     assert joint.get_damping() == pytest.approx(0.1)
     assert joint.get_parent_link().name == "base"
     assert joint.get_child_link().name == "arm"
@@ -233,7 +233,7 @@ def test_articulation_arrays_shapes(cabinet):
         assert_vec(link.get_cmass_pose().q, (4,))
         assert link.get_mass() > 0
     for joint in art.get_joints():
-        assert joint.get_limits().shape == (joint.get_dof(), 2)
+        assert joint.get_limits().shape == (2,)
         assert_vec(joint.get_global_axis(), (3,))
         assert isinstance(joint.get_global_pose(), partsim.Pose)
         assert isinstance(joint.get_pose_in_parent(), partsim.Pose)
@@ -257,7 +257,7 @@ def test_articulation_setters_round_trip(cabinet):
     np.testing.assert_allclose(art.get_qlimits(), [[-1.0, 0.4], [0.0, 0.2]])
     joint = art.find_joint_by_name("hinge")
     joint.set_limits(-1.5, 0.5)
-    np.testing.assert_allclose(joint.get_limits(), [[-1.5, 0.5]])
+    np.testing.assert_allclose(joint.get_limits(), [-1.5, 0.5])
     joint.set_friction(0.1)
     joint.set_damping(0.2)
     joint.set_armature(0.01)

@@ -115,8 +115,8 @@ def test_pictures_have_shapes_and_dtypes(render_scene):
     for name in ("Color", "Albedo", "Normal", "Position"):
         p = cam.get_picture(name)
         assert p.shape == (7, 10, 4) and p.dtype == np.float32, name
-    seg = cam.get_picture("Segmentation")  # SAPIEN's layout: visual id, entity id, 0, 0
-    assert seg.shape == (7, 10, 4) and seg.dtype == np.uint32
+    seg = cam.get_picture("Segmentation")  # visual id, entity id
+    assert seg.shape == (7, 10, 2) and seg.dtype == np.uint32
     rgba = cam.get_color_rgba8()
     assert rgba.shape == (7, 10, 4) and rgba.dtype == np.uint8
     depth = cam.get_depth()
@@ -134,14 +134,14 @@ def test_pictures_are_read_only_views_that_survive_the_next_picture(render_scene
     assert not color.flags.writeable
     with pytest.raises(ValueError):
         color[0, 0, 0] = 1
-    # two views of one picture share memory; depth (metres) views the picture's Position
-    # memory, while get_picture("Position") is a copy with SAPIEN's depth-buffer channel
+    # two views of one picture share memory; depth (metres) views the 4th channel of the
+    # picture's Position memory
     assert np.shares_memory(color, cam.get_picture("Color"))
     depth = cam.get_depth()
     assert np.shares_memory(depth, cam.get_depth())
     assert depth.strides == (6 * 16, 16)
     position = cam.get_picture("Position")
-    assert not np.shares_memory(depth, position) and position.flags.owndata
+    assert np.shares_memory(depth, position) and not position.flags.owndata
     # the next picture renders elsewhere while the old view is alive
     cam.take_picture()
     assert not np.shares_memory(color, cam.get_picture("Color"))
@@ -155,8 +155,8 @@ def test_pictures_are_read_only_views_that_survive_the_next_picture(render_scene
 def test_take_picture_without_update_render_and_with_lights(render_scene):
     render_scene.add_directional_light([0, 0.5, -1], [1, 1, 1], shadow=True)
     render_scene.add_point_light([0, 0, 2], [2, 2, 2])
-    # SAPIEN's positional form takes full cone angles (fov); partsim's half angles by keyword
-    render_scene.add_spot_light([0, 0, 3], [0, 0, -1], 0.2, 0.8, [5, 5, 5])
+    # half angles (rad), positional or by keyword
+    render_scene.add_spot_light([0, 0, 3], [0, 0, -1], 0.1, 0.4, [5, 5, 5])
     render_scene.add_spot_light([0, 0, 3], [0, 0, -1], inner_angle=0.1, outer_angle=0.4,
                                 color=[5, 5, 5])
     render_scene.set_ambient_light([0.3, 0.3, 0.3])

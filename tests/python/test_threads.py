@@ -19,7 +19,8 @@ def scene_with_boxes(n=3):
         b = scene.create_actor_builder()
         b.add_box_collision(half_size=[0.05] * 3)
         b.set_initial_pose(partsim.Pose([0.3 * k, 0, 0.2]))
-        boxes.append(b.build(name=f"box{k}"))
+        b.set_name(f"box{k}")
+        boxes.append(b.build())
     return scene, boxes
 
 
@@ -74,7 +75,8 @@ def test_calls_while_another_thread_steps_raise_and_the_scene_survives():
             try:
                 b = scene.create_actor_builder()
                 b.add_sphere_collision(radius=0.02)
-                a = b.build(name=f"extra{k}")
+                b.set_name(f"extra{k}")
+                a = b.build()
                 a.get_pose()
                 scene.remove_actor(a)
                 boxes[1].get_velocity()
@@ -89,7 +91,7 @@ def test_calls_while_another_thread_steps_raise_and_the_scene_survives():
     assert refused, "no call met a step under way: the test did not test anything"
     # the first actors are all there (an extra one is left where a refused call came between
     # its build and its removal), and the scene still steps
-    names = [a.get_name() for a in scene.get_all_actors()]
+    names = [a.get_name() for a in scene.get_actors()]
     assert names[:4] == ["ground", "box0", "box1", "box2"]
     assert all(n.startswith("extra") for n in names[4:])
     scene.step(10)
@@ -112,7 +114,7 @@ def test_handles_of_another_scene_are_refused():
     assert boxes_a[1].get_id() == boxes_b[1].get_id()
     with pytest.raises(partsim.PartsimError, match="belongs to another scene"):
         scene_b.remove_actor(boxes_a[1])
-    assert [a.get_name() for a in scene_b.get_all_actors()].count("box1") == 1
+    assert [a.get_name() for a in scene_b.get_actors()].count("box1") == 1
     loader_a = scene_a.create_urdf_loader()
     from conftest import CABINET_URDF
     art_a = loader_a.load_from_string(CABINET_URDF, "")
@@ -120,6 +122,6 @@ def test_handles_of_another_scene_are_refused():
     assert art_a.get_id() == art_b.get_id()
     with pytest.raises(partsim.PartsimError, match="belongs to another scene"):
         scene_b.remove_articulation(art_a)
-    assert len(scene_b.get_all_articulations()) == 1
+    assert len(scene_b.get_articulations()) == 1
     scene_a.remove_articulation(art_a)
-    assert scene_a.get_all_articulations() == []
+    assert scene_a.get_articulations() == []

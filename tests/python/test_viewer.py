@@ -170,8 +170,6 @@ def test_sapien_viewer_calls(scene):
     with pytest.raises(partsim.PartsimError, match="field of view"):
         viewer.set_fovy(0.0)
     assert len(content["bodies"]) == 2
-    viewer.toggle_axes(False)
-    viewer.toggle_camera_lines(False)
     viewer.render()
     viewer.close()
     assert viewer.closed
