@@ -220,3 +220,28 @@ def test_loader_parse_has_sapiens_meaning(tmp_path):
     arts, lone = loader.load_multiple(str(path))
     assert len(arts) == 1 and lone == []
     assert len(scene.get_all_articulations()) == 2
+
+
+def test_convex_mesh_shapes_from_points_and_from_a_file():
+    from conftest import REPO
+    scene = sapien.Scene()
+    scene.set_timestep(0.002)
+    scene.add_ground(0)
+    corners = np.array([[x, y, z] for x in (-.1, .1) for y in (-.1, .1) for z in (-.05, .05)])
+    body = physx.PhysxRigidDynamicComponent()
+    body.attach(physx.PhysxCollisionShapeConvexMesh(corners, [1, 1, 1], None))
+    pieces = physx.PhysxCollisionShapeConvexMesh.load_multiple(
+        os.path.join(REPO, "tests", "data", "meshes", "cube.obj"), [0.1, 0.1, 0.1])
+    assert len(pieces) == 1 and pieces[0].vertices.shape[1] == 3
+    e = sapien.Entity()
+    e.add_component(body)
+    e.set_pose(sapien.Pose([0, 0, 0.3]))
+    scene.add_entity(e)
+    # MuJoCo computes a mesh body's mass from its hull: 0.2 x 0.2 x 0.1 m of water
+    assert body.mass == pytest.approx(4.0, rel=1e-5)
+    with pytest.raises(partsim.PartsimError, match="computed by MuJoCo"):
+        body.inertia
+    scene.step(500)
+    assert e.pose.p[2] == pytest.approx(0.05, abs=2e-3)
+    with pytest.raises(partsim.PartsimError, match="n >= 4"):
+        physx.PhysxCollisionShapeConvexMesh(corners[:3], [1, 1, 1], None)

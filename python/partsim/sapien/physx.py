@@ -357,16 +357,10 @@ class PhysxCollisionShapeConvexMesh(PhysxCollisionShape):
 
     @staticmethod
     def load_multiple(filename, scale=(1, 1, 1), material=None):
-        """One convex piece per sub-mesh (or connected component) of the file."""
-        shapes = []
-        for mesh in _p.load_meshes(str(filename)) if hasattr(_p, "load_meshes") else []:
-            shapes.append(PhysxCollisionShapeConvexMesh(
-                vertices=np.asarray(mesh.mesh.vertices), scale=scale, material=material))
-        if not shapes:
-            s = PhysxCollisionShapeConvexMesh(filename, scale, material)
-            s._multiple = True
-            return [s]
-        return shapes
+        """One convex piece per sub-mesh of the file (the convex hull of each)."""
+        meshes = _p.load_mesh_file(str(filename), np.asarray(scale, dtype=np.float64))
+        return [PhysxCollisionShapeConvexMesh(vertices=np.asarray(m.mesh.vertices), scale=(1, 1, 1),
+                                              material=material) for m in meshes]
 
     def get_scale(self):
         return self.scale
@@ -381,13 +375,10 @@ class PhysxCollisionShapeConvexMesh(PhysxCollisionShape):
 
     def _add_to(self, b):
         if self._vertices is not None:
-            mesh = _p.MeshData(self._vertices, np.zeros((0, 3), dtype=np.int32))
+            mesh = _p.MeshData()
+            mesh.vertices = np.asarray(self._vertices, dtype=np.float32)
             b.add_convex_collision_from_mesh(mesh, self.local_pose, self.physical_material,
                                              self.density)
-        elif getattr(self, "_multiple", False) and hasattr(b, "add_multiple_convex_collisions_from_file"):
-            b.add_multiple_convex_collisions_from_file(self.filename, self.local_pose,
-                                                       self.scale, self.physical_material,
-                                                       self.density)
         else:
             b.add_convex_collision_from_file(self.filename, self.local_pose, self.scale,
                                              self.physical_material, self.density)
