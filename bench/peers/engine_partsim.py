@@ -54,5 +54,7 @@ def build(scene_name, assets, dt, sleep=False):
                                 density=scenes.BOX_DENSITY)
             boxes.append(b.build())
             boxes[-1].set_pose(partsim.Pose(p, q))
-        finish = lambda: {"mean_z": float(np.mean([a.get_pose().p[2] for a in boxes]))}  # noqa: E731
+        finish = lambda: {  # noqa: E731
+            "mean_z": float(np.mean([a.get_pose().p[2] for a in boxes]))
+        }
     return scene.step, finish

@@ -1,6 +1,7 @@
 """SAPIEN 3 (the `sapien` wheel): PhysX on the CPU (``PhysxCpuSystem``), no render system.
 PhysX's defaults otherwise: TGS, 10 position and 1 velocity solver iterations per body, sleeping
-off (threshold 0; PhysX's default 0.005 with --sleep), contact offset 1 cm, PCM. Drives in force mode (``mode="force"``)."""
+off (threshold 0; PhysX's default 0.005 with --sleep), contact offset 1 cm, PCM. Drives in force
+mode (``mode="force"``)."""
 
 import warnings
 
@@ -62,5 +63,7 @@ def build(scene_name, assets, dt, sleep=False):
                                 density=scenes.BOX_DENSITY)
             b.set_initial_pose(sapien.Pose(p, q))
             boxes.append(b.build())
-        finish = lambda: {"mean_z": float(np.mean([a.get_pose().p[2] for a in boxes]))}  # noqa: E731
+        finish = lambda: {  # noqa: E731
+            "mean_z": float(np.mean([a.get_pose().p[2] for a in boxes]))
+        }
     return scene.step, finish
