@@ -25,6 +25,9 @@ class Actor:
     def get_angular_velocity(self) -> numpy.ndarray:
         """World-frame angular velocity (3,), rad/s."""
         ...
+    def get_cmass_pose(self) -> Pose:
+        """X_WC: the centre of mass frame (principal axes) in the world."""
+        ...
     def get_collision_shapes(self) -> list:
         """One Shape per collision shape, in the order of get_desc().collisions."""
         ...
@@ -33,6 +36,9 @@ class Actor:
         ...
     def get_id(self) -> int:
         """Scene-wide id (unique among actors, articulations and links): also the actor's entity id in segmentation pictures."""
+        ...
+    def get_inertia(self) -> numpy.ndarray:
+        """Principal moments (3,), kg m^2, as compiled: given, or computed by MuJoCo from the shapes (meshes from their convex hulls)."""
         ...
     def get_linear_damping(self) -> float:
         """Linear velocity damping (1/s)."""
@@ -272,6 +278,9 @@ class Articulation:
         ...
     def get_link(self, index: int) -> Link:
         """Link `index` (0 is the root); raises PartsimIndexError when out of range."""
+        ...
+    def get_link_incoming_joint_forces(self) -> numpy.ndarray:
+        """(nlinks, 6): for each link, the spatial force its parent exerts on it through its joint, from the forward dynamics of the current state: force (N) then torque (N m) about the joint's origin, in the joint's frame on the child, as PhysX's incoming joint force; the root's row is zero."""
         ...
     def get_links(self) -> list:
         """Every link's handle, in index order (0 is the root; parents before children)."""
@@ -2587,6 +2596,27 @@ class QualityOptions:
     def rest_tolerance(self, value: float) -> None: ...
 
 
+class RayHit:
+    """Where a ray first meets a collision shape (Scene.raycast)."""
+    def __repr__(self) -> str: ...
+    @property
+    def body(self) -> ContactBody:
+        """ContactBody: the actor or link hit and which of its shapes (an actor id of -1 for a geom of an MJCF model that belongs to neither)."""
+        ...
+    @property
+    def distance(self) -> float:
+        """Along the ray (m)."""
+        ...
+    @property
+    def normal(self) -> numpy.ndarray:
+        """The surface's outward normal (3,), world."""
+        ...
+    @property
+    def position(self) -> numpy.ndarray:
+        """World point hit (3,), m."""
+        ...
+
+
 class RenderBackend:
     """The scene's rendering backend."""
     def get_device(self) -> str:
@@ -2872,6 +2902,9 @@ class Scene:
         ...
     def pack(self) -> bytes:
         """Whole dynamic state as bytes, bit-exact."""
+        ...
+    def raycast(self, origin: numpy.ndarray, direction: numpy.ndarray, distance: float) -> typing.Optional[RayHit]:
+        """The first collision shape a ray from `origin` (3,) along `direction` (3,, normalized here) meets within `distance` (m), at the current state: a RayHit, or None when it meets nothing."""
         ...
     def remove_actor(self, actor: Actor) -> None:
         """Removes the actor (its handles become invalid); raises PartsimError for an actor of another scene or one already removed."""

@@ -151,6 +151,23 @@ double Actor::GetMass() const {
   return s.m()->body_mass[body];
 }
 
+Eigen::Vector3d Actor::GetInertia() const {
+  SceneImpl& s = S(scene_);
+  const int body = s.Compiled(s.GetActor(id_)).body;  // may compile: before reading s.m()
+  return V3(s.m()->body_inertia + 3 * body);
+}
+
+Pose Actor::GetCMassPose() const {
+  SceneImpl& s = S(scene_);
+  const int body = s.Compiled(s.GetActor(id_)).body;
+  s.EnsureKinematics();
+  const mjData* d = s.d();
+  return Pose(
+      V3(d->xipos + 3 * body),
+      Eigen::Quaterniond(Eigen::Matrix3d(
+          Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d->ximat + 9 * body))));
+}
+
 void Actor::SetDamping(double linear, double angular) {
   SceneImpl& s = S(scene_);
   auto& a = s.GetActor(id_);
@@ -891,6 +908,31 @@ void Articulation::DisableCollision(const Link& a, const Link& b) {
   // excluded pairs are part of the compiled model: recompile, keeping the state
   r.s.dirty = true;
   r.s.EnsureCompiled();
+}
+
+Eigen::MatrixXd Articulation::GetLinkIncomingJointForces() const {
+  ArtRef r = DynamicArt(scene_, id_, "get_link_incoming_joint_forces");
+  r.s.EnsureForward();
+  const mjModel* m = r.s.m();
+  mjData* d = r.s.d();
+  // cfrc_int: the com-based force each body gets from its parent (torque about the subtree
+  // centre of mass of its tree's root, then force, world axes)
+  mj_rnePostConstraint(m, d);
+  const int n = static_cast<int>(r.a.desc.links.size());
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, 6);
+  for (int i = 0; i < n; ++i) {
+    if (r.a.desc.links[i].parent < 0) continue;  // the root has no joint to a parent
+    const int body = LinkBody(r.s, id_, i);
+    const Eigen::Vector3d c = V3(d->subtree_com + 3 * m->body_rootid[body]);
+    const Eigen::Vector3d torque_c = V3(d->cfrc_int + 6 * body);
+    const Eigen::Vector3d force = V3(d->cfrc_int + 6 * body + 3);
+    const Pose joint = Link(scene_, id_, i).GetPose() * r.a.desc.links[i].joint.pose_in_child;
+    const Eigen::Vector3d torque = torque_c + (c - joint.p).cross(force);
+    const Eigen::Matrix3d rt = joint.q.toRotationMatrix().transpose();
+    out.row(i).head<3>() = (rt * force).transpose();
+    out.row(i).tail<3>() = (rt * torque).transpose();
+  }
+  return out;
 }
 
 Eigen::MatrixXd Articulation::ComputeWorldCartesianJacobian() const {

@@ -766,6 +766,39 @@ std::vector<Contact> Scene::GetContacts() const {
   return out;
 }
 
+std::optional<RayHit> Scene::Raycast(const Eigen::Vector3d& origin,
+                                     const Eigen::Vector3d& direction, double distance) const {
+  if (!origin.allFinite()) throw Error("raycast: the origin must be finite");
+  const double length = direction.norm();
+  if (!std::isfinite(length) || length <= 0.0)
+    throw Error("raycast: the direction must be finite and non-zero");
+  if (std::isnan(distance) || distance < 0.0) throw Error("raycast: the distance must be >= 0 (m)");
+  Impl& s = impl();
+  s.EnsureKinematics();
+  const Eigen::Vector3d unit = direction / length;
+  int geom = -1;
+  mjtNum normal[3] = {0, 0, 0};
+  const mjtNum dist =
+      mj_ray(s.m(), s.d(), origin.data(), unit.data(), nullptr, 1, -1, &geom, normal);
+  if (geom < 0 || dist < 0.0 || dist > distance) return std::nullopt;
+  RayHit hit;
+  hit.distance = dist;
+  hit.position = origin + dist * unit;
+  hit.normal = Eigen::Vector3d(normal[0], normal[1], normal[2]);
+  const internal::GeomOwner& o = s.model.geom_owner[geom];
+  hit.body.shape_index = o.shape_index;
+  if (o.actor_id >= 0) {
+    hit.body.actor_id = o.actor_id;
+    hit.body.name = s.GetActor(o.actor_id).desc.name;
+  } else if (o.articulation_id >= 0) {
+    hit.body.kind = ContactBody::Kind::kLink;
+    hit.body.articulation_id = o.articulation_id;
+    hit.body.link_index = o.link_index;
+    hit.body.name = s.GetArticulation(o.articulation_id).desc.links[o.link_index].name;
+  }
+  return hit;
+}
+
 // ---------------------------------------------------------------------------------------------
 // pack / unpack
 

@@ -421,6 +421,11 @@ void BindHandles(py::module_& m) {
            "Sets the world-frame angular velocity (3,), rad/s; raises PartsimError for an "
            "actor that is not dynamic or a non-finite w.")
       .def("get_mass", &Actor::GetMass, "Mass (kg) as compiled.")
+      .def("get_inertia", &Actor::GetInertia,
+           "Principal moments (3,), kg m^2, as compiled: given, or computed by MuJoCo from the "
+           "shapes (meshes from their convex hulls).")
+      .def("get_cmass_pose", &Actor::GetCMassPose,
+           "X_WC: the centre of mass frame (principal axes) in the world.")
       .def("set_damping", &Actor::SetDamping, py::arg("linear"), py::arg("angular"),
            "Velocity damping (1/s, >= 0) of a dynamic actor, as PhysX's: dv/dt = -linear v, "
            "dw/dt = -angular w; integrated implicitly.")
@@ -643,6 +648,11 @@ void BindHandles(py::module_& m) {
            "angular).")
       .def("compute_world_cartesian_jacobian", &Articulation::ComputeWorldCartesianJacobian,
            "Stacked link Jacobians (6 nlinks, dof).")
+      .def("get_link_incoming_joint_forces", &Articulation::GetLinkIncomingJointForces,
+           "(nlinks, 6): for each link, the spatial force its parent exerts on it through its "
+           "joint, from the forward dynamics of the current state: force (N) then torque (N m) "
+           "about the joint's origin, in the joint's frame on the child, as PhysX's incoming "
+           "joint force; the root's row is zero.")
       .def("disable_collision", &Articulation::DisableCollision, py::arg("link_a"),
            py::arg("link_b"),
            "The two links of this articulation never collide with each other from now on "
@@ -698,6 +708,17 @@ void BindContacts(py::module_& m) {
       .def("__repr__", [](const Contact& self) {
         return "<Contact '" + self.body0.name + "' - '" + self.body1.name + "', " +
                std::to_string(self.points.size()) + " points>";
+      });
+
+  py::class_<RayHit>(m, "RayHit", "Where a ray first meets a collision shape (Scene.raycast).")
+      .def_readonly("distance", &RayHit::distance, "Along the ray (m).")
+      .def_readonly("position", &RayHit::position, "World point hit (3,), m.")
+      .def_readonly("normal", &RayHit::normal, "The surface's outward normal (3,), world.")
+      .def_readonly("body", &RayHit::body,
+                    "ContactBody: the actor or link hit and which of its shapes (an actor id of "
+                    "-1 for a geom of an MJCF model that belongs to neither).")
+      .def("__repr__", [](const RayHit& self) {
+        return "<RayHit '" + self.body.name + "' at " + FormatNumber(self.distance) + " m>";
       });
 
   py::class_<Warning>(m, "SceneWarning", "A warning recorded during stepping.")
@@ -917,6 +938,10 @@ void BindScene(py::module_& m) {
           "their steps of this scene wait their turn, and their other calls on it raise "
           "PartsimError until step returns.")
       .def("get_contacts", &Scene::GetContacts, "list of Contact: the contacts of the last step.")
+      .def("raycast", &Scene::Raycast, py::arg("origin"), py::arg("direction"), py::arg("distance"),
+           "The first collision shape a ray from `origin` (3,) along `direction` (3,, normalized "
+           "here) meets within `distance` (m), at the current state: a RayHit, or None when it "
+           "meets nothing.")
       .def("get_warnings", &Scene::GetWarnings,
            "list of SceneWarning recorded so far (numerical trouble during steps).")
       .def("clear_warnings", &Scene::ClearWarnings, "Forgets the warnings recorded so far.")

@@ -87,6 +87,11 @@ class Actor {
   void SetAngularVelocity(const Eigen::Vector3d& w);
   /// Mass (kg) as compiled.
   double GetMass() const;
+  /// Principal moments of inertia (kg m^2) as compiled: given, or computed by MuJoCo from the
+  /// shapes (meshes from their convex hulls).
+  Eigen::Vector3d GetInertia() const;
+  /// X_WC: the centre of mass frame (principal axes) in the world.
+  Pose GetCMassPose() const;
   /// Velocity damping (1/s, >= 0) of a dynamic actor, as PhysX's: the linear velocity decays as
   /// dv/dt = -linear v, the angular as dw/dt = -angular w (about each body axis, with the body's
   /// inertia about that axis). Integrated implicitly. Static and kinematic actors refuse.
@@ -307,6 +312,11 @@ class Articulation {
   Eigen::MatrixXd ComputeLinkJacobian(int index) const;
   /// Stacked link Jacobians, 6 nlinks x dof.
   Eigen::MatrixXd ComputeWorldCartesianJacobian() const;
+  /// For each link (nlinks x 6), the spatial force its parent exerts on it through its joint,
+  /// from the forward dynamics of the current state: force (N) then torque (N m) about the
+  /// joint's origin, both in the joint's frame on the child (the link frame times the joint's
+  /// pose in the child), as PhysX's incoming joint force. The root's row is zero.
+  Eigen::MatrixXd GetLinkIncomingJointForces() const;
 
   /// Two links of this articulation never collide with each other from now on (links joined by
   /// a joint never do in any case); the state of the scene is kept.
@@ -348,6 +358,16 @@ struct Contact {
   ContactBody body0;
   ContactBody body1;
   std::vector<ContactPoint> points;
+};
+
+/// Where a ray first meets a shape (Scene::Raycast).
+struct RayHit {
+  double distance = 0.0;     ///< along the ray (m)
+  Eigen::Vector3d position;  ///< world (m)
+  Eigen::Vector3d normal;    ///< world, the surface's outward normal
+  /// The actor or link hit, and which of its collision shapes; kind kActor with actor_id -1
+  /// for a geom of an MJCF model that belongs to neither.
+  ContactBody body;
 };
 
 /// Warnings recorded during stepping (numerical trouble); the scene stays usable.
@@ -403,6 +423,10 @@ class Scene {
   void Step(int n = 1);
   /// Contacts of the last step.
   std::vector<Contact> GetContacts() const;
+  /// The first collision shape a ray from `origin` along `direction` (normalized here) meets
+  /// within `distance` (m), at the current state; none when it meets nothing.
+  std::optional<RayHit> Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                                double distance) const;
   /// Warnings recorded so far (NaN state reset, etc.).
   const std::vector<Warning>& GetWarnings() const;
   void ClearWarnings();
