@@ -541,9 +541,6 @@ REFUSED_CALLS = {
     "set_cubemap": lambda: sapien.Scene().render_system.set_cubemap(None),
     "set_visibility": lambda: sapien.render.RenderBodyComponent().set_visibility(0.5),
     "disable_render_id": lambda: sapien.render.RenderBodyComponent().disable_render_id(),
-    "raycast": lambda: sapien.Scene().physx_system.raycast([0, 0, 1], [0, 0, -1], 10),
-    "get_link_incoming_joint_forces": lambda: build_two_links(
-        sapien.Scene(), "revolute", [[-1, 1]]).get_link_incoming_joint_forces(),
 }
 
 

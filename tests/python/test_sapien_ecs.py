@@ -237,11 +237,27 @@ def test_convex_mesh_shapes_from_points_and_from_a_file():
     e.add_component(body)
     e.set_pose(sapien.Pose([0, 0, 0.3]))
     scene.add_entity(e)
-    # MuJoCo computes a mesh body's mass from its hull: 0.2 x 0.2 x 0.1 m of water
+    # MuJoCo computes a mesh body's mass properties from its hull: 0.2 x 0.2 x 0.1 m of water
     assert body.mass == pytest.approx(4.0, rel=1e-5)
-    with pytest.raises(partsim.PartsimError, match="computed by MuJoCo"):
-        body.inertia
+    np.testing.assert_allclose(sorted(body.inertia), [4 / 12 * 0.05, 4 / 12 * 0.05,
+                                                      4 / 12 * 0.08], rtol=1e-5)
     scene.step(500)
     assert e.pose.p[2] == pytest.approx(0.05, abs=2e-3)
     with pytest.raises(partsim.PartsimError, match="n >= 4"):
         physx.PhysxCollisionShapeConvexMesh(corners[:3], [1, 1, 1], None)
+
+
+def test_raycasts_name_the_component_they_meet():
+    scene = sapien.Scene()
+    scene.add_ground(0)
+    e, body = box_entity("box", [0.1, 0.2, 0.3], sapien.Pose([1, 0, 0.3]))
+    scene.add_entity(e)
+    hit = scene.physx_system.raycast([0, 0, 0.2], [1, 0, 0], 10)
+    assert hit.component is body and hit.distance == pytest.approx(0.9)
+    np.testing.assert_allclose(hit.normal, [-1, 0, 0], atol=1e-9)
+    assert hit.shape.get_index() == 0
+    assert scene.physx_system.raycast([0, 0, 1], [0, 0, -1], 10).component.entity.name == \
+        "ground"
+    assert scene.physx_system.raycast([0, 0, 0.2], [-1, 0, 0], 10) is None
+    with pytest.raises(partsim.PartsimError, match="direction"):
+        scene.physx_system.raycast([0, 0, 0.2], [0, 0, 0], 10)

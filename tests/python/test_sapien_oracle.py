@@ -338,3 +338,68 @@ def test_a_world_point_lands_on_the_pixel_sapiens_matrices_give():
     # the dot's pixels centre on the point: within a quarter pixel of SAPIEN's projection
     assert cols.mean() + 0.5 == pytest.approx(u, abs=0.25)
     assert rows.mean() + 0.5 == pytest.approx(v, abs=0.25)
+
+
+# ------------------------------------------------------------------------------ queries
+
+def rays(sp):
+    """Rays against a box on the ground and a link of an articulation: (distance, position,
+    normal, the name of the entity hit) for each, None for a miss."""
+    scene = new_scene(sp)
+    add_ground(sp, scene)
+    b = scene.create_actor_builder()
+    b.add_box_collision(half_size=[0.1, 0.2, 0.3])
+    box = b.build_static(name="box")
+    box.set_pose(sp.Pose([1, 0, 0.3], [math.cos(0.2), 0, 0, math.sin(0.2)]))
+    robot, _ = one_joint(sp, scene, "revolute", [[-1, 1]])
+    robot.set_root_pose(sp.Pose([-1, 0, 0]))
+    scene.step()
+    out = []
+    for origin, direction in (([0, 0, 0.2], [1, 0, 0]), ([0, 0, 0.2], [1, 0.1, 0]),
+                              ([0, 0, 1], [0, 0, -1]), ([0, 0, 0.2], [0, 1, 0]),
+                              ([-1.0, 0.01, 2], [0, 0, -1])):
+        hit = scene.physx_system.raycast(origin, direction, 10)
+        out.append(None if hit is None else (hit.distance, np.array(hit.position),
+                                             np.array(hit.normal), hit.component.entity.name))
+    return out
+
+
+def test_rays_meet_the_same_shapes_at_the_same_points():
+    real, ours = both(rays)
+    for k, (r, o) in enumerate(zip(real, ours)):
+        assert (r is None) == (o is None)
+        if r is None:
+            continue
+        assert o[3] == r[3]
+        np.testing.assert_allclose(o[1], r[1], atol=1e-5)  # PhysX: float32
+        np.testing.assert_allclose(o[2], r[2], atol=1e-4)
+        if k == 1:
+            # a direction of length 1.005: partsim normalizes it and reports metres; SAPIEN
+            # hands it to PhysX as it is and reports the ray's parameter (metres / 1.005)
+            assert o[0] == pytest.approx(np.linalg.norm(o[1] - [0, 0, 0.2]), abs=1e-9)
+            assert r[0] == pytest.approx(o[0] / np.linalg.norm([1, 0.1, 0]), abs=1e-5)
+        else:
+            assert o[0] == pytest.approx(r[0], abs=1e-5)
+
+
+def incoming_forces(sp):
+    """A 1 kg box 0.3 m out on a hinge, held level by a stiff drive under a turned root, at rest:
+    the links' incoming joint forces."""
+    scene = new_scene(sp)
+    robot, joint = one_joint(sp, scene, "revolute", [[-3, 3]])
+    robot.set_root_pose(sp.Pose([0.5, 0.2, 0], [math.cos(0.3), 0, 0, math.sin(0.3)]))
+    joint.set_drive_property(1e4, 100)
+    joint.set_drive_target(0.0)
+    for _ in range(2000):
+        scene.step()
+    return np.asarray(robot.get_link_incoming_joint_forces(), dtype=float)
+
+
+def test_incoming_joint_forces_hold_the_same_weight_and_moment():
+    real, ours = both(incoming_forces)
+    assert real.shape == ours.shape == (2, 6)
+    np.testing.assert_allclose(ours[0], 0.0)
+    # force then torque about the hinge, in its frame: the weight (9.81 N up) and the moment
+    # 9.81 N x 0.3 m the drive holds; PhysX in float32 and a drive offset of 3e-4 rad
+    np.testing.assert_allclose(ours[1], real[1], atol=5e-3)
+    assert ours[1, 2] == pytest.approx(G, rel=1e-3)

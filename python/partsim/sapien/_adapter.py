@@ -282,3 +282,17 @@ def set_log_level(level: str) -> None:
         raise PartsimError(f"set_log_level: unknown level '{level}' (expected one of "
                            f"{', '.join(sorted(_LOG_LEVELS))})")
     _p.set_log_level(_LOG_LEVELS[key])
+
+
+def accessors(cls, **fields):
+    """Adds SAPIEN's get_NAME() and set_NAME(value) for plain attributes of cls: `fields` maps
+    each name to the conversion its setter applies (float, int, list, ...; None: as given).
+    Methods the class defines itself are kept."""
+    for name, convert in fields.items():
+        if "get_" + name not in cls.__dict__:
+            setattr(cls, "get_" + name, lambda self, _n=name: getattr(self, _n))
+        if "set_" + name not in cls.__dict__:
+            setattr(cls, "set_" + name,
+                    lambda self, value, _n=name, _c=convert: setattr(
+                        self, _n, value if _c is None else _c(value)))
+    return cls

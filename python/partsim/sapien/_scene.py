@@ -330,6 +330,20 @@ class Scene(Handle):
         return wrap(self._p.add_ground(altitude, *args, **kwargs), self)
 
     # ----------------------------------------------------------------------- contacts
+    def _body_component(self, body):
+        """The rigid body (or link) component a partsim ContactBody names; None when it names
+        neither (a geom of an MJCF model)."""
+        if body.kind == _p.ContactBody.Kind.ACTOR:
+            if body.actor_id < 0:
+                return None
+            actor = next((a for a in self._p.get_actors() if a.get_id() == body.actor_id), None)
+            return None if actor is None else self._actor_entity(actor).find_component_by_type(
+                physx.PhysxRigidBaseComponent)
+        for a in self._p.get_articulations():
+            if a.get_id() == body.articulation_id:
+                return wrap(a.get_links()[body.link_index], self)
+        return None
+
     def get_contacts(self):
         """Contacts of the last step (PhysxContact: bodies, actor0/actor1, points)."""
         contacts = self._p.get_contacts()
@@ -529,13 +543,6 @@ class _BodyBuilder(Handle):
 
     __slots__ = ()
 
-    for _n in _VISUAL_PARAMS:
-        locals()[_n] = _visual_adder(_n)
-    for _n in ("add_box_collision", "add_sphere_collision", "add_capsule_collision",
-               "add_cylinder_collision", "add_convex_collision_from_file"):
-        locals()[_n] = _collision_adder(_n)
-    del _n
-
     def add_collision_from_file(self, filename, pose=None, scale=(1, 1, 1), material=None,
                                 density=1000.0, **kwargs):
         """SAPIEN's name for add_convex_collision_from_file."""
@@ -579,6 +586,14 @@ class _BodyBuilder(Handle):
     def set_name(self, name):
         self._p.set_name(str(name))
         return self
+
+
+for _n in _VISUAL_PARAMS:
+    setattr(_BodyBuilder, _n, _visual_adder(_n))
+for _n in ("add_box_collision", "add_sphere_collision", "add_capsule_collision",
+           "add_cylinder_collision", "add_convex_collision_from_file"):
+    setattr(_BodyBuilder, _n, _collision_adder(_n))
+del _n
 
 
 @adapts(_p.ActorBuilder)

@@ -12,7 +12,8 @@ import math
 import numpy as np
 
 from .. import _partsim as _p
-from ._adapter import Handle, PartsimError, Pose, adapts, as_pose, unsupported, wrap
+from ._adapter import (Handle, PartsimError, Pose, accessors, adapts, as_pose, unsupported,
+                       wrap)
 from ._entity import Component
 
 # ------------------------------------------------------------------------------ materials
@@ -20,30 +21,14 @@ from ._entity import Component
 
 class PhysxMaterial(_p.PhysicalMaterial):
     """PhysxMaterial(static_friction=0.3, dynamic_friction=0.3, restitution=0.1): a
-    partsim.PhysicalMaterial. MuJoCo has one friction coefficient per contact: partsim uses
-    the static one; restitution is not modelled (contacts are soft)."""
+    partsim.PhysicalMaterial (docs/physics.md says how partsim maps the three to MuJoCo's
+    contacts)."""
 
     def __init__(self, static_friction=0.3, dynamic_friction=0.3, restitution=0.1):
         super().__init__(float(static_friction), float(dynamic_friction), float(restitution))
 
-    def get_static_friction(self):
-        return self.static_friction
 
-    def set_static_friction(self, friction):
-        self.static_friction = float(friction)
-
-    def get_dynamic_friction(self):
-        return self.dynamic_friction
-
-    def set_dynamic_friction(self, friction):
-        self.dynamic_friction = float(friction)
-
-    def get_restitution(self):
-        return self.restitution
-
-    def set_restitution(self, restitution):
-        self.restitution = float(restitution)
-
+accessors(PhysxMaterial, static_friction=float, dynamic_friction=float, restitution=float)
 
 # ------------------------------------------------------------------------------ configuration
 
@@ -226,42 +211,6 @@ class PhysxCollisionShape:
     def set_local_pose(self, pose):
         self.local_pose = Pose._of(as_pose(pose))
 
-    def get_physical_material(self):
-        return self.physical_material
-
-    def set_physical_material(self, material):
-        self.physical_material = material
-
-    def get_density(self):
-        return self.density
-
-    def set_density(self, density):
-        self.density = float(density)
-
-    def get_patch_radius(self):
-        return self.patch_radius
-
-    def set_patch_radius(self, radius):
-        self.patch_radius = float(radius)
-
-    def get_min_patch_radius(self):
-        return self.min_patch_radius
-
-    def set_min_patch_radius(self, radius):
-        self.min_patch_radius = float(radius)
-
-    def get_contact_offset(self):
-        return self.contact_offset
-
-    def set_contact_offset(self, offset):
-        self.contact_offset = float(offset)
-
-    def get_rest_offset(self):
-        return self.rest_offset
-
-    def set_rest_offset(self, offset):
-        self.rest_offset = float(offset)
-
     def get_collision_groups(self):
         if self._shape is not None:
             return list(self._shape.get_collision_groups())
@@ -281,6 +230,10 @@ class PhysxCollisionShape:
 
     def _add_to(self, builder):  # pragma: no cover - each shape defines it
         raise NotImplementedError
+
+
+accessors(PhysxCollisionShape, physical_material=None, density=float, patch_radius=float,
+          min_patch_radius=float, contact_offset=float, rest_offset=float)
 
 
 class PhysxCollisionShapeBox(PhysxCollisionShape):
@@ -467,17 +420,9 @@ class PhysxRigidBodyComponent(PhysxRigidBaseComponent):
             return (self._mass if self._mass is not None else auto[0],
                     self._cmass if self._cmass is not None else auto[1],
                     self._inertia if self._inertia is not None else auto[2])
-        desc = self._p.get_desc()
-        if desc.inertial is not None:
-            i = desc.inertial
-            return i.mass, Pose._of(i.cmass_local_pose), np.asarray(i.inertia)
-        auto = mass_properties(shape_specs(desc.collisions))
-        if auto is None:
-            raise PartsimError(f"'{self._p.get_name()}': the inertia of a body with mesh shapes "
-                               "is computed by MuJoCo and not reported for actors; set it "
-                               "(set_mass_and_inertia, or set_mass/set_inertia before adding the "
-                               "entity) to read it back")
-        return auto
+        body = self._p
+        return (body.get_mass(), Pose._of(body.get_pose().inv() * body.get_cmass_pose()),
+                np.asarray(body.get_inertia()))
 
     def get_mass(self):
         if self._p is not None:
@@ -786,9 +731,8 @@ class PhysxArticulation(Handle):
 
     def get_link_incoming_joint_forces(self):
         """(links, 6): for each link, the spatial force its parent exerts on it through its
-        joint, torque then force, in the world frame at the link's origin."""
-        if not hasattr(self._p, "get_link_incoming_joint_forces"):
-            raise PartsimError("get_link_incoming_joint_forces: not provided by partsim yet")
+        joint: force then torque about the joint's origin, in the joint's frame on the child,
+        as SAPIEN's (PhysX's incoming joint force); the root's row is zero."""
         return self._p.get_link_incoming_joint_forces()
 
     link_incoming_joint_forces = property(get_link_incoming_joint_forces)
@@ -1101,6 +1045,31 @@ class PhysxContact:
 # ------------------------------------------------------------------------------ the system
 
 
+class PhysxRayHit:
+    """Where a ray met a shape: position, normal (the surface's, outward), distance (m), the
+    rigid body (or link) component hit and the index of its collision shape."""
+
+    __slots__ = ("position", "normal", "distance", "component", "shape_index")
+
+    def __init__(self, hit, scene):
+        self.position = hit.position
+        self.normal = hit.normal
+        self.distance = hit.distance
+        self.component = scene._body_component(hit.body)
+        self.shape_index = hit.body.shape_index
+
+    @property
+    def shape(self):
+        """The collision shape hit (partsim's handle of it), None for a geom of an MJCF model."""
+        if self.component is None or self.shape_index < 0:
+            return None
+        return self.component.get_collision_shapes()[self.shape_index]
+
+    def __repr__(self):
+        return (f"PhysxRayHit(position={np.round(self.position, 6).tolist()}, "
+                f"distance={self.distance:.6g})")
+
+
 class PhysxSystem:
     """SAPIEN 3's physics system of a scene: partsim's scene is its own physics system; this
     gives SAPIEN's names for its timestep, contacts and state."""
@@ -1157,7 +1126,13 @@ class PhysxSystem:
     articulation_link_components = property(get_articulation_link_components)
 
     def raycast(self, position, direction, distance):
-        raise PartsimError("raycast: not provided by partsim yet")
+        """The first collision shape a ray from `position` along `direction` meets within
+        `distance` (m): a PhysxRayHit, or None when it meets nothing."""
+        scene = self._s()
+        hit = scene._p.raycast(np.asarray(position, dtype=np.float64).reshape(3),
+                               np.asarray(direction, dtype=np.float64).reshape(3),
+                               float(distance))
+        return None if hit is None else PhysxRayHit(hit, scene)
 
     scene_collision_id = property(lambda self: 0)
 
@@ -1245,18 +1220,6 @@ def mass_properties(shapes):
     frame = np.eye(4)
     frame[:3, :3], frame[:3, 3] = vectors, com
     return total, Pose(frame), values
-
-
-def shape_specs(collisions):
-    """(kind, dims, pose, density) of partsim CollisionShape descriptions."""
-    out = []
-    for c in collisions:
-        kind = str(c.type).rsplit(".", 1)[-1].lower()
-        dims = {"box": lambda: tuple(c.half_size), "sphere": lambda: (c.radius,),
-                "capsule": lambda: (c.radius, c.half_length),
-                "cylinder": lambda: (c.radius, c.half_length)}.get(kind, lambda: ())()
-        out.append((kind, dims, c.pose, c.density))
-    return out
 
 
 def _ecs_specs(shapes):

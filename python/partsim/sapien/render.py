@@ -13,8 +13,8 @@ import math
 import numpy as np
 
 from .. import _partsim as _p
-from ._adapter import (PartsimError, Pose, adapts, as_pose, color4, set_log_level,
-                       unsupported, unwrap, wrap)
+from ._adapter import (PartsimError, Pose, accessors, adapts, as_pose, color4,
+                       set_log_level, unsupported, unwrap, wrap)
 from ._entity import Component
 
 WINDOW_MESSAGE = (
@@ -58,18 +58,6 @@ class RenderMaterial(_p.RenderMaterial):
     def get_base_color(self):
         return self.base_color
 
-    def set_metallic(self, v):
-        self.metallic = float(v)
-
-    def get_metallic(self):
-        return self.metallic
-
-    def set_roughness(self, v):
-        self.roughness = float(v)
-
-    def get_roughness(self):
-        return self.roughness
-
     def _kept_value(name):
         def get(self):
             return self._kept[name]
@@ -86,30 +74,6 @@ class RenderMaterial(_p.RenderMaterial):
     transmission_roughness = _kept_value("transmission_roughness")
     del _kept_value
 
-    def get_specular(self):
-        return self.specular
-
-    def set_specular(self, v):
-        self.specular = float(v)
-
-    def get_emission(self):
-        return self.emission
-
-    def set_emission(self, v):
-        self.emission = list(v)
-
-    def get_transmission(self):
-        return self.transmission
-
-    def set_transmission(self, v):
-        self.transmission = float(v)
-
-    def get_ior(self):
-        return self.ior
-
-    def set_ior(self, v):
-        self.ior = float(v)
-
     def set_diffuse_texture_from_file(self, path):
         self.diffuse_texture = str(path)
 
@@ -125,6 +89,10 @@ class RenderMaterial(_p.RenderMaterial):
 
     get_diffuse_texture = get_base_color_texture
     base_color_texture = property(get_base_color_texture, set_base_color_texture)
+
+
+accessors(RenderMaterial, metallic=float, roughness=float, specular=float, emission=list,
+          transmission=float, ior=float, transmission_roughness=float)
 
 
 class RenderTexture2D:
@@ -666,9 +634,6 @@ class RenderLightComponent(Component):
     def set_color(self, color):
         self.color = np.asarray(color, dtype=np.float32).reshape(-1)[:3]
 
-    def get_color(self):
-        return self.color
-
     def enable_shadow(self):
         self.shadow = True
 
@@ -687,20 +652,15 @@ class RenderLightComponent(Component):
 
     global_pose = property(get_global_pose)
 
-    def set_shadow_near(self, near):
-        self.shadow_near = float(near)
-
-    def set_shadow_far(self, far):
-        self.shadow_far = float(far)
-
-    def set_shadow_map_size(self, size):
-        self.shadow_map_size = int(size)
-
     def _axis(self):
         return self.get_global_pose().to_transformation_matrix()[:3, 0]
 
     def _place(self, scene):  # pragma: no cover - each light defines it
         raise NotImplementedError
+
+
+accessors(RenderLightComponent, color=None, shadow=bool, shadow_near=float, shadow_far=float,
+          shadow_map_size=int)
 
 
 class RenderPointLightComponent(RenderLightComponent):
@@ -718,12 +678,6 @@ class RenderDirectionalLightComponent(RenderLightComponent):
         super().__init__()
         self.shadow_half_size = 10.0
 
-    def set_shadow_half_size(self, size):
-        self.shadow_half_size = float(size)
-
-    def get_shadow_half_size(self):
-        return self.shadow_half_size
-
     def _place(self, scene):
         scene._p.add_directional_light(self._axis(), self.color, bool(self.shadow))
 
@@ -737,21 +691,13 @@ class RenderSpotLightComponent(RenderLightComponent):
         self.inner_fov = 0.0
         self.outer_fov = math.pi / 2
 
-    def set_inner_fov(self, fov):
-        self.inner_fov = float(fov)
-
-    def set_outer_fov(self, fov):
-        self.outer_fov = float(fov)
-
-    def get_inner_fov(self):
-        return self.inner_fov
-
-    def get_outer_fov(self):
-        return self.outer_fov
-
     def _place(self, scene):
         scene._p.add_spot_light(self.get_global_pose().p, self._axis(), self.inner_fov / 2,
                                 self.outer_fov / 2, self.color, bool(self.shadow))
+
+
+accessors(RenderDirectionalLightComponent, shadow_half_size=float)
+accessors(RenderSpotLightComponent, inner_fov=float, outer_fov=float)
 
 
 class RenderTexturedLightComponent(RenderSpotLightComponent):
