@@ -1,5 +1,5 @@
-"""SAPIEN's names on partsim (partsim/_sapien.py): each means what it means in SAPIEN, and what
-partsim cannot do is refused with an error that says what to use instead."""
+"""SAPIEN's names in partsim's SAPIEN adapter (partsim.sapien): each means what it means in
+SAPIEN, and what partsim cannot do is refused with an error that says what to use instead."""
 
 import math
 import os

@@ -1,16 +1,18 @@
-"""partsim's SAPIEN layer against the real SAPIEN 3 (the `sapien` wheel from PyPI, PhysX on the
-CPU) as the oracle: the same short scenario, written once in SAPIEN's API, runs in both, and
+"""partsim's SAPIEN adapter against the real SAPIEN 3 (the `sapien` wheel from PyPI, PhysX on
+the CPU) as the oracle: the same short scenario, written once in SAPIEN's API, runs in both, and
 what a script observes is compared within the tolerance each test states.
 
-Only physics and kinematics: SAPIEN 3's renderer needs a Vulkan device it accepts, and it
-refuses Mesa's CPU driver (lavapipe: "Failed to find a supported physical device"), so camera
-intrinsics, pixels and segmentation cannot be compared on a machine without a GPU. For the same
-reason SAPIEN's scenes here hold only the PhysX system, and URDFs are given to SAPIEN without
-their <visual> elements (its loader makes render materials for them).
+Physics, kinematics and camera geometry: SAPIEN 3's renderer needs a Vulkan device it accepts,
+and it refuses Mesa's CPU driver (lavapipe: "Failed to find a supported physical device"), so
+SAPIEN's pictures cannot be made on a machine without a GPU; its camera components compute their
+matrices without a device, and those are compared. For the same reason SAPIEN's scenes here hold
+only the PhysX system, and URDFs are given to SAPIEN without their <visual> elements (its loader
+makes render materials for them).
 
 Differences by design, each stated where a test allows for it: PhysX and MuJoCo are different
 solvers (a resting contact is 4 PhysX points against MuJoCo's 4 to 8, an impulse split
-differently among them, while the total is the weight's); PhysX computes in float32.
+differently among them, while the total is the weight's); PhysX computes in float32; SAPIEN
+does not normalize a ray's direction.
 """
 
 import math
