@@ -296,3 +296,37 @@ def accessors(cls, **fields):
                     lambda self, value, _n=name, _c=convert: setattr(
                         self, _n, value if _c is None else _c(value)))
     return cls
+
+
+# ------------------------------------------------------------------------------ shape geometry
+# what a collision shape and a visual shape of one kind share: the sizes and SAPIEN's getters
+# (the shape classes put these before their base, which takes the material)
+
+
+class BoxGeometry:
+    def __init__(self, half_size, material=None):
+        super().__init__(material)
+        self.half_size = np.asarray(half_size, dtype=np.float64).reshape(3)
+
+    def get_half_size(self):
+        return self.half_size
+
+
+class SphereGeometry:
+    def __init__(self, radius, material=None):
+        super().__init__(material)
+        self.radius = float(radius)
+
+    def get_radius(self):
+        return self.radius
+
+
+class CapsuleGeometry(SphereGeometry):
+    """Along the shape's x axis, as SAPIEN's (cylinders too)."""
+
+    def __init__(self, radius, half_length, material=None):
+        super().__init__(radius, material)
+        self.half_length = float(half_length)
+
+    def get_half_length(self):
+        return self.half_length

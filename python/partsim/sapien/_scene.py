@@ -330,30 +330,16 @@ class Scene(Handle):
         return wrap(self._p.add_ground(altitude, *args, **kwargs), self)
 
     # ----------------------------------------------------------------------- contacts
-    def _body_component(self, body):
-        """The rigid body (or link) component a partsim ContactBody names; None when it names
-        neither (a geom of an MJCF model)."""
-        if body.kind == _p.ContactBody.Kind.ACTOR:
-            if body.actor_id < 0:
-                return None
-            actor = next((a for a in self._p.get_actors() if a.get_id() == body.actor_id), None)
-            return None if actor is None else self._actor_entity(actor).find_component_by_type(
-                physx.PhysxRigidBaseComponent)
-        for a in self._p.get_articulations():
-            if a.get_id() == body.articulation_id:
-                return wrap(a.get_links()[body.link_index], self)
-        return None
-
-    def get_contacts(self):
-        """Contacts of the last step (PhysxContact: bodies, actor0/actor1, points)."""
-        contacts = self._p.get_contacts()
-        if not contacts:
-            return []
+    def _body_resolver(self):
+        """A function from a partsim ContactBody to (its SAPIEN 2 handle, its component): the
+        entity and the rigid component of an actor, the link component (twice) of a link;
+        (None, None) for what names neither (a geom of an MJCF model). It reads the scene's
+        actors and articulations once."""
         actors = {a.get_id(): a for a in self._p.get_actors()}
         arts = {a.get_id(): a for a in self._p.get_articulations()}
         links = {}
 
-        def handles(body):
+        def resolve(body):
             if body.kind == _p.ContactBody.Kind.ACTOR:
                 a = actors.get(body.actor_id)
                 if a is None:
@@ -369,6 +355,14 @@ class Scene(Handle):
             comp = wrap(ls[body.link_index], self)
             return comp, comp
 
+        return resolve
+
+    def get_contacts(self):
+        """Contacts of the last step (PhysxContact: bodies, actor0/actor1, points)."""
+        contacts = self._p.get_contacts()
+        if not contacts:
+            return []
+        handles = self._body_resolver()
         out = []
         for c in contacts:
             (a0, b0), (a1, b1) = handles(c.body0), handles(c.body1)

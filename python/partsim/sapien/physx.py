@@ -12,8 +12,8 @@ import math
 import numpy as np
 
 from .. import _partsim as _p
-from ._adapter import (Handle, PartsimError, Pose, accessors, adapts, as_pose, unsupported,
-                       wrap)
+from ._adapter import (BoxGeometry, CapsuleGeometry, Handle, PartsimError, Pose, SphereGeometry,
+                       accessors, adapts, as_pose, unsupported, wrap)
 from ._entity import Component
 
 # ------------------------------------------------------------------------------ materials
@@ -236,44 +236,20 @@ accessors(PhysxCollisionShape, physical_material=None, density=float, patch_radi
           min_patch_radius=float, contact_offset=float, rest_offset=float)
 
 
-class PhysxCollisionShapeBox(PhysxCollisionShape):
-    def __init__(self, half_size, material=None):
-        super().__init__(material)
-        self.half_size = np.asarray(half_size, dtype=np.float64).reshape(3)
-
-    def get_half_size(self):
-        return self.half_size
-
+class PhysxCollisionShapeBox(BoxGeometry, PhysxCollisionShape):
     def _add_to(self, b):
         b.add_box_collision(self.local_pose, self.half_size, self.physical_material,
                             self.density)
 
 
-class PhysxCollisionShapeSphere(PhysxCollisionShape):
-    def __init__(self, radius, material=None):
-        super().__init__(material)
-        self.radius = float(radius)
-
-    def get_radius(self):
-        return self.radius
-
+class PhysxCollisionShapeSphere(SphereGeometry, PhysxCollisionShape):
     def _add_to(self, b):
         b.add_sphere_collision(self.local_pose, self.radius, self.physical_material,
                                self.density)
 
 
-class PhysxCollisionShapeCapsule(PhysxCollisionShape):
+class PhysxCollisionShapeCapsule(CapsuleGeometry, PhysxCollisionShape):
     """A capsule along the shape's x axis, as SAPIEN's."""
-
-    def __init__(self, radius, half_length, material=None):
-        super().__init__(material)
-        self.radius, self.half_length = float(radius), float(half_length)
-
-    def get_radius(self):
-        return self.radius
-
-    def get_half_length(self):
-        return self.half_length
 
     def _add_to(self, b):
         b.add_capsule_collision(self.local_pose, self.radius, self.half_length,
@@ -1055,7 +1031,7 @@ class PhysxRayHit:
         self.position = hit.position
         self.normal = hit.normal
         self.distance = hit.distance
-        self.component = scene._body_component(hit.body)
+        self.component = scene._body_resolver()(hit.body)[1]
         self.shape_index = hit.body.shape_index
 
     @property
@@ -1108,15 +1084,15 @@ class PhysxSystem:
     def step(self):
         self._s()._p.step()
 
+    def _rigid_components(self, cls):
+        found = (e.find_component_by_type(cls) for e in self._s()._actor_entities())
+        return [c for c in found if c is not None]
+
     def get_rigid_dynamic_components(self):
-        return [e.find_component_by_type(PhysxRigidDynamicComponent)
-                for e in self._s()._actor_entities()
-                if e.find_component_by_type(PhysxRigidDynamicComponent) is not None]
+        return self._rigid_components(PhysxRigidDynamicComponent)
 
     def get_rigid_static_components(self):
-        return [e.find_component_by_type(PhysxRigidStaticComponent)
-                for e in self._s()._actor_entities()
-                if e.find_component_by_type(PhysxRigidStaticComponent) is not None]
+        return self._rigid_components(PhysxRigidStaticComponent)
 
     def get_articulation_link_components(self):
         return [link for a in self._s().get_all_articulations() for link in a.get_links()]

@@ -13,8 +13,9 @@ import math
 import numpy as np
 
 from .. import _partsim as _p
-from ._adapter import (PartsimError, Pose, accessors, adapts, as_pose, color4,
-                       set_log_level, unsupported, unwrap, wrap)
+from ._adapter import (BoxGeometry, CapsuleGeometry, PartsimError, Pose, SphereGeometry,
+                       accessors, adapts, as_pose, color4, set_log_level, unsupported, unwrap,
+                       wrap)
 from ._entity import Component
 
 WINDOW_MESSAGE = (
@@ -159,42 +160,18 @@ class RenderShapePrimitive(RenderShape):
     pass
 
 
-class RenderShapeBox(RenderShapePrimitive):
-    def __init__(self, half_size, material=None):
-        super().__init__(material)
-        self.half_size = np.asarray(half_size, dtype=np.float64).reshape(3)
-
-    def get_half_size(self):
-        return self.half_size
-
+class RenderShapeBox(BoxGeometry, RenderShapePrimitive):
     def _add_visual(self, b):
         b.add_box_visual(self.local_pose, self.half_size, name=self.name)
 
 
-class RenderShapeSphere(RenderShapePrimitive):
-    def __init__(self, radius, material=None):
-        super().__init__(material)
-        self.radius = float(radius)
-
-    def get_radius(self):
-        return self.radius
-
+class RenderShapeSphere(SphereGeometry, RenderShapePrimitive):
     def _add_visual(self, b):
         b.add_sphere_visual(self.local_pose, self.radius, name=self.name)
 
 
-class RenderShapeCapsule(RenderShapePrimitive):
+class RenderShapeCapsule(CapsuleGeometry, RenderShapePrimitive):
     """Along the shape's x axis, as SAPIEN's."""
-
-    def __init__(self, radius, half_length, material=None):
-        super().__init__(material)
-        self.radius, self.half_length = float(radius), float(half_length)
-
-    def get_radius(self):
-        return self.radius
-
-    def get_half_length(self):
-        return self.half_length
 
     def _add_visual(self, b):
         b.add_capsule_visual(self.local_pose, self.radius, self.half_length, name=self.name)
