@@ -1,8 +1,9 @@
 """The SAPIEN-style example scripts (examples/sapien/) run to the end with partsim standing in for
 SAPIEN, and print what they check: the box rests and the contact force equals its weight with
-SAPIEN's sign, a box set down on a box is held by its contacts from the first step, the car drives straight on the ground at dt = 0.01 s, the PID arm reaches its
-target, the camera's point cloud lies on the objects; the entity-component tutorials build a
-scene from components and run components of their own."""
+SAPIEN's sign, a box set down on a box is held by its contacts from the first step, the car
+drives straight on the ground at dt = 0.01 s, the PID arm reaches its target, the camera's point
+cloud lies on the objects; the entity-component tutorials build a scene from components and run
+components of their own."""
 
 import os
 import subprocess
