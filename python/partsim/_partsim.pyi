@@ -2837,8 +2837,8 @@ class Scene:
     def create_urdf_loader(self) -> UrdfLoader:
         """A UrdfLoader whose load() adds to this scene."""
         ...
-    def create_viewer(self, port: int = ..., address: str = ..., token: typing.Optional[str] = ...) -> Viewer:
-        """A Viewer of this scene (SAPIEN's name): starts the browser viewer's server on a free port and prints the URL to open on stderr."""
+    def create_viewer(self, port: int = ..., address: str = ..., token: typing.Optional[str] = ..., realtime: bool = ...) -> Viewer:
+        """A Viewer of this scene (SAPIEN's name): starts the browser viewer's server on a free port and prints the URL to open on stderr. `realtime`: its render() paces the loop to real time (False: as fast as it can)."""
         ...
     def find_actor_by_name(self, name: str) -> Actor:
         """The first actor named `name`; raises PartsimError when there is none."""
@@ -3433,8 +3433,12 @@ class VideoWriter:
 
 class Viewer:
     """The scene in a web browser (docs/viewer.md): a server on one port for the page, the scene's meshes and a rosbridge WebSocket. SAPIEN's loop runs unchanged: while not viewer.closed: scene.step(); scene.update_render(); viewer.render()."""
-    def __init__(self, scene: Scene = ..., port: int = ..., address: str = ..., token: typing.Optional[str] = ..., allowed_origins: typing.List[str] = ..., web_root: str = ..., max_rate: float = ...) -> None:
-        """Starts serving `scene` (None: nothing until set_scene) on `address`:`port` (0: a free port) and prints the URL to open on stderr. `token`: what the page must carry (None: a random one, in the URL); `allowed_origins`: web pages of other origins that may connect (default: pages of this machine); `web_root`: the web bundle folder (default: $PARTSIM_WEB_DIR, the build tree's, the installed one); `max_rate`: most pose updates per second (Hz)."""
+    def __init__(self, scene: Scene = ..., port: int = ..., address: str = ..., token: typing.Optional[str] = ..., allowed_origins: typing.List[str] = ..., web_root: str = ..., max_rate: float = ..., realtime: bool = ...) -> None:
+        """Starts serving `scene` (None: nothing until set_scene) on `address`:`port` (0: a free port) and prints the URL to open on stderr. `token`: what the page must carry (None: a random one, in the URL); `allowed_origins`: web pages of other origins that may connect (default: pages of this machine); `web_root`: the web bundle folder (default: $PARTSIM_WEB_DIR, the build tree's, the installed one); `max_rate`: most pose updates per second (Hz); `realtime`: render() paces the loop to real time (see set_realtime)."""
+        ...
+    @property
+    def clients(self) -> int:
+        """The WebSocket clients (pages) connected now."""
         ...
     def close(self) -> None:
         """Marks the viewer closed (viewer.closed becomes True)."""
@@ -3451,8 +3455,12 @@ class Viewer:
     def port(self) -> int:
         """The port served."""
         ...
+    @property
+    def realtime(self) -> bool:
+        """Whether render() paces the loop to real time (set_realtime)."""
+        ...
     def render(self) -> None:
-        """Applies the page's commands (joint targets, reset, camera pictures) and sends it what moved (at most max_rate times a second). While the page has paused the scene it blocks until resumed, stepped (step n: this and the next n - 1 calls return) or closed; Ctrl-C raises KeyboardInterrupt and closes the viewer."""
+        """Applies the page's commands (joint targets, reset, camera pictures) and sends it what moved (at most max_rate times a second). In real time (the default) it first waits until the scene's time (scene.get_time()) no longer runs ahead of the wall clock's since the loop began. While the page has paused the scene it blocks until resumed, stepped (step n: this and the next n - 1 calls return) or closed; Ctrl-C raises KeyboardInterrupt and closes the viewer."""
         ...
     def set_camera_rpy(self, r: float, p: float, y: float) -> None:
         """How the page's camera starts: roll, pitch, yaw (rad); it looks along (cos p cos y, cos p sin y, sin p), as SAPIEN's viewer.set_camera_rpy."""
@@ -3462,6 +3470,9 @@ class Viewer:
         ...
     def set_fovy(self, fovy: float) -> None:
         """The page's camera's vertical field of view (rad, in (0, pi)), as SAPIEN's viewer.set_fovy; read by the page when it loads (scene.json's initial_camera.fovy, null unless set)."""
+        ...
+    def set_realtime(self, realtime: bool) -> None:
+        """True (the default): render() waits so that the scene's time does not run ahead of the wall clock (a loop slower than real time is not sped up to catch up, nor after a pause); False: the loop runs as fast as it can."""
         ...
     def set_scene(self, scene: Scene) -> None:
         """Views another scene (SAPIEN's viewer.set_scene); the page reloads."""
@@ -3476,6 +3487,9 @@ class Viewer:
     @property
     def url(self) -> str:
         """http://ADDRESS:PORT/?token=T: the page."""
+        ...
+    def wait_for_client(self, timeout: typing.Optional[float] = ...) -> bool:
+        """Waits until a page (a WebSocket client) is connected: True then, False when `timeout` seconds (None: no limit) pass first or the viewer is closed. Ctrl-C raises KeyboardInterrupt and closes the viewer."""
         ...
     @property
     def web_root(self) -> str:

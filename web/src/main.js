@@ -244,13 +244,21 @@ class Viewer {
       this.setCamera(c.position, target, fovy);
       return;
     }
-    // frame the scene's bounds from the front-right, above (objects face +x)
+    // frame the scene's bounds from the objects' front, turned 0.5 rad to the object's right
+    // and 0.45 rad above, as the gallery's thumbnails (FrameObjectCameraPose), with the bounds'
+    // sphere inside both fields of view
     const box = this.model.bounds();
     const centre = box.getCenter(new THREE.Vector3());
     const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 0.1);
     const fovy = c && typeof c.fovy === 'number' ? THREE.MathUtils.radToDeg(c.fovy) : 45;
-    const distance = (radius / Math.sin(THREE.MathUtils.degToRad(fovy) / 2)) * 1.3;
-    const dir = new THREE.Vector3(1.6, 1.0, 0.9).normalize();
+    const halfY = THREE.MathUtils.degToRad(fovy) / 2;
+    const halfX = Math.atan(Math.tan(halfY) * this.camera.aspect);
+    const distance = (radius / Math.sin(Math.min(halfX, halfY))) * 1.1;
+    const front = this.model.front();
+    const azimuth = Math.atan2(front.y, front.x) - 0.5;
+    const elevation = 0.45;
+    const dir = new THREE.Vector3(Math.cos(elevation) * Math.cos(azimuth),
+      Math.cos(elevation) * Math.sin(azimuth), Math.sin(elevation));
     const eye = centre.clone().addScaledVector(dir, distance);
     this.setCamera(eye.toArray(), centre.toArray(), fovy);
   }
@@ -413,6 +421,14 @@ class Viewer {
       this._api = {
         ready: this.ready,
         setCamera: (position, target, fovyDegrees) => this.setCamera(position, target, fovyDegrees),
+        // the page's camera now: eye and orbit target (m, world), vertical field of view (deg)
+        camera: () => ({
+          position: this.camera.position.toArray(),
+          target: this.controls.target.toArray(),
+          fovy_deg: this.camera.fov,
+        }),
+        // the horizontal direction the scene's objects face (the default camera looks from it)
+        front: () => this.model.front().toArray(),
         selectBody: (id) => this.panels.select(id),
         stats: () => this.stats(),
         toggle: (name, on) => this.panels.setToggle(name, on),

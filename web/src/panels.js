@@ -164,14 +164,30 @@ export class Panels {
     }
   }
 
+  /**
+   * The articulation whose sliders show while no part is selected: the scene's only articulation
+   * with movable joints, outside the gallery (whose animation sets the targets every step); else
+   * null.
+   */
+  defaultArticulation() {
+    if (this.viewer.gallery?.enabled) return null;
+    const movable = this.viewer.model.articulations.filter((a) => (a.joints || []).some((j) => j.type !== 'fixed'));
+    return movable.length === 1 ? movable[0] : null;
+  }
+
   select(id) {
     if (this.selected !== null) this.highlight(this.selected, false);
     const body = id === null || id === undefined ? null : this.viewer.model.bodies[id];
     this.selected = body ? id : null;
     if (!body) {
       $('info').hidden = true;
-      $('joints').hidden = true;
-      this.sliderArticulation = null;
+      const art = this.defaultArticulation();
+      if (art && art.id !== this.sliderArticulation) this.buildSliders(art);
+      else if (!art) {
+        $('joints').hidden = true;
+        this.sliderArticulation = null;
+      }
+      this.updateHint();
       return null;
     }
     this.highlight(id, true);
@@ -183,7 +199,14 @@ export class Panels {
       $('joints').hidden = true;
       this.sliderArticulation = null;
     }
+    this.updateHint();
     return { id, name: body.desc.name, label: body.desc.label || '' };
+  }
+
+  /** The side panel says that a click on a part shows it, while nothing else is there. */
+  updateHint() {
+    const empty = $('info').hidden && $('joints').hidden;
+    $('hint').hidden = !empty || this.viewer.model.bodies.length === 0;
   }
 
   updateInfo() {

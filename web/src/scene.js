@@ -180,6 +180,39 @@ export class SceneModel {
     return box;
   }
 
+  /**
+   * The horizontal unit direction the scene's objects face, which the page's first camera looks
+   * from: that of the first articulation, else -x. An articulation faces where its drawers open
+   * (the prismatic joints that move out horizontally along its root's x axis, by their larger
+   * limit) and, without such drawers, -x of its root: PartNet-Mobility objects face -x (the
+   * gallery's thumbnails and its "front" camera look from there).
+   */
+  front() {
+    const fallback = new THREE.Vector3(-1, 0, 0);
+    const art = this.articulations[0];
+    if (!art) return fallback;
+    const root = this.bodies.find((b) => b && b.desc.articulation === art.id && b.desc.link_index === 0);
+    if (!root) return fallback;
+    this.root.updateMatrixWorld(true);
+    const rootX = new THREE.Vector3(1, 0, 0).applyQuaternion(root.group.getWorldQuaternion(new THREE.Quaternion()));
+    // drawers' votes: + where they open along the root's +x, - along -x
+    let vote = 0;
+    for (const body of this.bodies) {
+      const j = body?.joint;
+      if (!j || body.articulation !== art || j.type !== 'prismatic') continue;
+      const lo = typeof j.lower === 'number' ? j.lower : 0;
+      const hi = typeof j.upper === 'number' ? j.upper : 0;
+      const opens = Math.abs(hi) >= Math.abs(lo) ? Math.sign(hi) : Math.sign(lo);
+      const frame = this.jointWorldMatrix(body);
+      const axis = new THREE.Vector3(...(j.axis || [1, 0, 0])).transformDirection(frame).multiplyScalar(opens);
+      const along = axis.dot(rootX);
+      if (Math.abs(along) > 0.7) vote += Math.sign(along);
+    }
+    const front = rootX.clone().multiplyScalar(vote > 0 ? 1 : -1);
+    front.z = 0;
+    return front.lengthSq() > 1e-6 ? front.normalize() : fallback;
+  }
+
   setSegmentation(on) {
     this.segmentation = on;
     for (const m of this.pickable) m.material = on ? m.userData.segMaterial : m.userData.material;
