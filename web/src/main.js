@@ -416,6 +416,29 @@ class Viewer {
     return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height };
   }
 
+  /** Screen box (CSS pixels) of a body's visuals' world bounds, null when any corner is behind the camera. */
+  bodyScreenBox(id) {
+    const body = this.model.bodies[id];
+    if (!body) return null;
+    const box = new THREE.Box3();
+    for (const m of body.visuals) box.expandByObject(m);
+    if (box.isEmpty()) return null;
+    const rect = this.canvas.getBoundingClientRect();
+    const out = { x0: Infinity, y0: Infinity, x1: -Infinity, y1: -Infinity };
+    for (let k = 0; k < 8; ++k) {
+      const p = new THREE.Vector3(k & 1 ? box.max.x : box.min.x, k & 2 ? box.max.y : box.min.y,
+        k & 4 ? box.max.z : box.min.z).project(this.camera);
+      if (p.z > 1) return null;
+      const x = rect.left + ((p.x + 1) / 2) * rect.width;
+      const y = rect.top + ((1 - p.y) / 2) * rect.height;
+      out.x0 = Math.min(out.x0, x);
+      out.y0 = Math.min(out.y0, y);
+      out.x1 = Math.max(out.x1, x);
+      out.y1 = Math.max(out.y1, y);
+    }
+    return out;
+  }
+
   get api() {
     if (!this._api) {
       this._api = {
@@ -434,6 +457,9 @@ class Viewer {
         toggle: (name, on) => this.panels.setToggle(name, on),
         setUiVisible: (on) => $('ui').classList.toggle('hidden', !on),
         projectBody: (id) => this.projectBody(id),
+        bodyScreenBox: (id) => this.bodyScreenBox(id),
+        // the body drawn at a point of the page (CSS pixels), as a click there would pick it
+        pickAt: (x, y) => this.panels.hit(x, y),
         bodies: () => this.model.bodies.filter(Boolean).map((b) => ({
           id: b.desc.id, name: b.desc.name, label: b.desc.label || '', kind: b.desc.kind,
           articulation: b.desc.articulation, joint: b.joint ? b.joint.name : null,

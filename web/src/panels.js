@@ -146,13 +146,18 @@ export class Panels {
     else this.select(null);
   }
 
-  pick(x, y) {
+  /** The id of the body drawn at (x, y), CSS pixels of the page; null for none. */
+  hit(x, y) {
     const rect = this.viewer.canvas.getBoundingClientRect();
     const ndc = new THREE.Vector2(((x - rect.left) / rect.width) * 2 - 1, -((y - rect.top) / rect.height) * 2 + 1);
     const ray = new THREE.Raycaster();
     ray.setFromCamera(ndc, this.viewer.camera);
     const hits = ray.intersectObjects(this.viewer.model.pickable, false);
-    this.select(hits.length ? hits[0].object.userData.bodyId : null);
+    return hits.length ? hits[0].object.userData.bodyId : null;
+  }
+
+  pick(x, y) {
+    this.select(this.hit(x, y));
   }
 
   highlight(id, on) {
