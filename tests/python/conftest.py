@@ -4,6 +4,7 @@ The built package is found through PARTSIM_PYTHON_DIR (default: <repo>/build/pyt
 folder that holds partsim/ with the compiled _partsim extension.
 """
 
+import importlib
 import os
 import sys
 
@@ -15,6 +16,23 @@ PYTHON_DIR = os.environ.get("PARTSIM_PYTHON_DIR", os.path.join(REPO, "build", "p
 sys.path.insert(0, os.path.abspath(PYTHON_DIR))
 
 import partsim  # noqa: E402
+
+
+def require(module, package):
+    """Imports `module` for a test module, `package` being what provides it (a pin of
+    requirements.lock or a Debian package of scripts/setup.sh). Where it does not import, the
+    module is skipped, except in a run of scripts/test.sh, which sets PARTSIM_REQUIRE_PINNED=1:
+    there the package is meant to be installed, and its absence fails, naming it."""
+    if os.environ.get("PARTSIM_REQUIRE_PINNED") == "1":
+        try:
+            return importlib.import_module(module)
+        except ImportError as e:
+            error = e
+        # a collection error: pytest stops the run there, naming the package
+        pytest.fail(f"{package} is pinned but '{module}' does not import ({error}): run "
+                    "scripts/setup.sh (PARTSIM_REQUIRE_PINNED=1 turns this skip into a failure)",
+                    pytrace=False)
+    return pytest.importorskip(module, reason=f"{package} is not installed ('{module}')")
 
 # A fixed cabinet-like object: a base, a door on a revolute hinge and a drawer on a prismatic
 # slide; explicit inertials so the numbers do not depend on the shapes.

@@ -12,9 +12,9 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import PYTHON_DIR
+from conftest import PYTHON_DIR, require
 
-torch = pytest.importorskip("torch")
+torch = require("torch", "python3-torch (scripts/setup.sh)")
 
 import partsim.envs as envs  # noqa: E402
 from partsim.learn import protocol  # noqa: E402

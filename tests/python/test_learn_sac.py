@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import partsim
-from conftest import REPO
+from conftest import REPO, require
 
-torch = pytest.importorskip("torch")
+torch = require("torch", "python3-torch (scripts/setup.sh)")
 
 # the build tree copies python/partsim/*.py beside the extension but not its sub-packages: take
 # partsim.learn from the sources when the build has none

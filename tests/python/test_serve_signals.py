@@ -14,9 +14,9 @@ import urllib.request
 
 import pytest
 
-from conftest import PYTHON_DIR
+from conftest import PYTHON_DIR, require
 
-websocket = pytest.importorskip("websocket")  # Debian's python3-websocket (scripts/setup.sh)
+websocket = require("websocket", "websocket-client (requirements.lock)")
 
 CLI = os.environ.get("PARTSIM_CLI", os.path.join(os.path.dirname(os.path.abspath(PYTHON_DIR)),
                                                  "partsim"))

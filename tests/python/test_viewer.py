@@ -16,8 +16,9 @@ import urllib.request
 import pytest
 
 import partsim
+from conftest import require
 
-websocket = pytest.importorskip("websocket")  # Debian's python3-websocket (scripts/setup.sh)
+websocket = require("websocket", "websocket-client (requirements.lock)")
 
 
 @pytest.fixture
@@ -46,6 +47,31 @@ def connect(viewer):
     ws.send(json.dumps({"op": "auth", "mac": viewer.token}))
     assert json.loads(ws.recv())["msg"] == "authenticated"
     return ws
+
+
+def wait_until(predicate, what, seen, timeout=60):
+    """Polls predicate() until it holds; after `timeout` seconds (a loaded 2-core machine takes
+    far less) fails, naming what was awaited and what seen() shows then."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            pytest.fail(f"waited {timeout} s for {what}; saw {seen()}")
+        time.sleep(0.01)
+
+
+def wait_until_blocked(returned, timeout=60, still=1.0):
+    """Waits until the render loop has stopped returning: len(returned) unchanged for `still`
+    seconds (a running loop returns thousands of times a second). Returns that length."""
+    deadline = time.monotonic() + timeout
+    count, since = len(returned), time.monotonic()
+    while time.monotonic() - since < still:
+        if time.monotonic() > deadline:
+            pytest.fail(f"waited {timeout} s for render() to block; it still returns "
+                        f"({len(returned)} times so far)")
+        time.sleep(0.05)
+        if len(returned) != count:
+            count, since = len(returned), time.monotonic()
+    return count
 
 
 def reply(ws, call_id):
@@ -104,13 +130,14 @@ def test_render_blocks_while_the_page_pauses(scene):
 
     t = threading.Thread(target=loop)
     t.start()
-    time.sleep(0.3)
+    time.sleep(0.3)  # a loop that did not block would have returned by now
     assert not returned  # blocked
     ws.send(json.dumps({"op": "call_service", "service": "/partsim/step", "args": {"n": 2},
                         "id": "s"}))
     reply(ws, "s")
-    time.sleep(0.3)
-    assert len(returned) == 2
+    wait_until(lambda: len(returned) >= 2, "render() to return twice after /partsim/step n=2",
+               lambda: f"{len(returned)} returns")
+    assert wait_until_blocked(returned) == 2  # and no more: blocked again
     ws.send(json.dumps({"op": "call_service", "service": "/partsim/close", "id": "c"}))
     reply(ws, "c")
     t.join(timeout=10)
@@ -132,21 +159,22 @@ def test_step_while_running_pauses_then_steps(scene):
 
     t = threading.Thread(target=loop)
     t.start()
-    time.sleep(0.2)
-    assert returned and not viewer.paused  # running
+    wait_until(lambda: len(returned) >= 10, "the render loop to run (10 returns)",
+               lambda: f"{len(returned)} returns, paused = {viewer.paused}")
+    assert not viewer.paused  # running
     ws.send(json.dumps({"op": "call_service", "service": "/partsim/step", "args": {"n": 3},
                         "id": "s"}))
     assert reply(ws, "s")["result"] is True
     assert viewer.paused
-    time.sleep(0.3)
-    count = len(returned)
-    time.sleep(0.3)
-    assert len(returned) == count  # blocked again after the 3 steps
+    count = wait_until_blocked(returned)  # blocked again after the 3 steps
+    assert t.is_alive(), f"the loop ended ({len(returned)} returns) instead of blocking"
     ws.send(json.dumps({"op": "call_service", "service": "/partsim/step", "args": {"n": 2},
                         "id": "s2"}))
     reply(ws, "s2")
-    time.sleep(0.3)
-    assert len(returned) == count + 2
+    wait_until(lambda: len(returned) >= count + 2,
+               "render() to return twice more after /partsim/step n=2",
+               lambda: f"{len(returned) - count} more returns")
+    assert wait_until_blocked(returned) == count + 2  # exactly 2, then blocked
     ws.send(json.dumps({"op": "call_service", "service": "/partsim/close", "id": "c"}))
     reply(ws, "c")
     t.join(timeout=10)

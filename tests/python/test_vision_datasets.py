@@ -31,7 +31,7 @@ import pytest
 
 import partsim
 import partsim.vision as vision
-from conftest import PYTHON_DIR, REPO
+from conftest import PYTHON_DIR, REPO, require
 
 CLI = os.environ.get("PARTSIM_CLI", os.path.join(os.path.dirname(os.path.abspath(PYTHON_DIR)),
                                                  "partsim"))
@@ -601,7 +601,7 @@ def test_evaluate_motion_of_the_ground_truth_is_perfect(data):
 # --- torch and missing packages ----------------------------------------------------------------
 
 def test_torch_datasets(data):
-    torch = pytest.importorskip("torch")
+    torch = require("torch", "python3-torch (scripts/setup.sh)")
     det = vision.DetectionDataset(data.det, "train")
     tds = det.torch()
     assert isinstance(tds, torch.utils.data.Dataset) and len(tds) == len(det)
