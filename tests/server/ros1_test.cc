@@ -113,7 +113,8 @@ TEST_F(Ros1ServeTest, RostopicListsEchoesMeasuresAndPublishes) {
           &code);
   ASSERT_EQ(code, 0) << out;
   double err = 1;
-  for (int attempt = 0; attempt < 40 && err > 0.01; ++attempt) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (err > 0.01 && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(250));
     std::vector<double> now = ArmPositions();
     if (now.size() != q.size()) continue;
@@ -153,9 +154,11 @@ TEST_F(Ros1ServeTest, RospyAndActionlibClientDrivesTheRobot) {
       r["sim_seconds_per_wall_second"].get<double>(), r["action_state"].dump().c_str(),
       r["action_feedback_messages"].get<int>(), r["action_final_error"].get<double>(),
       r["plan_time"].get<double>(), r["plan_final_error"].get<double>());
-  EXPECT_GT(r["joint_states_hz"].get<double>(), 50.0);
-  EXPECT_LE(r["joint_states_hz"].get<double>(), 520.0);
-  EXPECT_GT(r["clock_hz"].get<double>(), 50.0);
+  // messages per simulated second (one per 2 ms step), not per wall-clock second: a loaded
+  // machine steps more slowly but publishes as much for each step
+  EXPECT_GT(r["joint_states_per_sim_second"].get<double>(), 50.0);
+  EXPECT_LE(r["joint_states_per_sim_second"].get<double>(), 520.0);
+  EXPECT_GT(r["clock_per_sim_second"].get<double>(), 50.0);
   EXPECT_LT(r["action_final_error"].get<double>(), 0.02);
   EXPECT_TRUE(r["plan_success"].get<bool>());
   EXPECT_NEAR(r["stepped_seconds"].get<double>(), 0.05, 1e-6);

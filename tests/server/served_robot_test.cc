@@ -600,8 +600,11 @@ TEST(ServedRobotTest, CloseCancelsAPlanUnderWay) {
   req.options.algorithm = "RRTstar";
   req.options.time_limit = 25.0;
   PlanRecorder result;
+  const long long commands = w.sim->GetCommandsRun();
   w.served->Plan(req, result.Callback(w.sim.get()));
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // planning by now
+  // planning once the worker's snapshot command has run on the simulation thread
+  ASSERT_TRUE(WaitFor([&] { return w.sim->GetCommandsRun() > commands; }))
+      << "the plan's snapshot never ran";
   const auto t0 = std::chrono::steady_clock::now();
   w.served->Close();
   const double closing =
@@ -677,12 +680,15 @@ TEST(ServedRobotTest, CancelPlansStopsAnOwnersPlansAndTheNextOwnerPlansAtOnce) {
   DoneRecorder running_done;
   PlanRequest long_req = LongPlan(w, &gone);
   long_req.execute = true;
+  const long long commands = w.sim->GetCommandsRun();
   w.served->Plan(long_req, running.Callback(w.sim.get()), running_done.Callback());
   w.served->Plan(LongPlan(w, &gone), waiting.Callback(w.sim.get()));
   PlanRequest quick = LongPlan(w, &other, 2.0);
   quick.options.algorithm = "RRTConnect";
   w.served->Plan(quick, next.Callback(w.sim.get()));
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the first is under way
+  // the first is under way once its snapshot command has run on the simulation thread
+  ASSERT_TRUE(WaitFor([&] { return w.sim->GetCommandsRun() > commands; }))
+      << "the first plan's snapshot never ran";
   w.served->CancelPlans(&nobody);  // an owner with no plans: nothing happens
   EXPECT_FALSE(running.Got());
   w.served->CancelPlans(&gone);
@@ -692,7 +698,7 @@ TEST(ServedRobotTest, CancelPlansStopsAnOwnersPlansAndTheNextOwnerPlansAtOnce) {
     EXPECT_FALSE(r->result.success);
     EXPECT_EQ(r->result.message, "cancelled");
   }
-  // WaitFor's 10 s: the two RRT* plans would take 50 s
+  // WaitFor's 30 s: the two RRT* plans would take 50 s
   ASSERT_TRUE(WaitFor([&] { return next.Got(); }));
   {
     std::lock_guard<std::mutex> lock(next.mutex);

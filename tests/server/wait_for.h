@@ -6,10 +6,12 @@
 
 namespace partsim::testing {
 
-/// Calls `pred` every 10 ms until it holds, for up to 10 s; returns its last value.
+/// Calls `pred` every 10 ms until it holds, for up to 30 s (what a loaded 2-core machine needs
+/// is far less); returns its last value.
 template <class F>
 bool WaitFor(F pred) {
-  for (int i = 0; i < 1000; ++i) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < deadline) {
     if (pred()) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }

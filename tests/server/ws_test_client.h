@@ -164,7 +164,7 @@ class MessageLog {
     std::lock_guard<std::mutex> lock(mutex_);
     messages_.clear();
   }
-  /// Waits (up to 10 s) for a message satisfying `pred`; returns it, or null.
+  /// Waits (up to 30 s, WaitFor) for a message satisfying `pred`; returns it, or null.
   template <class F>
   json Wait(F pred) {
     json found;

@@ -128,7 +128,7 @@ class TestClient {
         WaitMessage([](const json& m) { return m.value("msg", "") == "authenticated"; }).is_null());
   }
   std::vector<json> Messages() { return log_.All(); }
-  /// Waits for a message satisfying `pred` (up to 10 s); returns it, or null.
+  /// Waits for a message satisfying `pred` (up to 30 s, WaitFor); returns it, or null.
   template <class F>
   json WaitMessage(F pred) {
     return log_.Wait(pred);
@@ -148,6 +148,27 @@ class TestClient {
 
 json Call(const std::string& service, const json& args, const std::string& id) {
   return {{"op", "call_service"}, {"service", service}, {"args", args}, {"id", id}};
+}
+
+/// Renders on this thread (synchronous mode runs the page's calls there) until `c` has the
+/// answer to call `id`, for up to 30 s; returns it (null if none came).
+json RenderUntilReply(Viewer& v, TestClient& c, const std::string& id) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (std::chrono::steady_clock::now() < deadline) {
+    v.Render();
+    for (const json& m : c.Messages())
+      if (m.value("id", "") == id) return m;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return json();
+}
+
+/// Waits until the simulation thread has run a command posted now: the step under way (if any)
+/// is over, and a paused server takes no step of its own after it.
+void WaitBetweenSteps(SimServer& sim) {
+  auto ran = std::make_shared<std::atomic<bool>>(false);
+  sim.Post([ran] { *ran = true; });
+  ASSERT_TRUE(WaitFor([&] { return ran->load(); })) << "a command did not run within 30 s";
 }
 
 class ViewerTest : public ::testing::Test {
@@ -397,13 +418,7 @@ TEST_F(ViewerTest, SetJointTargetDrivesTheJoint) {
   c.Send(Call("/partsim/set_joint_target",
               {{"articulation", 0}, {"joint", joint.GetName()}, {"position", target}}, "t"));
   // synchronous mode: the answer comes once Render has applied it
-  json reply;
-  for (int i = 0; i < 500 && reply.is_null(); ++i) {
-    v.Render();
-    for (const json& m : c.Messages())
-      if (m.value("id", "") == "t") reply = m;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
+  const json reply = RenderUntilReply(v, c, "t");
   ASSERT_FALSE(reply.is_null());
   EXPECT_TRUE(reply["result"].get<bool>()) << reply;
   EXPECT_TRUE(reply["values"]["success"].get<bool>());
@@ -493,13 +508,7 @@ TEST_F(ViewerTest, ExtensionsAddApiRoutesServicesAndCommandsOnTheScenesThread) {
   ASSERT_TRUE(c.WaitOpen());
   c.Auth(v.GetToken());
   c.Send(Call("/test/echo", {{"a", 1}}, "e"));
-  json reply;
-  for (int i = 0; i < 1000 && reply.is_null(); ++i) {
-    v.Render();  // the posted command runs here, on this thread
-    for (const json& m : c.Messages())
-      if (m.value("id", "") == "e") reply = m;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  const json reply = RenderUntilReply(v, c, "e");  // the posted command runs in Render
   ASSERT_FALSE(reply.is_null());
   EXPECT_TRUE(reply["result"].get<bool>());
   EXPECT_EQ(reply["values"], json({{"a", 1}}));
@@ -527,6 +536,7 @@ TEST_F(ViewerTest, StepWhileRunningPausesThenSteps) {
   ASSERT_FALSE(c.WaitReply("s").is_null());
   EXPECT_TRUE(sim.IsPaused());
   EXPECT_TRUE(WaitFor([&] { return sim.GetPendingSteps() == 0; }));
+  WaitBetweenSteps(sim);  // the last step, taken off the count as it began, is over
   const long long at = sim.GetClockSteps();
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   EXPECT_EQ(sim.GetClockSteps(), at) << "paused after the steps";
@@ -559,12 +569,7 @@ TEST_F(ViewerTest, ThePageSeesTheStateTheSimulationRestsIn) {
   };
   c.Send(Call("/partsim/pause", json::object(), "p"));
   ASSERT_FALSE(c.WaitReply("p").is_null());
-  // the thread may finish the step it is in
-  ASSERT_TRUE(WaitFor([&] {
-    const long long s = sim.GetClockSteps();
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    return sim.GetClockSteps() == s;
-  }));
+  WaitBetweenSteps(sim);  // the thread may finish the step it is in
   const long long paused_at = sim.GetClockSteps();
   EXPECT_FALSE(status_at(paused_at).is_null()) << "the status shows the step it paused at";
   for (int burst = 1; burst <= 5; ++burst) {
@@ -579,11 +584,7 @@ TEST_F(ViewerTest, ThePageSeesTheStateTheSimulationRestsIn) {
   sim.Resume();
   ASSERT_TRUE(WaitFor([&] { return sim.GetClockSteps() > paused_at + 40; }));
   sim.Pause();
-  ASSERT_TRUE(WaitFor([&] {
-    const long long s = sim.GetClockSteps();
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    return sim.GetClockSteps() == s;
-  }));
+  WaitBetweenSteps(sim);
   EXPECT_FALSE(status_at(sim.GetClockSteps()).is_null()) << "paused by the program";
   sim.Stop();
   viewer_.reset();
@@ -601,13 +602,7 @@ TEST_F(ViewerTest, CameraServiceAnswersAPngThatDecodes) {
   for (const char* picture : {"Color", "Depth", "Segmentation"}) {
     const std::string id = "cam" + std::to_string(k++);
     c.Send(Call("/partsim/camera", {{"name", "front"}, {"picture", picture}}, id));
-    json reply;
-    for (int i = 0; i < 1000 && reply.is_null(); ++i) {
-      v.Render();
-      for (const json& m : c.Messages())
-        if (m.value("id", "") == id) reply = m;
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    const json reply = RenderUntilReply(v, c, id);
     ASSERT_FALSE(reply.is_null()) << picture;
     ASSERT_TRUE(reply["result"].get<bool>()) << reply;
     const fs::path png = dir_ / (id + ".png");
@@ -621,13 +616,7 @@ TEST_F(ViewerTest, CameraServiceAnswersAPngThatDecodes) {
     EXPECT_GT(lit, 100) << picture << ": the cabinet is in view";
   }
   c.Send(Call("/partsim/camera", {{"name", "nope"}}, "bad"));
-  json bad;
-  for (int i = 0; i < 200 && bad.is_null(); ++i) {
-    v.Render();
-    for (const json& m : c.Messages())
-      if (m.value("id", "") == "bad") bad = m;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  const json bad = RenderUntilReply(v, c, "bad");
   ASSERT_FALSE(bad.is_null());
   EXPECT_FALSE(bad["result"].get<bool>());
   EXPECT_NE(bad["values"].get<std::string>().find("no camera 'nope' (cameras: front)"),
@@ -687,13 +676,7 @@ TEST_F(ViewerTest, BadMessagesGetErrorsAndTheViewerGoesOn) {
   c.Clear();
   c.Send(Call("/partsim/set_joint_target",
               {{"articulation", 0}, {"joint", "no_such_joint"}, {"position", 0}}, "j"));
-  json reply;
-  for (int i = 0; i < 500 && reply.is_null(); ++i) {
-    v.Render();
-    for (const json& m : c.Messages())
-      if (m.value("id", "") == "j") reply = m;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
+  const json reply = RenderUntilReply(v, c, "j");
   ASSERT_FALSE(reply.is_null());
   EXPECT_FALSE(reply["result"].get<bool>());
   EXPECT_NE(reply["values"].get<std::string>().find("no joint 'no_such_joint'"), std::string::npos);

@@ -137,6 +137,26 @@ export async function waitFor(page, fn, arg, timeoutMs, what) {
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
+/**
+ * Waits until `fn` (run in the page) has returned the same value for `stillMs`: a flow that
+ * stopped (the steps a pause lets finish). Throws naming `what` and the last value after
+ * `timeoutMs`.
+ */
+export async function waitStill(page, fn, stillMs, timeoutMs, what) {
+  const t0 = Date.now();
+  let last = JSON.stringify(await page.evaluate(fn));
+  let since = Date.now();
+  while (Date.now() - since < stillMs) {
+    if (Date.now() - t0 > timeoutMs) throw new Error(`${what}: still changing after ${timeoutMs} ms (${last})`);
+    await sleep(50);
+    const now = JSON.stringify(await page.evaluate(fn));
+    if (now !== last) {
+      last = now;
+      since = Date.now();
+    }
+  }
+}
+
 /** Waits until the page has drawn `n` more frames (a slow machine may take longer than a sleep). */
 export async function framesDrawn(page, n, timeoutMs = 30000) {
   const start = await page.evaluate(() => window.partsimViewer.stats().frames);

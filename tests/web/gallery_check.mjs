@@ -8,7 +8,7 @@
 // Exit code 0 with {"ok": true, ...}; 2 with {"skip": reason} when Chromium cannot start; 1 with
 // {"error": ...} otherwise.
 import path from 'node:path';
-import { openViewer, runCheck, sleep, waitFor } from './browser.mjs';
+import { openViewer, runCheck, sleep, waitFor, waitStill } from './browser.mjs';
 
 const config = JSON.parse(process.argv[2]);
 const shownNames = (items) => items.filter((i) => i.shown).map((i) => i.name);
@@ -122,7 +122,9 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: 1100, heig
         const before = (await ev(() => window.partsimViewer.stats())).status;
         await page.click('#btn-step');
         await waitFor(page, () => window.partsimViewer.stats().status?.paused === true, null, 10000, 'paused after step');
-        await sleep(600);
+        // the n steps come after the pause: wait until the reported step stands, then 1 s more
+        await waitStill(page, () => window.partsimViewer.stats().status?.step, 1000, 30000,
+          'the step after the Step button');
         const s1 = (await ev(() => window.partsimViewer.stats())).status;
         const badge1 = await ev(() => document.getElementById('sim-state').textContent);
         await sleep(1000);
@@ -156,6 +158,9 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: 1100, heig
     // 6. lazy thumbnails: in a small window only the cards near the visible part ask for theirs;
     //    the others do when scrolled into view
     const small = await openViewer(browser, config.url, { waitFor: 'gallery', viewport: { width: 440, height: 200 } });
+    // the first requests, then 1 s in which cards out of view must not ask
+    await waitFor(small.page, () => window.partsimViewer.galleryItems().some((i) => i.thumbnail !== 'waiting'),
+      null, 30000, 'the first thumbnail requests');
     await sleep(1000);
     const requested = () => small.page.evaluate(() => window.partsimViewer.galleryItems()
       .filter((i) => i.thumbnail !== 'waiting').map((i) => i.name));

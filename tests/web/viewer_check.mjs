@@ -6,7 +6,7 @@
 // Exit code 0 with {"ok": true, ...}; 2 with {"skip": reason} when Chromium cannot start; 1 with
 // {"error": ...} otherwise.
 import path from 'node:path';
-import { framesDrawn, openViewer, runCheck, sleep, waitFor } from './browser.mjs';
+import { framesDrawn, openViewer, runCheck, sleep, waitFor, waitStill } from './browser.mjs';
 
 const config = JSON.parse(process.argv[2]);
 runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: config.camera.width, height: config.camera.height } },
@@ -120,9 +120,11 @@ runCheck({ timeoutMs: config.timeout_ms || 180000, viewport: { width: config.cam
       const s = window.partsimViewer.stats();
       return { step: s.status.step, time: s.status.time, pose_step: s.last_pose_step, wall: Date.now() / 1000 };
     });
-    await sleep(300);
+    // the step under way when the pause came may still be reported: wait until the step stands
+    await waitStill(page, () => window.partsimViewer.stats().status?.step, 1000, 30000,
+      'the paused step');
     const p0 = await statusStep();
-    await sleep(2000);
+    await sleep(2000);  // then 2 s in which it must not move
     const p1 = await statusStep();
     result.pause = { before: p0, after: p1 };
     await page.click('#btn-resume');
