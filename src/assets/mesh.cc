@@ -10,7 +10,6 @@
 #include <array>
 #include <assimp/Importer.hpp>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -23,6 +22,7 @@
 #include "assets/obj_reader.h"
 #include "core/ascii.h"
 #include "core/file_read.h"
+#include "core/number_text.h"
 #include "partsim/assets/convex_decomposition.h"
 #include "partsim/core/error.h"
 
@@ -151,13 +151,6 @@ void CollectNode(const aiScene* scene, const aiNode* node, const Eigen::Matrix4d
   }
 }
 
-// "%.3g" of a length or count, for messages.
-std::string Short(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.3g", v);
-  return buf;
-}
-
 // Whether a triangle surface is (nearly) closed and consistently wound, so that its enclosed
 // volume means something: after welding equal positions no directed edge appears twice, and at
 // most 2% of them lack their reverse (exported meshes often have a few cracks).
@@ -223,7 +216,7 @@ std::string Simplified(const MeshData& hull, const std::vector<Eigen::Vector3d>&
   return "has a convex hull of over " + std::to_string(kMaxConvexPieceVertices) + " vertices (" +
          std::to_string(points.size()) + " distinct points): collides as the hull of " +
          std::to_string(hull.vertices.size()) + " of them, which leaves points up to " +
-         Short(outside) + " m outside" + (stride > 1 ? " (of a sample)" : "");
+         internal::Significant(outside, 3) + " m outside" + (stride > 1 ? " (of a sample)" : "");
 }
 
 }  // namespace
@@ -271,7 +264,8 @@ ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh) {
   std::sort(order.begin(), order.end(), [&](int a, int b) { return extent[a] > extent[b]; });
   const double size = extent[order[0]], middle = extent[order[1]], thin = extent[order[2]];
   const std::string counted = std::to_string(points.size()) + " distinct point" +
-                              (points.size() == 1 ? "" : "s") + ", " + Short(size) + " m across";
+                              (points.size() == 1 ? "" : "s") + ", " +
+                              internal::Significant(size, 3) + " m across";
   if (size < kTiny) {
     out.piece = nullptr;
     out.repair = "is under 0.1 mm across (" + counted + "): dropped";
@@ -310,14 +304,14 @@ ConvexPieceCheck CheckConvexPiece(const std::shared_ptr<const MeshData>& mesh) {
                        : line            ? "lies on a line"
                        : !hull           ? "is flat"
                                          : "is nearly flat";
-    what += " (" + counted + ", " + Short(thin) + " m thick)";
+    what += " (" + counted + ", " + internal::Significant(thin, 3) + " m thick)";
     try {
       std::shared_ptr<MeshData> thick = ConvexHull(pushed, kMaxConvexPieceVertices);
       thick->source = mesh->source;
       thick->name = mesh->name;
       out.piece = thick;
       out.thickness = t;
-      out.repair = what + ": given a convex hull " + Short(t) + " m thick";
+      out.repair = what + ": given a convex hull " + internal::Significant(t, 3) + " m thick";
       out.simplified = Simplified(*thick, pushed);
     } catch (const Error&) {
       out.piece = nullptr;

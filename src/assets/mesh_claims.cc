@@ -48,8 +48,6 @@ std::optional<uint64_t> Count(std::string_view s) {
   return v;
 }
 
-std::string Str(double v) { return FormatNumber(v); }
-
 uint32_t Le32(const std::string& b, size_t at) {
   uint32_t v = 0;
   for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(b[at + k]);
@@ -145,9 +143,10 @@ void CheckPly(const std::string& path, uint64_t size) {
     // (the last line of an ASCII file may lack its newline)
     if (needed > static_cast<double>(body) + (ascii ? 1 : 0)) {
       Refuse(path, "the PLY header claims " + std::to_string(e.count) + " '" + e.name +
-                       "' elements (" + (ascii ? "ascii" : "binary") + ", at least " + Str(needed) +
-                       " bytes" + (first ? "" : " with the elements before it") +
-                       "), but the file holds " + std::to_string(body) + " bytes after its header");
+                       "' elements (" + (ascii ? "ascii" : "binary") + ", at least " +
+                       FormatNumber(needed) + " bytes" +
+                       (first ? "" : " with the elements before it") + "), but the file holds " +
+                       std::to_string(body) + " bytes after its header");
     }
     first = false;
   }
@@ -198,8 +197,8 @@ void CheckCollada(const std::string& path, uint64_t size) {
       tag = "<" + text.substr(lt + 1, e - lt - 1) + ">";
     }
     Refuse(path, "COLLADA " + tag + " claims count " + std::to_string(*n) + " (at least " +
-                     Str(2.0 * static_cast<double>(*n)) + " bytes of text), but the file holds " +
-                     std::to_string(size) + " bytes");
+                     FormatNumber(2.0 * static_cast<double>(*n)) +
+                     " bytes of text), but the file holds " + std::to_string(size) + " bytes");
   }
 }
 
@@ -275,8 +274,9 @@ void CheckGltfJson(const std::string& path, const std::string& text, uint64_t si
       if (static_cast<double>(offset) + static_cast<double>(*length) >
           static_cast<double>(*buffers[*buffer]))
         Refuse(path, "glTF bufferViews[" + std::to_string(i) + "] claims bytes " +
-                         std::to_string(offset) + " to " + Str(double(offset) + double(*length)) +
-                         " of buffers[" + std::to_string(*buffer) + "], which holds " +
+                         std::to_string(offset) + " to " +
+                         FormatNumber(double(offset) + double(*length)) + " of buffers[" +
+                         std::to_string(*buffer) + "], which holds " +
                          std::to_string(*buffers[*buffer]) + " bytes");
     }
   }
@@ -301,7 +301,7 @@ void CheckGltfJson(const std::string& path, const std::string& text, uint64_t si
     if (!view) {
       // no data: zeros (or sparse values) the reader allocates in full
       if (element * static_cast<double>(*count) > static_cast<double>(all_data))
-        Refuse(path, claim + " without a buffer view (" + Str(element * double(*count)) +
+        Refuse(path, claim + " without a buffer view (" + FormatNumber(element * double(*count)) +
                          " bytes), more than the file and its buffers hold (" +
                          std::to_string(all_data) + " bytes)");
       continue;
@@ -311,7 +311,7 @@ void CheckGltfJson(const std::string& path, const std::string& text, uint64_t si
     const double needed = static_cast<double>(JsonCount(a, "byteOffset", 0).value()) +
                           (*count > 0 ? (static_cast<double>(*count) - 1) * stride + element : 0);
     if (needed > static_cast<double>(*views[*view]))
-      Refuse(path, claim + " (" + Str(needed) + " bytes), but bufferViews[" +
+      Refuse(path, claim + " (" + FormatNumber(needed) + " bytes), but bufferViews[" +
                        std::to_string(*view) + "] holds " + std::to_string(*views[*view]) +
                        " bytes");
   }

@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/number_text.h"
 #include "partsim/assets/generator.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/physics/scene.h"
@@ -27,12 +28,6 @@ QualityCheck Check(const std::string& name, bool passed, const std::string& deta
   return {name, passed, detail};
 }
 
-std::string Fmt(double v) {
-  std::ostringstream s;
-  s << std::setprecision(4) << v;
-  return s.str();
-}
-
 // Undriven, fixed base: how far does each joint move, and does anything blow up?
 QualityCheck RestCheck(Scene& scene, Articulation& art, const QualityOptions& o) {
   Eigen::VectorXd q0 = art.GetQpos();
@@ -46,9 +41,9 @@ QualityCheck RestCheck(Scene& scene, Articulation& art, const QualityOptions& o)
   Eigen::Index worst;
   double max = dq.maxCoeff(&worst);
   std::string joint = art.GetActiveJoints()[worst].GetName();
-  return Check(
-      "rest", max <= o.rest_tolerance,
-      "largest motion " + Fmt(max) + " at joint '" + joint + "' in " + Fmt(o.rest_seconds) + " s");
+  return Check("rest", max <= o.rest_tolerance,
+               "largest motion " + internal::Significant(max, 4) + " at joint '" + joint + "' in " +
+                   internal::Significant(o.rest_seconds, 4) + " s");
 }
 
 // Mass (kg) of the links that joint `joint` moves, and their centre of mass (world).
@@ -99,9 +94,11 @@ std::string DriveThroughRange(Scene& scene, Articulation& art, size_t k, double 
       scene.Step(kControlSteps);
     }
     double q = art.GetQpos()[k];
-    if (!std::isfinite(q)) return "became non-finite on its way to " + Fmt(end);
+    if (!std::isfinite(q))
+      return "became non-finite on its way to " + internal::Significant(end, 4);
     if (std::abs(q - end) > (1.0 - o.range_fraction) * span)
-      return "stopped at " + Fmt(q) + " on its way to " + Fmt(end);
+      return "stopped at " + internal::Significant(q, 4) + " on its way to " +
+             internal::Significant(end, 4);
   }
   return "";
 }
@@ -154,11 +151,13 @@ QualityCheck RangeCheck(Scene& scene, Articulation& art, const QualityOptions& o
     const std::string unit = prismatic ? " N" : " N m";
     if (needed < 0) {
       jammed.push_back("'" + joints[k].GetName() + "' " + stop + " (gentle drive, " +
-                       Fmt(gentle[k]) + unit + ") and with a drive sized to its mass (" +
-                       Fmt(sized) + unit + ")");
+                       internal::Significant(gentle[k], 4) + unit +
+                       ") and with a drive sized to its mass (" + internal::Significant(sized, 4) +
+                       unit + ")");
     } else {
-      forced.push_back("'" + joints[k].GetName() + "' needed " + Fmt(needed) + unit +
-                       " (a gentle drive of " + Fmt(gentle[k]) + unit + " " + stop + ")");
+      forced.push_back("'" + joints[k].GetName() + "' needed " + internal::Significant(needed, 4) +
+                       unit + " (a gentle drive of " + internal::Significant(gentle[k], 4) + unit +
+                       " " + stop + ")");
     }
   }
   scene.Unpack(state);

@@ -7,7 +7,6 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 
 #include "core/ascii.h"
 #include "core/file_read.h"
@@ -29,13 +28,6 @@ constexpr double kUnitTolerance = 1e-3;  // |norm - 1| allowed for quaternions, 
 
 // What a path names.
 enum class PathKind { kUrdf, kPartNetFolder, kSceneFile, kMjcf };
-
-std::string Number(double x) {
-  std::ostringstream s;
-  s.precision(17);
-  s << x;
-  return s.str();
-}
 
 // Tells what `path` is; throws naming the path when it is none of the three.
 PathKind Classify(const fs::path& path, const std::string& where) {
@@ -85,7 +77,7 @@ class Fields {
   double Finite(const json& v, const std::string& field) const {
     if (!v.is_number()) Fail(field, std::string("must be a number, not ") + v.type_name());
     double x = v.get<double>();
-    if (!std::isfinite(x)) Fail(field, "must be finite, not " + Number(x));
+    if (!std::isfinite(x)) Fail(field, "must be finite, not " + FormatNumber(x));
     return x;
   }
 
@@ -128,7 +120,8 @@ Pose ReadPose(const json& j, const Fields& f) {
     double norm = wxyz.norm();
     if (norm == 0.0) f.Fail("orientation", "quaternion [w, x, y, z] is zero (must have norm 1)");
     if (std::abs(norm - 1.0) > kUnitTolerance)
-      f.Fail("orientation", "quaternion [w, x, y, z] has norm " + Number(norm) + " (must be 1)");
+      f.Fail("orientation",
+             "quaternion [w, x, y, z] has norm " + FormatNumber(norm) + " (must be 1)");
     pose.q = Eigen::Quaterniond(wxyz[0], wxyz[1], wxyz[2], wxyz[3]).normalized();
   } else if (j.contains("rpy")) {
     Eigen::Vector3d rpy = f.Numbers(j, "rpy", 3);
@@ -158,7 +151,7 @@ SceneObjectSpec ReadEntry(const json& j, const Fields& f, const fs::path& base_d
   if (j.contains("fix_root")) spec.fix_root = f.Bool(j, "fix_root");
   if (j.contains("scale")) {
     spec.scale = f.Finite(j.at("scale"), "scale");
-    if (spec.scale <= 0.0) f.Fail("scale", "must be > 0, not " + Number(spec.scale));
+    if (spec.scale <= 0.0) f.Fail("scale", "must be > 0, not " + FormatNumber(spec.scale));
   }
   return spec;
 }

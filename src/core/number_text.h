@@ -1,5 +1,7 @@
-// Text of numbers for the files partsim writes (MJCF, URDF): shortest text that reads back to the
-// same double.
+// Text of numbers, one family for all of partsim: exact text for the files partsim writes (MJCF,
+// URDF, scene files) and rounded text for messages, tables and reports. The shortest text that
+// reads back to the same double, for messages that quote a value, is FormatNumber
+// (partsim/core/check.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -18,6 +20,21 @@ inline std::string Num(double v) {
 /// "x y z" with Num.
 inline std::string Vec(const Eigen::Vector3d& v) {
   return Num(v.x()) + " " + Num(v.y()) + " " + Num(v.z());
+}
+
+/// "%.*g": `digits` significant digits (1 to 17), for messages and tables; "inf", "-inf" and
+/// "nan" as printf writes them.
+inline std::string Significant(double v, int digits) {
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%.*g", digits, v);
+  return buf;
+}
+
+/// "%.*f": `decimals` digits after the point (0 to 17), for values of a known range.
+inline std::string Fixed(double v, int decimals) {
+  char buf[352];  // the longest double in full, 309 digits, and the decimals
+  std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
+  return buf;
 }
 
 }  // namespace partsim::internal

@@ -1,11 +1,9 @@
-// PNG (libpng), PLY and NPY writers, depth images and point clouds.
+// PNG (libpng, to memory or a file), PLY and NPY writers, depth images and point clouds.
 #include "partsim/render/image_io.h"
 
 #include <png.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/atomic_file.h"
 #include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/render/camera.h"
@@ -22,37 +21,15 @@
 namespace partsim {
 namespace {
 
-// A file written under a temporary name beside its path and renamed onto it by Close: a
-// process stopped meanwhile leaves no torn file under the real name. Throws naming the path.
-struct File {
-  File(const std::string& path, const char* what)
-      : path_(path), tmp_(path + ".partsim-tmp-" + std::to_string(::getpid())) {
-    f_ = std::fopen(tmp_.c_str(), "wb");
-    if (!f_)
-      throw Error(std::string(what) + ": cannot write '" + path + "': " + std::strerror(errno));
+// writes a whole file through a temporary renamed onto the path (no torn file under the real
+// name, and writers at once each land whole); throws naming `what` and the path
+void SaveFile(const char* what, const std::string& path, const std::string& bytes) {
+  try {
+    internal::WriteFileAtomically(path, bytes);
+  } catch (const Error& e) {
+    throw Error(std::string(what) + ": " + e.what());
   }
-  ~File() {
-    if (!f_) return;
-    std::fclose(f_);  // not closed by Close: an error on the way, the temporary goes
-    std::remove(tmp_.c_str());
-  }
-  // flushes, closes and renames into place, reporting a failed write (a full disk) by the path
-  void Close(const char* what) {
-    bool bad = std::ferror(f_) != 0;
-    bad = (std::fclose(f_) != 0) || bad;
-    f_ = nullptr;
-    if (!bad) bad = std::rename(tmp_.c_str(), path_.c_str()) != 0;
-    if (bad) {
-      std::remove(tmp_.c_str());
-      throw Error(std::string(what) + ": writing '" + path_ + "' failed");
-    }
-  }
-  FILE* get() { return f_; }
-
- private:
-  std::string path_, tmp_;
-  FILE* f_ = nullptr;
-};
+}
 
 void CheckSize(const char* what, int width, int height) {
   if (width < 1 || height < 1)
@@ -76,22 +53,23 @@ void CheckPicture(const char* what, const Picture& p, unsigned needs) {
                 std::to_string(p.width) + " x " + std::to_string(p.height));
 }
 
-// writes rows of `bit_depth`-bit samples; 16-bit rows hold native uint16 values
-void WritePngRows(const std::string& path, int width, int height, int color_type, int bit_depth,
-                  int bytes_per_pixel, const uint8_t* data, const PngCompression& compression,
-                  const char* what) {
+// a PNG's bytes from rows of `bit_depth`-bit samples; 16-bit rows hold native uint16 values;
+// `where` (" (writing 'path')" or "") ends messages about the arguments
+std::string EncodePngRows(int width, int height, int color_type, int bit_depth, int bytes_per_pixel,
+                          const uint8_t* data, const PngCompression& compression, const char* what,
+                          const std::string& where) {
   if (compression.level < -1 || compression.level > 9)
     throw Error(std::string(what) + ": compression level must be in [-1, 9], got " +
-                std::to_string(compression.level) + " (writing '" + path + "')");
+                std::to_string(compression.level) + where);
   if (compression.filter < -1 || compression.filter > 4)
     throw Error(std::string(what) + ": PNG filter must be in [-1, 4], got " +
-                std::to_string(compression.filter) + " (writing '" + path + "')");
-  File file(path, what);
+                std::to_string(compression.filter) + where);
+  std::string out;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
     png_destroy_write_struct(&png, &info);
-    throw Error(std::string(what) + ": libpng could not start writing '" + path + "'");
+    throw Error(std::string(what) + ": libpng could not start" + where);
   }
   std::vector<png_bytep> rows(static_cast<size_t>(height));
   size_t stride = static_cast<size_t>(width) * bytes_per_pixel;
@@ -100,9 +78,15 @@ void WritePngRows(const std::string& path, int width, int height, int color_type
   // libpng reports errors by longjmp; nothing with a destructor is created after this point
   if (setjmp(png_jmpbuf(png))) {
     png_destroy_write_struct(&png, &info);
-    throw Error(std::string(what) + ": libpng failed writing '" + path + "'");
+    throw Error(std::string(what) + ": libpng failed" + where);
   }
-  png_init_io(png, file.get());
+  // the file's bytes go to `out`
+  png_set_write_fn(
+      png, &out,
+      [](png_structp p, png_bytep bytes, png_size_t n) {
+        static_cast<std::string*>(png_get_io_ptr(p))->append(reinterpret_cast<char*>(bytes), n);
+      },
+      [](png_structp) {});  // nothing to flush (a null one would fflush the string)
   if (compression.level >= 0) png_set_compression_level(png, compression.level);
   // PNG_FILTER_NONE ... PNG_FILTER_PAETH are the bits 0x08 << filter number
   if (compression.filter >= 0)
@@ -115,7 +99,24 @@ void WritePngRows(const std::string& path, int width, int height, int color_type
   png_write_image(png, rows.data());
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  file.Close(what);
+  return out;
+}
+
+// libpng's colour type of 8-bit pixels with `channels` samples
+int PngColorType(int channels, const char* what, const std::string& where) {
+  switch (channels) {
+    case 1:
+      return PNG_COLOR_TYPE_GRAY;
+    case 2:
+      return PNG_COLOR_TYPE_GRAY_ALPHA;
+    case 3:
+      return PNG_COLOR_TYPE_RGB;
+    case 4:
+      return PNG_COLOR_TYPE_RGBA;
+    default:
+      throw Error(std::string(what) + ": channels must be 1, 2, 3 or 4, got " +
+                  std::to_string(channels) + where);
+  }
 }
 
 // little-endian helpers for binary PLY and NPY (the machines partsim runs on are little-endian;
@@ -145,15 +146,13 @@ void WriteNpyImpl(const std::string& path, const T* data, const std::vector<size
   size_t total = 10 + header.size() + 1;
   header.append((64 - total % 64) % 64, ' ');
   header += '\n';
-  File file(path, what);
-  const char magic[] = "\x93NUMPY\x01\x00";
-  std::fwrite(magic, 1, 8, file.get());
-  uint16_t len = static_cast<uint16_t>(header.size());
-  uint8_t len_le[2] = {static_cast<uint8_t>(len & 0xff), static_cast<uint8_t>(len >> 8)};
-  std::fwrite(len_le, 1, 2, file.get());
-  std::fwrite(header.data(), 1, header.size(), file.get());
-  if (count > 0) std::fwrite(data, sizeof(T), count, file.get());
-  file.Close(what);
+  std::string bytes("\x93NUMPY\x01\x00", 8);
+  const uint16_t len = static_cast<uint16_t>(header.size());
+  bytes += static_cast<char>(len & 0xff);
+  bytes += static_cast<char>(len >> 8);
+  bytes += header;
+  if (count > 0) bytes.append(reinterpret_cast<const char*>(data), sizeof(T) * count);
+  SaveFile(what, path, bytes);
 }
 
 }  // namespace
@@ -288,37 +287,32 @@ std::array<uint8_t, 3> SegmentationColor(uint32_t id) {
           static_cast<uint8_t>(std::lround(c[2] * 255))};
 }
 
+std::string EncodePng(int width, int height, int channels, const uint8_t* pixels,
+                      const PngCompression& compression) {
+  const char* what = "encode_png";
+  CheckSize(what, width, height);
+  const int type = PngColorType(channels, what, "");
+  return EncodePngRows(width, height, type, 8, channels, pixels, compression, what, "");
+}
+
 void WritePng(const std::string& path, int width, int height, int channels, const uint8_t* pixels,
               const PngCompression& compression) {
   const char* what = "write_png";
+  const std::string where = " (writing '" + path + "')";
   CheckSize(what, width, height);
-  int type;
-  switch (channels) {
-    case 1:
-      type = PNG_COLOR_TYPE_GRAY;
-      break;
-    case 2:
-      type = PNG_COLOR_TYPE_GRAY_ALPHA;
-      break;
-    case 3:
-      type = PNG_COLOR_TYPE_RGB;
-      break;
-    case 4:
-      type = PNG_COLOR_TYPE_RGBA;
-      break;
-    default:
-      throw Error(std::string(what) + ": channels must be 1, 2, 3 or 4, got " +
-                  std::to_string(channels) + " (writing '" + path + "')");
-  }
-  WritePngRows(path, width, height, type, 8, channels, pixels, compression, what);
+  const int type = PngColorType(channels, what, where);
+  SaveFile(what, path,
+           EncodePngRows(width, height, type, 8, channels, pixels, compression, what, where));
 }
 
 void WritePng16(const std::string& path, int width, int height, const uint16_t* pixels,
                 const PngCompression& compression) {
   const char* what = "write_png16";
   CheckSize(what, width, height);
-  WritePngRows(path, width, height, PNG_COLOR_TYPE_GRAY, 16, 2,
-               reinterpret_cast<const uint8_t*>(pixels), compression, what);
+  SaveFile(what, path,
+           EncodePngRows(width, height, PNG_COLOR_TYPE_GRAY, 16, 2,
+                         reinterpret_cast<const uint8_t*>(pixels), compression, what,
+                         " (writing '" + path + "')"));
 }
 
 void WriteColorPng(const std::string& path, const Picture& picture) {
@@ -406,16 +400,15 @@ void WritePly(const std::string& path, const PointCloud& cloud, bool binary) {
   if (binary && !LittleEndian())
     throw Error(std::string(what) + ": binary PLY needs a little-endian machine");
 
-  File file(path, what);
-  std::string header = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
-                       " 1.0\ncomment partsim point cloud\nelement vertex " + std::to_string(n) +
-                       "\nproperty float x\nproperty float y\nproperty float z\n"
-                       "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-                       "property uchar alpha\nproperty uint visual_id\nproperty uint entity_id\n"
-                       "end_header\n";
-  std::fwrite(header.data(), 1, header.size(), file.get());
+  std::string bytes = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") +
+                      " 1.0\ncomment partsim point cloud\nelement vertex " + std::to_string(n) +
+                      "\nproperty float x\nproperty float y\nproperty float z\n"
+                      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                      "property uchar alpha\nproperty uint visual_id\nproperty uint entity_id\n"
+                      "end_header\n";
   // one record per point: 12 bytes of position, 4 of colour, 8 of ids
-  std::vector<uint8_t> record(24);
+  bytes.reserve(bytes.size() + n * (binary ? 24 : 64));
+  char record[24];
   for (size_t i = 0; i < n; ++i) {
     const float* p = cloud.positions.data() + 3 * i;
     uint8_t c[4] = {255, 255, 255, 255};
@@ -423,16 +416,18 @@ void WritePly(const std::string& path, const PointCloud& cloud, bool binary) {
     uint32_t ids[2] = {cloud.visual_ids.empty() ? 0u : cloud.visual_ids[i],
                        cloud.entity_ids.empty() ? 0u : cloud.entity_ids[i]};
     if (binary) {
-      std::memcpy(record.data(), p, 12);
-      std::memcpy(record.data() + 12, c, 4);
-      std::memcpy(record.data() + 16, ids, 8);
-      std::fwrite(record.data(), 1, record.size(), file.get());
+      std::memcpy(record, p, 12);
+      std::memcpy(record + 12, c, 4);
+      std::memcpy(record + 16, ids, 8);
+      bytes.append(record, sizeof(record));
     } else {
-      std::fprintf(file.get(), "%.9g %.9g %.9g %u %u %u %u %u %u\n", p[0], p[1], p[2], c[0], c[1],
-                   c[2], c[3], ids[0], ids[1]);
+      char line[160];
+      const int n_chars = std::snprintf(line, sizeof(line), "%.9g %.9g %.9g %u %u %u %u %u %u\n",
+                                        p[0], p[1], p[2], c[0], c[1], c[2], c[3], ids[0], ids[1]);
+      bytes.append(line, static_cast<size_t>(n_chars));
     }
   }
-  file.Close(what);
+  SaveFile(what, path, bytes);
 }
 
 void WriteNpy(const std::string& path, const float* data, const std::vector<size_t>& shape) {

@@ -3,8 +3,10 @@
 // caps and the plane; smooth on curved surfaces).
 #include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
+#include "core/number_text.h"
 #include "partsim/core/constants.h"
 #include "partsim/core/error.h"
 #include "partsim/render/backend.h"
@@ -178,5 +180,16 @@ std::shared_ptr<MeshData> MakePrimitiveMesh(const VisualShape& shape) {
   m->name = ShapeTypeName(shape.type);
   return m;
 }
+
+namespace internal {
+
+std::string PrimitiveKey(const VisualShape& shape) {
+  // "%.17g" reads back bit-exact: equal text, equal sizes
+  return std::to_string(static_cast<int>(shape.type)) + " " + Num(shape.half_size.x()) + " " +
+         Num(shape.half_size.y()) + " " + Num(shape.half_size.z()) + " " + Num(shape.radius) + " " +
+         Num(shape.half_length);
+}
+
+}  // namespace internal
 
 }  // namespace partsim

@@ -3,11 +3,11 @@
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <mutex>
-#include <system_error>
+#include <optional>
 #include <vector>
 
+#include "core/atomic_file.h"
 #include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/render/image_io.h"
@@ -38,7 +38,9 @@ uint8_t ToSrgb8(float linear) {
 }  // namespace
 
 struct VideoWriter::Impl {
-  std::string path, partial;
+  std::string path, partial;  // the video, and the name it is written under until Close
+  // renames `partial` onto `path` at Close; removes it when the video is not finished
+  std::optional<internal::StagedPath> staged;
   int width = 0, height = 0;  // of the frames given
   int enc_width = 0, enc_height = 0;
   VideoOptions options;
@@ -110,6 +112,7 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height,
   static std::once_flag quiet;
   std::call_once(quiet, [] { av_log_set_level(AV_LOG_ERROR); });
 
+  s.staged.emplace(s.path, s.partial);
   try {
     int rc = avformat_alloc_output_context2(&s.format, nullptr, "mp4", s.partial.c_str());
     if (rc < 0 || !s.format) s.Fail("no MP4 muxer", rc);
@@ -161,8 +164,7 @@ VideoWriter::VideoWriter(const std::string& path, int width, int height,
     if (rc < 0) s.Fail("cannot write the MP4 header", rc);
   } catch (...) {
     s.Free();
-    std::error_code ec;
-    std::filesystem::remove(s.partial, ec);
+    s.staged.reset();
     throw;
   }
 }
@@ -233,9 +235,11 @@ void VideoWriter::Close() {
     rc = avio_closep(&s.format->pb);
     if (rc < 0) s.Fail("cannot close '" + s.partial + "'", rc);
     s.Free();
-    std::error_code ec;
-    std::filesystem::rename(s.partial, s.path, ec);
-    if (ec) s.Fail("cannot rename '" + s.partial + "' into place: " + ec.message());
+    try {
+      s.staged->Commit();
+    } catch (const Error& e) {
+      s.Fail(e.what());
+    }
   } catch (...) {
     s.Free();
     throw;

@@ -1,6 +1,5 @@
 // ArticulationTask: a generated cabinet, the flying gripper and three cameras.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -8,11 +7,13 @@
 #include <random>
 #include <thread>
 
+#include "core/atomic_file.h"
 #include "partsim/assets/generator.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/core/check.h"
 #include "partsim/core/error.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/tasks/tasks.h"
 #include "tasks/task_internal.h"
 
@@ -53,15 +54,11 @@ std::string EnsureObjectFolder(const GeneratedObject& object, const std::string&
   fs::path dir =
       root / (object.category + "_s" + std::to_string(object.seed) + "_pm2") / object.anno_id;
   if (fs::exists(dir / "mobility_v2.json")) return dir.string();
-  // write beside, then rename: tasks on several threads may ask for the same object
-  static std::atomic<int> counter{0};
-  fs::path tmp = dir;
-  tmp += ".tmp" + std::to_string(std::hash<std::thread::id>()(std::this_thread::get_id())) + "_" +
-         std::to_string(counter++);
-  WriteObject(object, tmp.string());
-  std::error_code ec;
-  fs::rename(tmp, dir, ec);
-  if (ec) fs::remove_all(tmp, ec);  // another writer won the race: its folder is identical
+  // write beside, then rename: tasks on several threads may ask for the same object, and the
+  // first folder to land stays (a later one is identical)
+  StagedPath staged(dir.string());
+  WriteObject(object, staged.Temporary());
+  staged.CommitUnlessPresent();
   if (!fs::exists(dir / "mobility_v2.json"))
     throw Error("task: cannot write the object folder '" + dir.string() + "'");
   return dir.string();
@@ -382,9 +379,9 @@ TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
   }
 
   // render ids of the candidates and their handles
-  for (const RenderEntityInfo& e : scene->GetRenderEntities())
+  for (const RenderEntityInfo& e : GetRenderEntities(*scene))
     if (e.is_link && e.articulation_id == object.GetId()) entity_ids[e.link_index] = e.id;
-  for (const RenderVisualInfo& v : scene->GetRenderVisuals()) {
+  for (const RenderVisualInfo& v : GetRenderVisuals(*scene)) {
     if (v.name.rfind("handle-", 0) != 0) continue;
     for (int li : candidates)
       if (entity_ids.count(li) && entity_ids[li] == v.entity_id) handle_visuals[li].push_back(v.id);
@@ -399,13 +396,13 @@ TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
       // at less than half the cost of the default 2048 on a CPU rasterizer
       RasterOptions ro;
       ro.shadow_map_size = 1024;
-      scene->SetRenderBackend(MakeRasterBackend(ro));
+      SetRenderBackend(*scene, MakeRasterBackend(ro));
     } else {
-      scene->SetRenderBackend(o.render_backend);
+      SetRenderBackend(*scene, o.render_backend);
     }
-    scene->SetAmbientLight(Eigen::Vector3f(0.35f, 0.35f, 0.35f));
-    scene->AddDirectionalLight(Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f),
-                               video);
+    SetAmbientLight(*scene, Eigen::Vector3f(0.35f, 0.35f, 0.35f));
+    AddDirectionalLight(*scene, Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f),
+                        video);
   }
   if (video) {
     // a floor for the eye only: a static actor with a visual and no collision shape
@@ -414,12 +411,13 @@ TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
         .AddBoxVisual(Pose(Eigen::Vector3d(0, 0, -0.01)), Eigen::Vector3d(10, 10, 0.01),
                       Eigen::Vector4f(0.55f, 0.52f, 0.48f, 1.0f), "floor")
         .BuildStatic();
-    scene->AddDirectionalLight(Eigen::Vector3d(0.6, 0.8, -0.5), Eigen::Vector3f(0.3f, 0.3f, 0.35f));
+    AddDirectionalLight(*scene, Eigen::Vector3d(0.6, 0.8, -0.5),
+                        Eigen::Vector3f(0.3f, 0.3f, 0.35f));
     // three-quarter view from the front right, a little above: the drawer's travel (+x) and
     // the door's swing are across the image
     const Eigen::Vector3d look = centre + Eigen::Vector3d(0.15, 0, -0.1 * cabinet_height);
     Camera cam =
-        scene->AddCamera("video", o.video_width, o.video_height, 45.0 * M_PI / 180.0, 0.05, 20.0);
+        AddCamera(*scene, "video", o.video_width, o.video_height, 45.0 * M_PI / 180.0, 0.05, 20.0);
     cam.SetLocalPose(
         CameraLookAt(look + 0.9 * d * Eigen::Vector3d(1.0, -0.75, 0.6).normalized(), look));
     video_camera = cam;
@@ -432,7 +430,7 @@ TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
     for (const View& v : {View{"left", Eigen::Vector3d(1.0, 0.8, 0.45)},
                           View{"right", Eigen::Vector3d(1.0, -0.8, 0.45)},
                           View{"front", Eigen::Vector3d(1.0, 0.0, 0.3)}}) {
-      Camera cam = scene->AddCamera(v.name, o.camera_width, o.camera_height, fovy, 0.05, 10.0);
+      Camera cam = AddCamera(*scene, v.name, o.camera_width, o.camera_height, fovy, 0.05, 10.0);
       cam.SetLocalPose(CameraLookAt(centre + d * v.dir.normalized(), centre));
       cameras.push_back(cam);
     }
@@ -662,7 +660,7 @@ void TaskImpl::StepControl() {
 
 void TaskImpl::TakePictures() {
   if (cameras.empty()) throw Error("task: TakePictures: this task was made without cameras");
-  scene->UpdateRender();
+  UpdateRender(*scene);
   for (Camera& c : cameras) c.TakePicture();
 }
 

@@ -14,6 +14,7 @@
 
 #include "arg_parser.h"
 #include "commands.h"
+#include "core/number_text.h"
 #include "object_loader.h"
 
 namespace partsim::tools {
@@ -24,13 +25,6 @@ struct InfoArgs {
   ObjectArgs object;
   bool json = false;
 };
-
-std::string LimitText(double v) {
-  if (std::isinf(v)) return v < 0 ? "-inf" : "inf";
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.6g", v);
-  return buf;
-}
 
 nlohmann::ordered_json LimitJson(double v) {
   return std::isfinite(v) ? nlohmann::ordered_json(v) : nullptr;
@@ -166,8 +160,8 @@ int Info(const InfoArgs& args) {
     std::string limits = "-";
     if (joint.GetDof() > 0 || joint.GetType() != JointType::kFixed) {
       Eigen::Vector2d lim = joint.GetLimits();
-      limits =
-          "[" + LimitText(lim[0]) + ", " + LimitText(lim[1]) + "] " + JointUnit(joint.GetType());
+      limits = "[" + internal::Significant(lim[0], 6) + ", " + internal::Significant(lim[1], 6) +
+               "] " + JointUnit(joint.GetType());
     }
     std::printf("  %-24s %-11s %-40s %s\n", joint.GetName().c_str(), JointTypeName(joint.GetType()),
                 link_pair.c_str(), limits.c_str());

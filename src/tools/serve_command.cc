@@ -16,11 +16,13 @@
 
 #include "arg_parser.h"
 #include "commands.h"
+#include "net_options.h"
 #include "partsim/assets/default_objects.h"
 #include "partsim/assets/scene_file.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/robot/robots.h"
 #include "partsim/server/ros1_bridge.h"
 #include "partsim/server/rosbridge.h"
@@ -97,12 +99,12 @@ void AddServedObjects(Scene* scene, const std::string& scene_file, const Pose& w
 }
 
 int RunServeCommand(int argc, char** argv) {
-  std::string scene_file, robot_kind = "panda", address = "127.0.0.1";
+  std::string scene_file, robot_kind = "panda";
+  NetOptions net;
+  net.port = 9090;
   const char* env_token = std::getenv("PARTSIM_SERVE_TOKEN");
-  std::string token = env_token ? env_token : "";
-  std::vector<std::string> origins;
+  if (env_token) net.token = env_token;
   size_t max_clients = 100;
-  int port = 9090;
   double rate = 500, factor = 1, duration = 0;
   bool fast = false, ros1 = false, ros1_sim_time = true, viewer = false;
   int viewer_port = 8000;
@@ -119,27 +121,20 @@ int RunServeCommand(int argc, char** argv) {
       if (!scene_file.empty()) v.Fail("unexpected extra argument '" + v.Text() + "'");
       scene_file = v.Text();
     });
-    p.Option("--port", [&](const FlagValue& v) {
-      port = static_cast<int>(v.Integer(0, 65535, "(0 picks a free port)"));
-    });
+    AddNetOptions(&p, &net);
     p.Option("--rate", [&](const FlagValue& v) { rate = v.Number(0, false, 1e9); });
     p.Option("--realtime-factor", [&](const FlagValue& v) { factor = v.Number(0, false, 1e9); });
     p.Switch("--fast", [&] { fast = true; });
     p.Option("--robot", [&](const FlagValue& v) { robot_kind = v.Choice({"gripper", "panda"}); });
-    p.Option("--address", [&](const FlagValue& v) { address = v.Text(); });
     p.Option("--duration", [&](const FlagValue& v) { duration = v.Number(0, false, 1e9); });
     p.Option("--camera", [&](const FlagValue& v) { std::tie(cam_w, cam_h) = v.Size(1, 8192); });
     p.Option("--camera-rate", [&](const FlagValue& v) { camera_rate = v.Number(0, true, 1e9); });
-    p.Option("--token", [&](const FlagValue& v) { token = v.NonEmpty("a non-empty token"); });
-    p.Option("--allow-origin", [&](const FlagValue& v) { origins.push_back(v.Text()); });
     p.Option("--max-clients",
              [&](const FlagValue& v) { max_clients = static_cast<size_t>(v.Integer(1, 100000)); });
     p.Switch("--ros1", [&] { ros1 = true; });
     p.Switch("--ros1-wall-time", [&] { ros1_sim_time = false; });
     p.Switch("--viewer", [&] { viewer = true; });
-    p.Option("--viewer-port", [&](const FlagValue& v) {
-      viewer_port = static_cast<int>(v.Integer(0, 65535, "(0 picks a free port)"));
-    });
+    p.Option("--viewer-port", [&](const FlagValue& v) { viewer_port = PortValue(v); });
     p.Switch("--help", [] {});  // answered above; declared to be suggested
     p.Parse(args);
     return 0;
@@ -188,9 +183,9 @@ int RunServeCommand(int argc, char** argv) {
     }
     robot.SetQpos(q);
     // lights and a camera in front of the robot and the object, looking at both
-    scene.SetAmbientLight(Eigen::Vector3f(0.35f, 0.35f, 0.35f));
-    scene.AddDirectionalLight(Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
-    Camera camera = scene.AddCamera("front_camera", cam_w, cam_h, 1.0, 0.05, 20.0);
+    SetAmbientLight(scene, Eigen::Vector3f(0.35f, 0.35f, 0.35f));
+    AddDirectionalLight(scene, Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+    Camera camera = AddCamera(scene, "front_camera", cam_w, cam_h, 1.0, 0.05, 20.0);
     camera.SetLocalPose(
         CameraLookAt(Eigen::Vector3d(1.3, -2.2, 1.4), Eigen::Vector3d(0.5, 0, 0.4)));
 
@@ -206,34 +201,27 @@ int RunServeCommand(int argc, char** argv) {
     sro.tcp_in_ee = model.tcp_in_ee;
     ServedRobot served(&sim, &scene, &loop, robot, robot.GetName(), sro);
     RosbridgeOptions ro;
-    ro.address = address;
-    ro.port = port;
-    ro.auth_token = token;
-    ro.allowed_origins = origins;
+    net.ApplyTo(&ro);
     ro.max_clients = max_clients;
     ro.log_clients = true;
     RosbridgeServer bridge(&served, ro);
     try {
       bridge.Start();
     } catch (const std::exception& e) {
-      throw std::runtime_error(std::string(e.what()) +
-                               "; choose another port with --port P, or --port 0 for a free one");
+      throw CannotListen(e);
     }
     // the browser viewer, attached to the same simulation (before it starts)
     std::unique_ptr<Viewer> page;
     if (viewer) {
       ViewerOptions vo;
-      vo.address = address;
+      net.ApplyTo(&vo);
       vo.port = viewer_port;
-      vo.auth_token = token;
-      vo.allowed_origins = origins;
       page = std::make_unique<Viewer>(&scene, vo);
       page->Attach(&sim);
       try {
         page->Start();
       } catch (const std::exception& e) {
-        throw std::runtime_error(std::string(e.what()) +
-                                 "; choose another port with --viewer-port P (0: a free one)");
+        throw CannotListen(e, "choose another port with --viewer-port P (0: a free one)");
       }
     }
 #ifdef PARTSIM_WITH_ROS1
@@ -249,12 +237,12 @@ int RunServeCommand(int argc, char** argv) {
     std::printf(
         "partsim serve: rosbridge on ws://%s:%d, robot /%s (%d joints), %zu articulations, %g Hz "
         "physics, %s%s\n",
-        address.c_str(), bridge.GetPort(), robot.GetName().c_str(), robot.Dof(),
+        net.address.c_str(), bridge.GetPort(), robot.GetName().c_str(), robot.Dof(),
         scene.GetArticulations().size(), rate,
         fast ? "as fast as possible" : ("real-time factor " + std::to_string(factor)).c_str(),
         ros1 ? ", ROS 1 node /partsim" : "");
     // what to do next: connect a client, find the topics and services
-    const std::string url = "ws://" + address + ":" + std::to_string(bridge.GetPort());
+    const std::string url = "ws://" + net.address + ":" + std::to_string(bridge.GetPort());
     char stop[64] = "stop with Ctrl-C";
     if (duration > 0) std::snprintf(stop, sizeof(stop), "stops after %g s", duration);
     std::printf(
@@ -264,7 +252,8 @@ int RunServeCommand(int argc, char** argv) {
         "/front_camera/image_raw, ...; the service /rosapi/topics lists them all "
         "(partsim serve --help)\n"
         "  clients are logged on stderr as they connect and leave; %s\n",
-        url.c_str(), address.c_str(), bridge.GetPort(), url.c_str(), robot.GetName().c_str(), stop);
+        url.c_str(), net.address.c_str(), bridge.GetPort(), url.c_str(), robot.GetName().c_str(),
+        stop);
     if (page)
       std::printf(
           "  viewer: open %s in a browser%s\n", page->GetUrl().c_str(),

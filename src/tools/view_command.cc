@@ -14,9 +14,11 @@
 
 #include "arg_parser.h"
 #include "commands.h"
+#include "net_options.h"
 #include "partsim/physics/scene.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/server/sim_server.h"
 #include "partsim/viewer/gallery.h"
 #include "partsim/viewer/viewer.h"
@@ -59,8 +61,7 @@ void OnSignal(int) { g_stop = true; }
 
 /// partsim view --dataset: the gallery, the viewer in synchronous mode on this thread.
 int RunGallery(const std::string& root, const std::string& category, double timestep,
-               const std::string& address, int port, const std::string& token,
-               const std::vector<std::string>& origins, double duration) {
+               const NetOptions& net, double duration) {
   std::unique_ptr<Gallery> gallery;
   try {
     GalleryOptions go;
@@ -80,17 +81,13 @@ int RunGallery(const std::string& root, const std::string& category, double time
   }
   try {
     ViewerOptions vo;
-    vo.address = address;
-    vo.port = port;
-    vo.auth_token = token;
-    vo.allowed_origins = origins;
+    net.ApplyTo(&vo);
     Viewer viewer(nullptr, vo);
     gallery->AttachTo(&viewer);
     try {
       viewer.Start();
     } catch (const std::exception& e) {
-      throw std::runtime_error(std::string(e.what()) +
-                               "; choose another port with --port P, or --port 0 for a free one");
+      throw CannotListen(e);
     }
     std::printf("  open %s in a browser%s; stop with Ctrl-C\n", viewer.GetUrl().c_str(),
                 viewer.GetWebRoot().empty()
@@ -117,9 +114,9 @@ int RunGallery(const std::string& root, const std::string& category, double time
 }  // namespace
 
 int RunViewCommand(int argc, char** argv) {
-  std::string file, address = "127.0.0.1", token, dataset, category;
-  std::vector<std::string> origins;
-  int port = 8000;
+  std::string file, dataset, category;
+  NetOptions net;
+  net.port = 8000;
   double rate = 500, duration = 0;
   bool paused = false;
   const std::vector<std::string> args(argv, argv + argc);
@@ -133,14 +130,9 @@ int RunViewCommand(int argc, char** argv) {
       if (!file.empty()) v.Fail("unexpected extra argument '" + v.Text() + "'");
       file = v.Text();
     });
-    p.Option("--port", [&](const FlagValue& v) {
-      port = static_cast<int>(v.Integer(0, 65535, "(0 picks a free port)"));
-    });
-    p.Option("--address", [&](const FlagValue& v) { address = v.Text(); });
+    AddNetOptions(&p, &net);
     p.Switch("--paused", [&] { paused = true; });
     p.Option("--rate", [&](const FlagValue& v) { rate = v.Number(0, false, 1e9); });
-    p.Option("--token", [&](const FlagValue& v) { token = v.NonEmpty("a non-empty token"); });
-    p.Option("--allow-origin", [&](const FlagValue& v) { origins.push_back(v.Text()); });
     p.Option("--duration", [&](const FlagValue& v) { duration = v.Number(0, false, 1e9); });
     p.Option("--dataset", [&](const FlagValue& v) { dataset = v.NonEmpty("a folder"); });
     p.Option("--category", [&](const FlagValue& v) { category = v.NonEmpty("a category"); });
@@ -163,7 +155,7 @@ int RunViewCommand(int argc, char** argv) {
                    file.empty() ? "--paused" : ("FILE ('" + file + "')").c_str());
       return 2;
     }
-    return RunGallery(dataset, category, 1.0 / rate, address, port, token, origins, duration);
+    return RunGallery(dataset, category, 1.0 / rate, net, duration);
   }
 
   try {
@@ -173,24 +165,20 @@ int RunViewCommand(int argc, char** argv) {
     Scene scene(cfg);
     scene.AddGround(0.0);
     AddServedObjects(&scene, file, Pose());
-    scene.SetAmbientLight(Eigen::Vector3f(0.35f, 0.35f, 0.35f));
-    scene.AddDirectionalLight(Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
-    Camera camera = scene.AddCamera("front", 640, 480, 1.0, 0.05, 20.0);
+    SetAmbientLight(scene, Eigen::Vector3f(0.35f, 0.35f, 0.35f));
+    AddDirectionalLight(scene, Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+    Camera camera = AddCamera(scene, "front", 640, 480, 1.0, 0.05, 20.0);
     camera.SetLocalPose(CameraLookAt(Eigen::Vector3d(1.8, -1.8, 1.4), Eigen::Vector3d(0, 0, 0.4)));
 
     SimServer sim(&scene, nullptr);
     ViewerOptions vo;
-    vo.address = address;
-    vo.port = port;
-    vo.auth_token = token;
-    vo.allowed_origins = origins;
+    net.ApplyTo(&vo);
     Viewer viewer(&scene, vo);
     viewer.Attach(&sim);
     try {
       viewer.Start();
     } catch (const std::exception& e) {
-      throw std::runtime_error(std::string(e.what()) +
-                               "; choose another port with --port P, or --port 0 for a free one");
+      throw CannotListen(e);
     }
     sim.Start(paused);
     std::printf("partsim view: %zu articulations, %zu actors, %g Hz physics%s\n",

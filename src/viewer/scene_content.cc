@@ -10,6 +10,7 @@
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/scene_render.h"
 #include "viewer/http_util.h"
 
 namespace partsim::internal {
@@ -27,14 +28,6 @@ Json Vec3(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()});
 
 // a limit as JSON: null when unlimited (JSON has no infinity)
 Json Limit(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
-
-// key of a primitive visual: its type and exact sizes (equal primitives share one mesh)
-std::string PrimitiveKey(const VisualShape& v) {
-  char buf[160];
-  std::snprintf(buf, sizeof(buf), "%d %.17g %.17g %.17g %.17g %.17g", static_cast<int>(v.type),
-                v.half_size.x(), v.half_size.y(), v.half_size.z(), v.radius, v.half_length);
-  return buf;
-}
 
 // the tables that give meshes and textures their indices
 struct Indexer {
@@ -206,7 +199,7 @@ std::shared_ptr<SceneContent> MakeSceneContent(Scene& scene, long long version) 
   }
 
   Json cameras = Json::array();
-  for (const Camera& cam : scene.GetCameras())
+  for (const Camera& cam : GetCameras(scene))
     cameras.push_back({{"name", cam.GetName()},
                        {"width", cam.GetWidth()},
                        {"height", cam.GetHeight()},

@@ -1,8 +1,6 @@
 // GenerateDataset: the detection and motion-attribute datasets (partsim/vision/dataset.h).
 #include "partsim/vision/dataset.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -23,6 +21,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "core/atomic_file.h"
 #include "core/file_read.h"
 #include "core/json_parse.h"
 #include "core/progress.h"
@@ -34,6 +33,7 @@
 #include "partsim/core/log.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/vision/coco.h"
 #include "vision/npz.h"
 
@@ -167,20 +167,14 @@ void WriteText(const std::string& path, const std::string& text) {
   if (!f) throw Error("vision dataset: cannot write '" + path + "'");
 }
 
-// Writes `text` to a file of its own beside `path` and renames it into place: a reader never
+// Writes `text` through a temporary of its own beside `path`, renamed into place: a reader never
 // sees half a file, and writers at once (shards of one dataset in several processes, say) never
 // write into one another's file; the last rename wins.
 void WriteTextAtomic(const std::string& path, const std::string& text) {
-  static std::atomic<unsigned long> count{0};
-  const std::string mine =
-      path + ".partial." + std::to_string(::getpid()) + "." + std::to_string(count.fetch_add(1));
   try {
-    WriteText(mine, text);
-    fs::rename(mine, path);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(mine, ignored);
-    throw;
+    partsim::internal::WriteFileAtomically(path, text);
+  } catch (const Error& e) {
+    throw Error(std::string("vision dataset: ") + e.what());
   }
 }
 
@@ -361,21 +355,21 @@ class ObjectRenderer {
   ObjectRenderer(const DatasetOptions& options, const std::string& folder, RenderBackend* backend)
       : options_(options), scene_(std::make_unique<Scene>()) {
     if (backend != nullptr)
-      scene_->SetRenderBackend(std::make_unique<LentBackend>(backend));
+      SetRenderBackend(*scene_, std::make_unique<LentBackend>(backend));
     else
-      scene_->SetRenderBackend(options.backend);
+      SetRenderBackend(*scene_, options.backend);
     PartNetMobilityLoader loader(scene_.get());
     loader.urdf.load_collisions = false;  // rendered, never stepped
     object_ = loader.Parse(folder);
     articulation_ = scene_->AddArticulation(object_.articulation);
     const double fovy = options.fovy_degrees * kPi / 180.0;
-    camera_ = scene_->AddCamera("dataset", options.size, options.size, fovy, 0.01, 100.0);
+    camera_ = AddCamera(*scene_, "dataset", options.size, options.size, fovy, 0.01, 100.0);
     // ambient light and one directional light from above the object's front, no shadows
-    scene_->SetAmbientLight(Eigen::Vector3f::Constant(0.35f));
+    SetAmbientLight(*scene_, Eigen::Vector3f::Constant(0.35f));
     const Eigen::Vector3d front = Front();
-    scene_->AddDirectionalLight((-front - Eigen::Vector3d(0, 0, 1.5)).normalized(),
-                                Eigen::Vector3f::Constant(2.2f), false);
-    for (const RenderEntityInfo& e : scene_->GetRenderEntities()) {
+    AddDirectionalLight(*scene_, (-front - Eigen::Vector3d(0, 0, 1.5)).normalized(),
+                        Eigen::Vector3f::Constant(2.2f), false);
+    for (const RenderEntityInfo& e : GetRenderEntities(*scene_)) {
       if (!e.is_link || e.articulation_id != articulation_.GetId()) continue;
       const std::size_t id = e.id;
       if (id >= entity_link_.size()) entity_link_.resize(id + 1, -1);
@@ -411,9 +405,9 @@ class ObjectRenderer {
   // in frame (1.0 to 1.3 times the nearest such distance).
   void Render(const Eigen::VectorXd& q, Random* rng, View* view) {
     articulation_.SetQpos(q);
-    scene_->UpdateRender();
+    UpdateRender(*scene_);
     Eigen::Vector3d lo, hi;
-    RenderBounds(scene_->GetRenderWorld(), &mesh_bounds_, &lo, &hi);
+    RenderBounds(GetRenderWorld(*scene_), &mesh_bounds_, &lo, &hi);
     const Eigen::Vector3d centre = 0.5 * (lo + hi);
     const double radius = std::max(0.5 * (hi - lo).norm(), 1e-3);
     const Eigen::Vector3d front = Front();
@@ -485,7 +479,7 @@ std::map<int, const PartNetLink*> LabelledLinks(const PartNetMobilityObject& o) 
 // The datasets' PNGs: zlib level 1, rows not filtered. The same pixels as libpng's default
 // compression (level 6, a filter chosen per row by trying all five), written about five times
 // faster in files 1.5 to 2 times larger: tens of kB per view, beside the 1 MB depth NPY.
-constexpr PngCompression kPngCompression{1, 0};
+constexpr PngCompression kPngCompression = kFastPngCompression;
 
 void WriteViewPictures(const std::string& dir, const std::string& stem, const View& v) {
   WritePng(dir + "/rgb/" + stem + ".png", v.width, v.height, 3, v.rgb.data(), kPngCompression);
@@ -840,33 +834,30 @@ void Merge(const DatasetOptions& options, const std::vector<ObjectInfo>& objects
 }
 
 void CheckOptions(const DatasetOptions& o) {
-  PARTSIM_THROW_UNLESS(!o.dataset_root.empty(), "vision dataset: --dataset is required");
-  PARTSIM_THROW_UNLESS(!o.out.empty(), "vision dataset: --out is required");
-  PARTSIM_THROW_UNLESS(
-      o.views >= 1 && o.views <= 10000,
-      "vision dataset: --views must be in [1, 10000], got " + std::to_string(o.views));
-  PARTSIM_THROW_UNLESS(
-      o.size >= 16 && o.size <= 4096,
-      "vision dataset: --size must be in [16, 4096], got " + std::to_string(o.size));
-  PARTSIM_THROW_UNLESS(o.split >= 0 && o.split <= 1,
-                       "vision dataset: --split must be in [0, 1], got " + FormatNumber(o.split));
-  PARTSIM_THROW_UNLESS(o.jobs >= 1 && o.jobs <= 256,
-                       "vision dataset: --jobs must be in [1, 256], got " + std::to_string(o.jobs));
-  PARTSIM_THROW_UNLESS(o.shard_count >= 1 && o.shard_index >= 0 && o.shard_index < o.shard_count,
-                       "vision dataset: --shard i/N needs 0 <= i < N, got " +
-                           std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count));
-  PARTSIM_THROW_UNLESS(
-      o.backend == "rasterizer" || o.backend == "pathtracer",
-      "vision dataset: --backend must be rasterizer or pathtracer, got '" + o.backend + "'");
-  PARTSIM_THROW_UNLESS(o.min_area_fraction >= 0 && o.min_area_fraction < 1,
-                       "vision dataset: the minimum area fraction must be in [0, 1)");
-  PARTSIM_THROW_UNLESS(o.fovy_degrees > 1 && o.fovy_degrees < 170,
-                       "vision dataset: the field of view must be in (1, 170) degrees");
-  PARTSIM_THROW_UNLESS(!o.motion_parts.empty(), "vision dataset: --parts names no label word");
+  if (o.dataset_root.empty()) throw Error("vision dataset: --dataset is required");
+  if (o.out.empty()) throw Error("vision dataset: --out is required");
+  if (!(o.views >= 1 && o.views <= 10000))
+    throw Error("vision dataset: --views must be in [1, 10000], got " + std::to_string(o.views));
+  if (!(o.size >= 16 && o.size <= 4096))
+    throw Error("vision dataset: --size must be in [16, 4096], got " + std::to_string(o.size));
+  if (!(o.split >= 0 && o.split <= 1))
+    throw Error("vision dataset: --split must be in [0, 1], got " + FormatNumber(o.split));
+  if (!(o.jobs >= 1 && o.jobs <= 256))
+    throw Error("vision dataset: --jobs must be in [1, 256], got " + std::to_string(o.jobs));
+  if (!(o.shard_count >= 1 && o.shard_index >= 0 && o.shard_index < o.shard_count))
+    throw Error("vision dataset: --shard i/N needs 0 <= i < N, got " +
+                std::to_string(o.shard_index) + "/" + std::to_string(o.shard_count));
+  if (!(o.backend == "rasterizer" || o.backend == "pathtracer"))
+    throw Error("vision dataset: --backend must be rasterizer or pathtracer, got '" + o.backend +
+                "'");
+  if (!(o.min_area_fraction >= 0 && o.min_area_fraction < 1))
+    throw Error("vision dataset: the minimum area fraction must be in [0, 1)");
+  if (!(o.fovy_degrees > 1 && o.fovy_degrees < 170))
+    throw Error("vision dataset: the field of view must be in (1, 170) degrees");
+  if (o.motion_parts.empty()) throw Error("vision dataset: --parts names no label word");
   for (const std::string& w : o.motion_parts)
-    PARTSIM_THROW_UNLESS(
-        !w.empty() && w.find_first_of(" ,\t\n") == std::string::npos,
-        "vision dataset: --parts takes label words without spaces, got '" + w + "'");
+    if (w.empty() || w.find_first_of(" ,\t\n") != std::string::npos)
+      throw Error("vision dataset: --parts takes label words without spaces, got '" + w + "'");
 }
 
 // The options that decide the bytes of a dataset, as dataset.json records them; a run into an
@@ -1030,10 +1021,12 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
     RunParts(options.jobs, static_cast<int>(pending.size()), [&](int part) {
       const ObjectInfo& info = objects[pending[static_cast<std::size_t>(part)]];
       const std::string final_dir = options.out + "/objects/" + info.name;
-      const std::string dir = final_dir + ".partial";
       long views = 0;
       std::string error;
       try {
+        // made under <name>.partial (removed on an error), renamed into place when whole
+        partsim::internal::StagedPath staged(final_dir, final_dir + ".partial");
+        const std::string& dir = staged.Temporary();
         fs::remove_all(dir);  // a torn earlier attempt
         fs::remove_all(final_dir);
         fs::create_directories(dir);
@@ -1046,7 +1039,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
         backends.Put(std::move(backend));
         WriteText(dir + "/views.json", doc.dump(1));
         WriteText(dir + "/" + kDone, "");
-        fs::rename(dir, final_dir);
+        staged.Commit();
       } catch (const std::exception& e) {
         error = info.folder + ": " + e.what();
       }

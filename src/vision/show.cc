@@ -4,11 +4,11 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <utility>
 
+#include "core/number_text.h"
 #include "partsim/core/error.h"
 #include "partsim/render/image_io.h"
 #include "partsim/render/image_read.h"
@@ -342,12 +342,6 @@ std::string PartLabel(const std::string& category) {
   return slash == std::string::npos ? category : category.substr(slash + 1);
 }
 
-std::string Fixed(double value, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", digits, value);
-  return buf;
-}
-
 // ---------------------------------------------------------------------------------------------
 // detection
 
@@ -564,13 +558,13 @@ ShownImage ShowMotion(const ShowOptions& o, const std::string& split_file) {
   // slider range, metres)
   std::string state;
   if (hinge) {
-    state = Fixed(m[11].get<double>() * 360.0, 1) + " deg";
+    state = partsim::internal::Fixed(m[11].get<double>() * 360.0, 1) + " deg";
   } else {
     const double range = doc.contains("slider_range") && doc["slider_range"].is_number()
                              ? doc["slider_range"].get<double>()
                              : 0.0;
-    state = range > 0 ? Fixed(m[12].get<double>() * range, 3) + " m"
-                      : "x " + Fixed(m[12].get<double>(), 3);
+    state = range > 0 ? partsim::internal::Fixed(m[12].get<double>() * range, 3) + " m"
+                      : "x " + partsim::internal::Fixed(m[12].get<double>(), 3);
   }
   out.caption = std::string(hinge ? "hinge " : "slider ") + part.label + " " + state;
   const PixelBox caption_size = TextBox(out.caption, scale);

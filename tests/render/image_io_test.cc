@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "partsim/render/camera.h"
+#include "partsim/render/scene_render.h"
 #include "render/render_test_util.h"
 
 namespace partsim {
@@ -75,8 +76,8 @@ class ImageIoTest : public ::testing::Test {
 
   // a picture from the plane backend: depth 2 m, colour 0.5, left column empty
   Picture PlanePicture(int w, int h) {
-    scene_.SetRenderBackend(std::make_unique<testing::PlaneBackend>(2.0, 0.5f));
-    camera_ = scene_.AddCamera("c", w, h, 1.0, 0.1, 10.0);
+    SetRenderBackend(scene_, std::make_unique<testing::PlaneBackend>(2.0, 0.5f));
+    camera_ = AddCamera(scene_, "c", w, h, 1.0, 0.1, 10.0);
     camera_.TakePicture();
     return camera_.GetPictureData();
   }
@@ -103,6 +104,33 @@ TEST_F(ImageIoTest, Png8RoundTrip) {
   PngImage g = ReadPng(Path("g.png"));
   EXPECT_EQ(g.color_type, PNG_COLOR_TYPE_GRAY);
   EXPECT_EQ(g.bytes, grey);
+}
+
+// EncodePng gives the bytes WritePng writes, and with kFastPngCompression (the viewer's camera
+// pictures) other bytes of the same pixels, for every channel count; sizes below 1 x 1 and other
+// channel counts are refused.
+TEST_F(ImageIoTest, EncodedPngDecodesToTheSamePixels) {
+  const int w = 7, h = 5;
+  const int types[] = {PNG_COLOR_TYPE_GRAY, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_COLOR_TYPE_RGB,
+                       PNG_COLOR_TYPE_RGBA};
+  for (int channels : {1, 2, 3, 4}) {
+    std::vector<uint8_t> px(static_cast<size_t>(w) * h * channels);
+    for (size_t i = 0; i < px.size(); ++i) px[i] = static_cast<uint8_t>(37 * i + channels);
+    WritePng(Path("w.png"), w, h, channels, px.data());
+    EXPECT_EQ(ReadFile(Path("w.png")), EncodePng(w, h, channels, px.data())) << channels;
+    std::ofstream(Path("fast.png"), std::ios::binary)
+        << EncodePng(w, h, channels, px.data(), kFastPngCompression);
+    const PngImage back = ReadPng(Path("fast.png"));
+    EXPECT_EQ(back.width, w);
+    EXPECT_EQ(back.height, h);
+    EXPECT_EQ(back.bit_depth, 8);
+    EXPECT_EQ(back.color_type, types[channels - 1]);
+    EXPECT_EQ(back.bytes, px) << channels << " channels";
+  }
+  const uint8_t one = 0;
+  EXPECT_THROW(EncodePng(0, 1, 1, &one), Error);
+  EXPECT_THROW(EncodePng(1, 1, 5, &one), Error);
+  EXPECT_THROW(EncodePng(1, 1, 1, &one, PngCompression{10, 0}), Error);
 }
 
 // Files are written under a temporary name and renamed: nothing else is left in the folder, and
@@ -195,8 +223,8 @@ TEST_F(ImageIoTest, PictureImagesAndSegmentationColours) {
 TEST_F(ImageIoTest, PointCloudInWorldProjectsBackToItsPixels) {
   Pose X_WC(Eigen::Vector3d(1, -1, 2),
             Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(0.2, 1, 0.3).normalized())));
-  scene_.SetRenderBackend(std::make_unique<testing::PlaneBackend>(2.0, 0.5f));
-  Camera cam = scene_.AddCamera("c", 8, 6, 1.0, 0.1, 10.0);
+  SetRenderBackend(scene_, std::make_unique<testing::PlaneBackend>(2.0, 0.5f));
+  Camera cam = AddCamera(scene_, "c", 8, 6, 1.0, 0.1, 10.0);
   cam.SetLocalPose(X_WC);
   cam.TakePicture();
   PointCloud camera_frame = MakePointCloud(cam, PointCloudFrame::kCamera);

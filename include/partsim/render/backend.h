@@ -38,7 +38,7 @@ struct RenderInstance {
   uint32_t entity_id = 0;  ///< scene-wide id of the actor or link (>= 1)
 };
 
-/// What a backend renders: the snapshot taken by Scene::UpdateRender.
+/// What a backend renders: the snapshot taken by UpdateRender(scene) (scene_render.h).
 struct RenderWorld {
   std::vector<RenderInstance> instances;
   std::vector<LightDesc> lights;
@@ -158,5 +158,11 @@ std::unique_ptr<RenderBackend> MakePathTracerBackend(
 /// frame, with outward normals; capsules and cylinders along x; a plane is a square of
 /// half-size `half_size.x() x half_size.y()` facing +z.
 std::shared_ptr<MeshData> MakePrimitiveMesh(const VisualShape& shape);
+
+namespace internal {
+/// Key of a primitive visual for sharing meshes (the renderer's mesh cache, the viewer's mesh
+/// table): its type and exact sizes, so that shapes with one key have the same MakePrimitiveMesh.
+std::string PrimitiveKey(const VisualShape& shape);
+}  // namespace internal
 
 }  // namespace partsim

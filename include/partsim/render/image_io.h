@@ -65,6 +65,17 @@ struct PngCompression {
   int filter = -1;
 };
 
+/// Fast compression for pictures that go to a browser at once (the viewer's camera pictures):
+/// zlib level 1, rows not filtered.
+constexpr PngCompression kFastPngCompression{1, 0};
+
+/// The bytes of an 8-bit PNG, the file WritePng writes: `channels` 1 (grey), 2 (grey, alpha),
+/// 3 (RGB) or 4 (RGBA), row-major pixels, top row first, width x height x channels bytes. Throws
+/// partsim::Error for a size below 1 x 1, other channel counts, and a `compression` level
+/// outside [-1, 9] or filter outside [-1, 4].
+std::string EncodePng(int width, int height, int channels, const uint8_t* pixels,
+                      const PngCompression& compression = PngCompression());
+
 /// 8-bit PNG with `channels` 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA): row-major pixels,
 /// top row first, width x height x channels bytes. Throws partsim::Error for a `compression`
 /// level outside [-1, 9] or filter outside [-1, 4].

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "assets/generator/mesh_builder.h"
+#include "core/atomic_file.h"
 #include "core/file_read.h"
 #include "partsim/assets/generator.h"
 #include "partsim/core/constants.h"
@@ -425,15 +426,16 @@ bool IsPartialObjectFolder(const std::string& folder) {
 
 void WriteObject(const GeneratedObject& object, const std::string& dir) {
   namespace fs = std::filesystem;
-  // everything goes to a staging folder, renamed into place at the end
+  // everything goes to a staging folder, renamed into place at the end (removed on an error)
   const fs::path target(dir);
-  fs::path root(dir + kPartialSuffix);
   std::error_code ec;
   if (fs::exists(target, ec) &&
       !(fs::is_directory(target, ec) &&
         (fs::is_empty(target, ec) || IsGeneratedObjectFolder(target.string()))))
     throw Error("WriteObject: '" + dir +
                 "' exists and holds something partsim did not generate: not replaced");
+  internal::StagedPath staged(dir, dir + kPartialSuffix);
+  const fs::path root(staged.Temporary());
   fs::remove_all(root, ec);
   fs::create_directories(root / "textured_objs", ec);
   if (ec) throw Error("WriteObject: cannot create '" + (root / "textured_objs").string() + "'");
@@ -482,10 +484,11 @@ void WriteObject(const GeneratedObject& object, const std::string& dir) {
   WriteFile(root / "result_after_merging.json", "[" + MergedJson(tree, &next) + "]\n");
   // complete: into place
   fs::remove_all(target, ec);
-  fs::rename(root, target, ec);
-  if (ec)
-    throw Error("WriteObject: cannot rename '" + root.string() + "' to '" + target.string() +
-                "': " + ec.message());
+  try {
+    staged.Commit();
+  } catch (const Error& e) {
+    throw Error(std::string("WriteObject: ") + e.what());
+  }
 }
 
 }  // namespace partsim
