@@ -39,6 +39,7 @@
 #include "partsim/assets/urdf.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/robot/robots.h"
 #include "partsim/server/rosbridge.h"
 #include "partsim/server/served_robot.h"
@@ -250,10 +251,10 @@ class ServedScene {
     }
     robot_.SetQpos(q);
     // lights and the front camera
-    scene_->SetAmbientLight(Eigen::Vector3f(0.35f, 0.35f, 0.35f));
-    scene_->AddDirectionalLight(Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+    SetAmbientLight(*scene_, Eigen::Vector3f(0.35f, 0.35f, 0.35f));
+    AddDirectionalLight(*scene_, Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
     partsim::Camera camera =
-        scene_->AddCamera("front_camera", kImageWidth, kImageHeight, 1.0, 0.05, 20.0);
+        AddCamera(*scene_, "front_camera", kImageWidth, kImageHeight, 1.0, 0.05, 20.0);
     camera.SetLocalPose(
         partsim::CameraLookAt(Eigen::Vector3d(1.3, -2.2, 1.4), Eigen::Vector3d(0.5, 0, 0.4)));
 
@@ -297,7 +298,7 @@ class ServedScene {
         .dump();
   }
   /// The device that renders (call once stopped, after pictures were taken).
-  std::string Renderer() { return scene_->GetRenderBackend().Device(); }
+  std::string Renderer() { return GetRenderBackend(*scene_).Device(); }
 
  private:
   std::unique_ptr<partsim::Scene> scene_;

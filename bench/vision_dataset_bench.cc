@@ -58,6 +58,7 @@
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/vision/dataset.h"
 
 namespace {
@@ -127,12 +128,12 @@ ObjectView MakeObjectView(const std::string& folder, int size) {
   const partsim::PartNetMobilityObject object = loader.Parse(folder);
   partsim::Articulation art = scene.AddArticulation(object.articulation);
   const Eigen::Vector3d front = art.GetRootPose().q * -Eigen::Vector3d::UnitX();
-  scene.SetAmbientLight(Eigen::Vector3f::Constant(0.35f));
-  scene.AddDirectionalLight((-front - Eigen::Vector3d(0, 0, 1.5)).normalized(),
-                            Eigen::Vector3f::Constant(2.2f), false);
-  scene.UpdateRender();
+  SetAmbientLight(scene, Eigen::Vector3f::Constant(0.35f));
+  AddDirectionalLight(scene, (-front - Eigen::Vector3d(0, 0, 1.5)).normalized(),
+                      Eigen::Vector3f::Constant(2.2f), false);
+  UpdateRender(scene);
   ObjectView out;
-  out.world = scene.GetRenderWorld();
+  out.world = GetRenderWorld(scene);
   Eigen::AlignedBox3d box;
   for (const RenderInstance& inst : out.world.instances)
     for (const Eigen::Vector3f& v : inst.mesh->vertices)

@@ -48,7 +48,7 @@ std::string Urdf(int n, bool deep) {
 void Run(int n, bool deep, int steps) {
   const std::string text = Urdf(n, deep);
   partsim::Scene scene;
-  partsim::UrdfLoader loader = scene.CreateUrdfLoader();
+  partsim::UrdfLoader loader = CreateUrdfLoader(scene);
   auto t0 = Clock::now();
   std::string outcome;
   double load = 0, step = 0;

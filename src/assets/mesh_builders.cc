@@ -1,6 +1,8 @@
-// The builder members that need the assets layer: mesh files (assimp) and the convex-piece check
-// (qhull), and Scene::CreateUrdfLoader. Physics declares them (partsim/physics/scene.h) and builds
-// without them; they are defined and instantiated here, one layer up.
+// The builder steps that need the assets layer: mesh files (assimp) and the convex-piece check
+// (qhull), for actor and link builders (partsim/assets/mesh_builders.h); and CreateUrdfLoader
+// (partsim/assets/urdf.h). Physics builds without them.
+#include "partsim/assets/mesh_builders.h"
+
 #include <mutex>
 #include <set>
 
@@ -70,66 +72,64 @@ void AddVisualFile(BodyDesc& b, const std::string& filename, const Pose& pose,
 
 }  // namespace
 
-template <typename D>
-D& BodyBuilder<D>::AddConvexCollisionFromFile(const std::string& filename, const Pose& pose,
-                                              const Eigen::Vector3d& scale,
-                                              const std::optional<PhysicalMaterial>& material,
-                                              double density) {
+template <typename Builder>
+Builder& AddConvexCollisionFromFile(Builder& builder, const std::string& filename, const Pose& pose,
+                                    const Eigen::Vector3d& scale,
+                                    const std::optional<PhysicalMaterial>& material,
+                                    double density) {
   CheckScale(scale, filename);
   if (auto piece = CollidablePiece(LoadMergedMesh(filename, scale), true))
-    AddConvexMesh(body(), piece, pose, material, density);
-  return self();
+    AddConvexMesh(builder.Body(), piece, pose, material, density);
+  return builder;
 }
-template <typename D>
-D& BodyBuilder<D>::AddMultipleConvexCollisionsFromFile(
-    const std::string& filename, const Pose& pose, const Eigen::Vector3d& scale,
-    const std::optional<PhysicalMaterial>& material, double density) {
+
+template <typename Builder>
+Builder& AddMultipleConvexCollisionsFromFile(Builder& builder, const std::string& filename,
+                                             const Pose& pose, const Eigen::Vector3d& scale,
+                                             const std::optional<PhysicalMaterial>& material,
+                                             double density) {
   CheckScale(scale, filename);
   for (auto& loaded : LoadConvexPieces(filename, scale))
     if (auto piece = CollidablePiece(loaded, false))
-      AddConvexMesh(body(), piece, pose, material, density);
-  return self();
+      AddConvexMesh(builder.Body(), piece, pose, material, density);
+  return builder;
 }
-template <typename D>
-D& BodyBuilder<D>::AddConvexCollisionFromMesh(std::shared_ptr<const MeshData> mesh,
-                                              const Pose& pose,
-                                              const std::optional<PhysicalMaterial>& material,
-                                              double density) {
+
+template <typename Builder>
+Builder& AddConvexCollisionFromMesh(Builder& builder, std::shared_ptr<const MeshData> mesh,
+                                    const Pose& pose,
+                                    const std::optional<PhysicalMaterial>& material,
+                                    double density) {
   if (!mesh) throw Error("add_convex_collision_from_mesh: the mesh is null");
   if (auto piece = CollidablePiece(std::move(mesh), false))
-    AddConvexMesh(body(), piece, pose, material, density);
-  return self();
-}
-template <typename D>
-D& BodyBuilder<D>::AddVisualFromFile(const std::string& filename, const Pose& pose,
-                                     const Eigen::Vector3d& scale, const std::string& name) {
-  AddVisualFile(body(), filename, pose, scale, name);
-  return self();
+    AddConvexMesh(builder.Body(), piece, pose, material, density);
+  return builder;
 }
 
-template ActorBuilder& BodyBuilder<ActorBuilder>::AddConvexCollisionFromFile(
-    const std::string&, const Pose&, const Eigen::Vector3d&, const std::optional<PhysicalMaterial>&,
-    double);
-template ActorBuilder& BodyBuilder<ActorBuilder>::AddMultipleConvexCollisionsFromFile(
-    const std::string&, const Pose&, const Eigen::Vector3d&, const std::optional<PhysicalMaterial>&,
-    double);
-template ActorBuilder& BodyBuilder<ActorBuilder>::AddConvexCollisionFromMesh(
-    std::shared_ptr<const MeshData>, const Pose&, const std::optional<PhysicalMaterial>&, double);
-template ActorBuilder& BodyBuilder<ActorBuilder>::AddVisualFromFile(const std::string&, const Pose&,
-                                                                    const Eigen::Vector3d&,
-                                                                    const std::string&);
-template LinkBuilder& BodyBuilder<LinkBuilder>::AddConvexCollisionFromFile(
-    const std::string&, const Pose&, const Eigen::Vector3d&, const std::optional<PhysicalMaterial>&,
-    double);
-template LinkBuilder& BodyBuilder<LinkBuilder>::AddMultipleConvexCollisionsFromFile(
-    const std::string&, const Pose&, const Eigen::Vector3d&, const std::optional<PhysicalMaterial>&,
-    double);
-template LinkBuilder& BodyBuilder<LinkBuilder>::AddConvexCollisionFromMesh(
-    std::shared_ptr<const MeshData>, const Pose&, const std::optional<PhysicalMaterial>&, double);
-template LinkBuilder& BodyBuilder<LinkBuilder>::AddVisualFromFile(const std::string&, const Pose&,
-                                                                  const Eigen::Vector3d&,
-                                                                  const std::string&);
+template <typename Builder>
+Builder& AddVisualFromFile(Builder& builder, const std::string& filename, const Pose& pose,
+                           const Eigen::Vector3d& scale, const std::string& name) {
+  AddVisualFile(builder.Body(), filename, pose, scale, name);
+  return builder;
+}
 
-UrdfLoader Scene::CreateUrdfLoader() { return UrdfLoader(this); }
+// the builders these are for
+#define PARTSIM_INSTANTIATE(Builder)                                                            \
+  template Builder& AddConvexCollisionFromFile(Builder&, const std::string&, const Pose&,       \
+                                               const Eigen::Vector3d&,                          \
+                                               const std::optional<PhysicalMaterial>&, double); \
+  template Builder& AddMultipleConvexCollisionsFromFile(                                        \
+      Builder&, const std::string&, const Pose&, const Eigen::Vector3d&,                        \
+      const std::optional<PhysicalMaterial>&, double);                                          \
+  template Builder& AddConvexCollisionFromMesh(Builder&, std::shared_ptr<const MeshData>,       \
+                                               const Pose&,                                     \
+                                               const std::optional<PhysicalMaterial>&, double); \
+  template Builder& AddVisualFromFile(Builder&, const std::string&, const Pose&,                \
+                                      const Eigen::Vector3d&, const std::string&);
+PARTSIM_INSTANTIATE(ActorBuilder)
+PARTSIM_INSTANTIATE(LinkBuilder)
+#undef PARTSIM_INSTANTIATE
+
+UrdfLoader CreateUrdfLoader(Scene& scene) { return UrdfLoader(&scene); }
 
 }  // namespace partsim

@@ -1,6 +1,6 @@
 // ActorBuilder, LinkBuilder and ArticulationBuilder: assemble descriptions piece by piece. The
-// members that read mesh files or check convex pieces are in the assets layer
-// (src/assets/mesh_builders.cc), as is Scene::CreateUrdfLoader.
+// steps that read mesh files or check convex pieces are free functions of the assets layer
+// (partsim/assets/mesh_builders.h), as is CreateUrdfLoader (partsim/assets/urdf.h).
 #include <cmath>
 
 #include "partsim/core/log.h"

@@ -91,7 +91,7 @@ void BindAssets(py::module_& m) {
            py::arg("base_dir") = ".", ka, "Parses URDF text and adds it to the scene.");
 
   py::class_<Scene, std::shared_ptr<Scene>>(m.attr("Scene"))
-      .def("create_urdf_loader", &Scene::CreateUrdfLoader, ka,
+      .def("create_urdf_loader", &CreateUrdfLoader, ka,
            "A UrdfLoader whose load() adds to this scene.");
 
   py::class_<LoadedMesh>(m, "LoadedMesh", "One sub-mesh of a file with its render material.")

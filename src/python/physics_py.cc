@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bindings.h"
+#include "partsim/assets/mesh_builders.h"
 #include "partsim/core/check.h"
 #include "partsim/physics/description.h"
 #include "partsim/physics/mjcf.h"
@@ -75,7 +76,7 @@ void BindShapeAdders(PyClass& c) {
            py::arg("density") = 1000.0, ri,
            "Adds a cylinder along the shape's local x axis: `radius` and `half_length` (m). "
            "Returns self.")
-      .def("add_convex_collision_from_file", &Builder::AddConvexCollisionFromFile,
+      .def("add_convex_collision_from_file", &AddConvexCollisionFromFile<Builder>,
            py::arg("filename"), py::arg("pose") = Pose(),
            py::arg("scale") = Eigen::Vector3d::Ones().eval(), py::arg("material") = py::none(),
            py::arg("density") = 1000.0, ri,
@@ -97,7 +98,7 @@ void BindShapeAdders(PyClass& c) {
            py::arg("radius") = 1.0, py::arg("half_length") = 1.0, py::arg("color") = kGrey,
            py::arg("name") = "", ri,
            "Adds a cylinder visual along local x; color is linear RGBA. Returns self.")
-      .def("add_visual_from_file", &Builder::AddVisualFromFile, py::arg("filename"),
+      .def("add_visual_from_file", &AddVisualFromFile<Builder>, py::arg("filename"),
            py::arg("pose") = Pose(), py::arg("scale") = Eigen::Vector3d::Ones().eval(),
            py::arg("name") = "", ri,
            "Adds every sub-mesh of a mesh file as visuals, multiplied by `scale`. Returns self.")
@@ -745,7 +746,7 @@ void BindBuilders(py::module_& m) {
   BindShapeAdders<ActorBuilder>(actor_builder);
   actor_builder
       .def("add_multiple_convex_collisions_from_file",
-           &ActorBuilder::AddMultipleConvexCollisionsFromFile, py::arg("filename"),
+           &AddMultipleConvexCollisionsFromFile<ActorBuilder>, py::arg("filename"),
            py::arg("pose") = Pose(), py::arg("scale") = Eigen::Vector3d::Ones().eval(),
            py::arg("material") = py::none(), py::arg("density") = 1000.0, ri,
            "One convex piece per sub-mesh (or connected component) of a mesh file. Returns "
@@ -754,7 +755,7 @@ void BindBuilders(py::module_& m) {
           "add_convex_collision_from_mesh",
           [](ActorBuilder& self, std::shared_ptr<MeshData> mesh, const Pose& pose,
              const std::optional<PhysicalMaterial>& material, double density) -> ActorBuilder& {
-            return self.AddConvexCollisionFromMesh(std::move(mesh), pose, material, density);
+            return AddConvexCollisionFromMesh(self, std::move(mesh), pose, material, density);
           },
           py::arg("mesh"), py::arg("pose") = Pose(), py::arg("material") = py::none(),
           py::arg("density") = 1000.0, ri,

@@ -22,6 +22,7 @@
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/render/video.h"
 
 namespace partsim::python {
@@ -256,52 +257,52 @@ void BindSceneRender(py::module_& m) {
   const auto ka = py::keep_alive<0, 1>();
   auto scene = py::reinterpret_borrow<py::class_<Scene, std::shared_ptr<Scene>>>(m.attr("Scene"));
   scene
-      .def("add_camera", &Scene::AddCamera, py::arg("name"), py::arg("width"), py::arg("height"),
+      .def("add_camera", &AddCamera, py::arg("name"), py::arg("width"), py::arg("height"),
            py::arg("fovy"), py::arg("near"), py::arg("far"), ka,
            "A camera fixed in the world: size in pixels (1 to 16384), vertical field of view "
            "(rad), clipping distances (m). Place it with set_pose.")
       .def("add_mounted_camera",
-           py::overload_cast<const std::string&, const Actor&, const Pose&, int, int, double,
-                             double, double>(&Scene::AddMountedCamera),
+           py::overload_cast<Scene&, const std::string&, const Actor&, const Pose&, int, int,
+                             double, double, double>(&AddMountedCamera),
            py::arg("name"), py::arg("mount"), py::arg("pose"), py::arg("width"), py::arg("height"),
            py::arg("fovy"), py::arg("near"), py::arg("far"), ka,
            "A camera moving with an actor; `pose` is its pose in the actor's frame.")
       .def("add_mounted_camera",
-           py::overload_cast<const std::string&, const Link&, const Pose&, int, int, double, double,
-                             double>(&Scene::AddMountedCamera),
+           py::overload_cast<Scene&, const std::string&, const Link&, const Pose&, int, int, double,
+                             double, double>(&AddMountedCamera),
            py::arg("name"), py::arg("mount"), py::arg("pose"), py::arg("width"), py::arg("height"),
            py::arg("fovy"), py::arg("near"), py::arg("far"), ka,
            "A camera moving with a link; `pose` is its pose in the link's frame.")
-      .def("remove_camera", &Scene::RemoveCamera, py::arg("camera"),
+      .def("remove_camera", &RemoveCamera, py::arg("camera"),
            "Removes a camera; raises PartsimError when it was removed already or belongs to "
            "another scene.")
       .def(
           "get_cameras",
-          [](py::object self) { return HandleList(self.cast<const Scene&>().GetCameras(), self); },
+          [](py::object self) { return HandleList(GetCameras(self.cast<const Scene&>()), self); },
           "Handles of every camera of the scene, fixed and mounted.")
-      .def("add_directional_light", &Scene::AddDirectionalLight, py::arg("direction"),
-           py::arg("color"), py::arg("shadow") = false,
+      .def("add_directional_light", &AddDirectionalLight, py::arg("direction"), py::arg("color"),
+           py::arg("shadow") = false,
            "Light travelling along `direction` (3,) (world); color (3,) linear RGB.")
-      .def("add_point_light", &Scene::AddPointLight, py::arg("position"), py::arg("color"),
+      .def("add_point_light", &AddPointLight, py::arg("position"), py::arg("color"),
            "Point light at `position` (3,) (m, world).")
-      .def("add_spot_light", &Scene::AddSpotLight, py::arg("position"), py::arg("direction"),
+      .def("add_spot_light", &AddSpotLight, py::arg("position"), py::arg("direction"),
            py::arg("inner_angle"), py::arg("outer_angle"), py::arg("color"),
            py::arg("shadow") = false,
            "Spot light; half angles in radians, 0 <= inner <= outer <= pi/2.")
-      .def("set_ambient_light", &Scene::SetAmbientLight, py::arg("color"),
+      .def("set_ambient_light", &SetAmbientLight, py::arg("color"),
            "Ambient light (3,), linear RGB.")
-      .def("get_lights", &Scene::GetLights,
+      .def("get_lights", &GetLights,
            "list of LightDesc: the scene's directional, point and spot lights.")
-      .def("set_render_backend", py::overload_cast<const std::string&>(&Scene::SetRenderBackend),
+      .def("set_render_backend", py::overload_cast<Scene&, const std::string&>(&SetRenderBackend),
            py::arg("name"), "'rasterizer' (the default), 'pathtracer' or 'null'.")
-      .def("get_render_backend", &Scene::GetRenderBackend, py::return_value_policy::reference, ka,
+      .def("get_render_backend", &GetRenderBackend, py::return_value_policy::reference, ka,
            "The backend (created on first use: the rasterizer unless another was set).")
-      .def("update_render", &Scene::UpdateRender,
+      .def("update_render", &UpdateRender,
            "Copies the current poses of everything visible (and mounted cameras) into the "
            "render world.")
-      .def("get_render_entities", &Scene::GetRenderEntities,
+      .def("get_render_entities", &GetRenderEntities,
            "What the actor/link ids of segmentation (channel 1) name.")
-      .def("get_render_visuals", &Scene::GetRenderVisuals,
+      .def("get_render_visuals", &GetRenderVisuals,
            "What the visual ids of segmentation (channel 0) name.");
 }
 

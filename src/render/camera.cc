@@ -13,6 +13,7 @@
 #include "partsim/core/constants.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/scene_render.h"
 #include "render/render_state.h"
 
 namespace partsim {
@@ -228,8 +229,8 @@ void Camera::TakePicture(unsigned outputs) {
   // the backend's Render checks `outputs` and the camera, for every backend
   internal::RenderState& s = RenderOf(*scene_);
   // the first picture of a scene needs a render world: build it now
-  if (!s.render_world_built) scene_->UpdateRender();
-  RenderBackend& backend = scene_->GetRenderBackend();
+  if (!s.render_world_built) UpdateRender(*scene_);
+  RenderBackend& backend = GetRenderBackend(*scene_);
   CameraParams params = GetParams();
   // render into a fresh picture while an older one is still viewed (from Python)
   std::shared_ptr<Picture> picture =

@@ -1,5 +1,7 @@
-// The scene's rendering methods: cameras, lights, the render world that backends draw, and the
-// tables that name segmentation ids.
+// The scene's rendering (partsim/render/scene_render.h): cameras, lights, the render world that
+// backends draw, and the tables that name segmentation ids.
+#include "partsim/render/scene_render.h"
+
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -144,58 +146,60 @@ using internal::RenderOf;
 // ---------------------------------------------------------------------------------------------
 // cameras
 
-Camera Scene::AddCamera(const std::string& name, int width, int height, double fovy, double near,
-                        double far) {
+Camera AddCamera(Scene& scene, const std::string& name, int width, int height, double fovy,
+                 double near, double far) {
   CheckCameraArgs("add_camera '" + name + "'", width, height, fovy, near, far);
-  int id = NewEntityId(*this);
-  RenderOf(*this).cameras.push_back(MakeEntry(id, name, width, height, fovy, near, far));
-  return Camera(this, id);
+  int id = NewEntityId(scene);
+  RenderOf(scene).cameras.push_back(MakeEntry(id, name, width, height, fovy, near, far));
+  return Camera(&scene, id);
 }
 
-Camera Scene::AddMountedCamera(const std::string& name, const Actor& mount, const Pose& local_pose,
-                               int width, int height, double fovy, double near, double far) {
+Camera AddMountedCamera(Scene& scene, const std::string& name, const Actor& mount,
+                        const Pose& local_pose, int width, int height, double fovy, double near,
+                        double far) {
   std::string what = "add_mounted_camera '" + name + "'";
   CheckCameraArgs(what, width, height, fovy, near, far);
   CheckPose(what + ": local_pose", local_pose);
-  if (mount.GetScene() != this) throw Error(what + ": the mount actor belongs to another scene");
+  if (mount.GetScene() != &scene) throw Error(what + ": the mount actor belongs to another scene");
   // the pose is known at once, before the first UpdateRender (GetPose throws when removed)
   Pose X_WC = mount.GetPose() * local_pose;
-  RenderState& s = RenderOf(*this);
-  int id = NewEntityId(*this);
+  RenderState& s = RenderOf(scene);
+  int id = NewEntityId(scene);
   CameraEntry c = MakeEntry(id, name, width, height, fovy, near, far);
   c.local_pose = local_pose;
   c.mount_actor = mount.GetId();
   c.X_WC = X_WC;
   s.cameras.push_back(std::move(c));
-  return Camera(this, id);
+  return Camera(&scene, id);
 }
 
-Camera Scene::AddMountedCamera(const std::string& name, const Link& mount, const Pose& local_pose,
-                               int width, int height, double fovy, double near, double far) {
+Camera AddMountedCamera(Scene& scene, const std::string& name, const Link& mount,
+                        const Pose& local_pose, int width, int height, double fovy, double near,
+                        double far) {
   std::string what = "add_mounted_camera '" + name + "'";
   CheckCameraArgs(what, width, height, fovy, near, far);
   CheckPose(what + ": local_pose", local_pose);
-  if (mount.GetScene() != this) throw Error(what + ": the mount link belongs to another scene");
+  if (mount.GetScene() != &scene) throw Error(what + ": the mount link belongs to another scene");
   // throws when the articulation was removed
-  const size_t links = Articulation(this, mount.GetArticulationId()).GetLinks().size();
+  const size_t links = Articulation(&scene, mount.GetArticulationId()).GetLinks().size();
   if (mount.GetIndex() < 0 || mount.GetIndex() >= static_cast<int>(links))
     throw Error(what + ": link index " + std::to_string(mount.GetIndex()) + " out of range");
   Pose X_WC = mount.GetPose() * local_pose;
-  RenderState& s = RenderOf(*this);
-  int id = NewEntityId(*this);
+  RenderState& s = RenderOf(scene);
+  int id = NewEntityId(scene);
   CameraEntry c = MakeEntry(id, name, width, height, fovy, near, far);
   c.local_pose = local_pose;
   c.mount_articulation = mount.GetArticulationId();
   c.mount_link = mount.GetIndex();
   c.X_WC = X_WC;
   s.cameras.push_back(std::move(c));
-  return Camera(this, id);
+  return Camera(&scene, id);
 }
 
-void Scene::RemoveCamera(const Camera& camera) {
-  RenderState& s = RenderOf(*this);
+void RemoveCamera(Scene& scene, const Camera& camera) {
+  RenderState& s = RenderOf(scene);
   for (auto it = s.cameras.begin(); it != s.cameras.end(); ++it)
-    if (it->id == camera.GetId() && camera.GetScene() == this) {
+    if (it->id == camera.GetId() && camera.GetScene() == &scene) {
       s.cameras.erase(it);
       return;
     }
@@ -203,41 +207,41 @@ void Scene::RemoveCamera(const Camera& camera) {
               " does not exist (it was removed, or belongs to another scene)");
 }
 
-std::vector<Camera> Scene::GetCameras() const {
+std::vector<Camera> GetCameras(const Scene& scene) {
   std::vector<Camera> out;
-  for (const auto& c : RenderOf(*this).cameras) out.emplace_back(const_cast<Scene*>(this), c.id);
+  for (const auto& c : RenderOf(scene).cameras) out.emplace_back(const_cast<Scene*>(&scene), c.id);
   return out;
 }
 
 // ---------------------------------------------------------------------------------------------
 // lights
 
-void Scene::AddDirectionalLight(const Eigen::Vector3d& direction, const Eigen::Vector3f& color,
-                                bool shadow) {
+void AddDirectionalLight(Scene& scene, const Eigen::Vector3d& direction,
+                         const Eigen::Vector3f& color, bool shadow) {
   LightDesc l;
   l.type = LightType::kDirectional;
   l.direction = CheckDirection("add_directional_light", direction);
   CheckColor("add_directional_light", color);
   l.color = color;
   l.shadow = shadow;
-  l.name = "directional_" + std::to_string(RenderOf(*this).lights.size());
-  RenderOf(*this).lights.push_back(l);
+  l.name = "directional_" + std::to_string(RenderOf(scene).lights.size());
+  RenderOf(scene).lights.push_back(l);
 }
 
-void Scene::AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f& color) {
+void AddPointLight(Scene& scene, const Eigen::Vector3d& position, const Eigen::Vector3f& color) {
   CheckFinite("add_point_light: position", position);
   CheckColor("add_point_light", color);
   LightDesc l;
   l.type = LightType::kPoint;
   l.position = position;
   l.color = color;
-  l.name = "point_" + std::to_string(RenderOf(*this).lights.size());
-  RenderOf(*this).lights.push_back(l);
+  l.name = "point_" + std::to_string(RenderOf(scene).lights.size());
+  RenderOf(scene).lights.push_back(l);
 }
 
-void Scene::AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d& direction,
-                         double inner_angle, double outer_angle, const Eigen::Vector3f& color,
-                         bool shadow) {
+void AddSpotLight(Scene& scene, const Eigen::Vector3d& position, const Eigen::Vector3d& direction,
+                  double inner_angle, double outer_angle, const Eigen::Vector3f& color,
+                  bool shadow) {
   CheckFinite("add_spot_light: position", position);
   LightDesc l;
   l.type = LightType::kSpot;
@@ -254,31 +258,31 @@ void Scene::AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d&
   l.outer_angle = outer_angle;
   l.color = color;
   l.shadow = shadow;
-  l.name = "spot_" + std::to_string(RenderOf(*this).lights.size());
-  RenderOf(*this).lights.push_back(l);
+  l.name = "spot_" + std::to_string(RenderOf(scene).lights.size());
+  RenderOf(scene).lights.push_back(l);
 }
 
-void Scene::SetAmbientLight(const Eigen::Vector3f& color) {
+void SetAmbientLight(Scene& scene, const Eigen::Vector3f& color) {
   CheckColor("set_ambient_light", color);
-  RenderOf(*this).ambient = color;
+  RenderOf(scene).ambient = color;
 }
 
-const std::vector<LightDesc>& Scene::GetLights() const { return RenderOf(*this).lights; }
+const std::vector<LightDesc>& GetLights(const Scene& scene) { return RenderOf(scene).lights; }
 
 // ---------------------------------------------------------------------------------------------
 // backend (by name: backend_registry.cc)
 
-void Scene::SetRenderBackend(std::unique_ptr<RenderBackend> backend) {
+void SetRenderBackend(Scene& scene, std::unique_ptr<RenderBackend> backend) {
   if (!backend) throw Error("set_render_backend: backend is null");
-  RenderOf(*this).render_backend = std::move(backend);
+  RenderOf(scene).render_backend = std::move(backend);
 }
 
 // ---------------------------------------------------------------------------------------------
 // render world
 
-void Scene::UpdateRender() {
-  RenderState& s = RenderOf(*this);
-  const uint64_t version = GetDescriptionVersion(*this);  // compiles pending additions
+void UpdateRender(Scene& scene) {
+  RenderState& s = RenderOf(scene);
+  const uint64_t version = GetDescriptionVersion(scene);  // compiles pending additions
   RenderWorld& world = s.render_world;
 
   // rebuild the instances when actors or articulations changed
@@ -307,7 +311,7 @@ void Scene::UpdateRender() {
       instances.push_back(std::move(inst));
       sources.push_back(src);
     };
-    for (const VisualBody& b : GetVisualBodies(*this)) {
+    for (const VisualBody& b : GetVisualBodies(scene)) {
       for (size_t j = 0; j < b.visuals.size(); ++j) {
         RenderSource src;
         src.actor_id = b.actor_id;
@@ -333,8 +337,8 @@ void Scene::UpdateRender() {
     const RenderSource& src = s.render_sources[k];
     std::tuple<int, int, int> body(src.actor_id, src.articulation_id, src.link_index);
     if (body != last_body) {
-      X_WB = src.actor_id >= 0 ? Actor(this, src.actor_id).GetPose()
-                               : Link(this, src.articulation_id, src.link_index).GetPose();
+      X_WB = src.actor_id >= 0 ? Actor(&scene, src.actor_id).GetPose()
+                               : Link(&scene, src.articulation_id, src.link_index).GetPose();
       last_body = body;
     }
     world.instances[k].X_WV = (X_WB * src.X_BV).ToMatrix();
@@ -349,7 +353,7 @@ void Scene::UpdateRender() {
       continue;
     }
     Pose X_WM;
-    if (MountPose(this, c, &X_WM)) {
+    if (MountPose(&scene, c, &X_WM)) {
       c.X_WC = X_WM * c.local_pose;
     } else {
       c.mount_actor = c.mount_articulation = c.mount_link = -1;
@@ -358,11 +362,11 @@ void Scene::UpdateRender() {
   }
 }
 
-const RenderWorld& Scene::GetRenderWorld() const { return RenderOf(*this).render_world; }
+const RenderWorld& GetRenderWorld(const Scene& scene) { return RenderOf(scene).render_world; }
 
-std::vector<RenderEntityInfo> Scene::GetRenderEntities() const {
+std::vector<RenderEntityInfo> GetRenderEntities(const Scene& scene) {
   std::vector<RenderEntityInfo> out;
-  for (const VisualBody& b : GetVisualBodies(*this)) {
+  for (const VisualBody& b : GetVisualBodies(scene)) {
     RenderEntityInfo e;
     e.id = b.entity_id;
     e.is_link = b.actor_id < 0;
@@ -380,9 +384,9 @@ std::vector<RenderEntityInfo> Scene::GetRenderEntities() const {
   return out;
 }
 
-std::vector<RenderVisualInfo> Scene::GetRenderVisuals() const {
+std::vector<RenderVisualInfo> GetRenderVisuals(const Scene& scene) {
   std::vector<RenderVisualInfo> out;
-  for (const VisualBody& b : GetVisualBodies(*this))
+  for (const VisualBody& b : GetVisualBodies(scene))
     for (size_t j = 0; j < b.visuals.size(); ++j)
       out.push_back({b.visual_id_base + static_cast<uint32_t>(j), b.entity_id, b.visuals[j].name});
   return out;

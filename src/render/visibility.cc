@@ -9,6 +9,7 @@
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 
 namespace partsim {
 
@@ -32,8 +33,8 @@ std::vector<std::string> FindHiddenMovingLinks(Scene& scene, const Articulation&
   double radius = std::max(0.5 * (hi - lo).norm(), 0.02);
   const double fovy = 0.8;
   double distance = radius / std::sin(0.5 * fovy) * 1.05;
-  scene.SetRenderBackend(backend);
-  scene.AddDirectionalLight(Eigen::Vector3d(-0.3, 0.4, -1), Eigen::Vector3f(1, 1, 1));
+  SetRenderBackend(scene, backend);
+  AddDirectionalLight(scene, Eigen::Vector3d(-0.3, 0.4, -1), Eigen::Vector3f(1, 1, 1));
   std::vector<Camera> cams;
   // five views around from above (front first: the object's front faces world -y), four
   // around from below (wheels, undersides), one from the top
@@ -51,22 +52,22 @@ std::vector<std::string> FindHiddenMovingLinks(Scene& scene, const Articulation&
   for (size_t i = 0; i < dirs.size(); ++i) {
     const Eigen::Vector3d& dir = dirs[i];
     Eigen::Vector3d eye = centre + distance * dir;
-    Camera cam = scene.AddCamera("quality_" + std::to_string(i), image_size, image_size, fovy, 0.01,
-                                 10 * distance + 1);
+    Camera cam = AddCamera(scene, "quality_" + std::to_string(i), image_size, image_size, fovy,
+                           0.01, 10 * distance + 1);
     cam.SetLocalPose(CameraLookAt(eye, centre));
     cams.push_back(cam);
   }
-  scene.UpdateRender();
+  UpdateRender(scene);
   std::set<uint32_t> seen;
   for (Camera& cam : cams) {
     cam.TakePicture();
     const std::vector<uint32_t>& seg = cam.GetUintPicture("Segmentation");
     for (size_t p = 1; p < seg.size(); p += 2) seen.insert(seg[p]);
   }
-  for (Camera& cam : cams) scene.RemoveCamera(cam);
+  for (Camera& cam : cams) RemoveCamera(scene, cam);
   // map entity ids to links of this articulation
   std::vector<std::string> hidden;
-  std::vector<RenderEntityInfo> entities = scene.GetRenderEntities();
+  std::vector<RenderEntityInfo> entities = GetRenderEntities(scene);
   for (const Joint& j : art.GetActiveJoints()) {
     int link = j.GetChildLink().GetIndex();
     for (const RenderEntityInfo& e : entities) {

@@ -13,6 +13,7 @@
 #include "partsim/core/error.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/scene_render.h"
 
 namespace partsim {
 
@@ -308,7 +309,7 @@ ServedRobot::ServedRobot(SimServer* sim, Scene* scene, ControlLoop* loop, const 
     m.ee_link = options.ee_link.empty() ? links.back().GetName()
                                         : robot.FindLinkByName(options.ee_link).GetName();
   }
-  for (const Camera& cam : scene->GetCameras())
+  for (const Camera& cam : partsim::GetCameras(*scene))
     cameras_.push_back({cam, cam.GetName(), cam.GetName() + "_optical_frame"});
   m.pictured_at.assign(cameras_.size(), -1);
   if (robot.Dof() > 0) m.planner = std::make_unique<MotionPlanner>(robot);
@@ -585,7 +586,7 @@ const Camera& ServedRobot::TakePicture(size_t i) {
   Impl& m = *impl_;
   const long long step = sim_->GetClockSteps();
   if (m.pictured_at.at(i) == step) return cameras_[i].camera;
-  if (m.rendered_at != step) scene_->UpdateRender();  // this step's poses, once for all cameras
+  if (m.rendered_at != step) UpdateRender(*scene_);  // this step's poses, once for all cameras
   m.rendered_at = step;
   cameras_[i].camera.TakePicture(kColor | kPosition);  // what the topics carry: the fast path
   m.pictured_at[i] = step;

@@ -11,6 +11,7 @@
 #include "partsim/core/error.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/render/video.h"
 #include "partsim/tasks/tasks.h"
 #include "tasks/task_internal.h"
@@ -71,7 +72,7 @@ class Runner {
 
   /// Renders the recording camera and writes its frame to the PNG folder and the video.
   void Record() {
-    task_.GetScene().UpdateRender();
+    UpdateRender(task_.GetScene());
     recorder_->TakePicture(kColor);
     const Picture& picture = recorder_->GetPictureData();
     if (!options_.frames_dir.empty()) {

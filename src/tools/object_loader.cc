@@ -59,7 +59,7 @@ void AddObjectArgs(ArgParser* parser, ObjectArgs* args) {
 LoadedObject LoadObject(const ObjectArgs& args, const SceneConfig& config) {
   LoadedObject out;
   out.scene = std::make_unique<Scene>(config);
-  UrdfLoader loader = out.scene->CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(*out.scene);
   loader.fix_root_link = args.fix_root;
   if (args.file.empty()) {
     std::cerr << "partsim: no file given, using the built-in cabinet (a drawer and a door)\n";

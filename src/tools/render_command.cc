@@ -24,6 +24,7 @@
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/scene_render.h"
 
 namespace partsim::tools {
 
@@ -134,11 +135,11 @@ int Render(const RenderArgs& args) {
   if (args.backend == "pathtracer") {
     PathTracerOptions options;
     options.samples_per_pixel = args.spp.value_or(64);
-    scene.SetRenderBackend(MakePathTracerBackend(options));
+    SetRenderBackend(scene, MakePathTracerBackend(options));
   } else {
-    scene.SetRenderBackend(args.backend);
+    SetRenderBackend(scene, args.backend);
   }
-  RenderBackend& backend = scene.GetRenderBackend();
+  RenderBackend& backend = GetRenderBackend(scene);
 
   // the object's extent, from its visuals (else from its link origins)
   // (an MJCF model's: all its articulations and actors but the floor of its worldbody)
@@ -152,11 +153,11 @@ int Render(const RenderArgs& args) {
   auto has = [](const std::vector<int>& v, int id) {
     return id >= 0 && std::find(v.begin(), v.end(), id) != v.end();
   };
-  for (const RenderEntityInfo& e : scene.GetRenderEntities())
+  for (const RenderEntityInfo& e : GetRenderEntities(scene))
     if (has(articulations, e.articulation_id) || has(actors, e.actor_id)) ids.push_back(e.id);
-  scene.UpdateRender();
+  UpdateRender(scene);
   Eigen::Vector3d lo, hi;
-  if (!VisualBounds(scene.GetRenderWorld(), ids, &lo, &hi)) {
+  if (!VisualBounds(GetRenderWorld(scene), ids, &lo, &hi)) {
     if (!l.art.GetScene()) throw std::runtime_error(l.source + ": nothing to draw");
     std::cerr << "partsim render: the object has no visuals; framing its link origins\n";
     lo = hi = l.art.GetLink(0).GetPose().p;
@@ -172,10 +173,10 @@ int Render(const RenderArgs& args) {
 
   // ground under the object, a key light with shadows, a fill light and some ambient
   scene.AddGround(lo.z());
-  scene.AddDirectionalLight(Eigen::Vector3d(-0.4, 0.3, -1.0), Eigen::Vector3f(2.5f, 2.4f, 2.3f),
-                            true);
-  scene.AddDirectionalLight(Eigen::Vector3d(0.5, -0.6, -0.4), Eigen::Vector3f(0.6f, 0.6f, 0.7f));
-  scene.SetAmbientLight(Eigen::Vector3f(0.25f, 0.25f, 0.25f));
+  AddDirectionalLight(scene, Eigen::Vector3d(-0.4, 0.3, -1.0), Eigen::Vector3f(2.5f, 2.4f, 2.3f),
+                      true);
+  AddDirectionalLight(scene, Eigen::Vector3d(0.5, -0.6, -0.4), Eigen::Vector3f(0.6f, 0.6f, 0.7f));
+  SetAmbientLight(scene, Eigen::Vector3f(0.25f, 0.25f, 0.25f));
 
   // cameras on a circle around the centre, 25 degrees above it, the whole object in view
   const double fovy = 0.8;
@@ -183,7 +184,7 @@ int Render(const RenderArgs& args) {
   std::vector<Camera> cameras;
   for (int k = 0; k < args.views; ++k) {
     Camera cam =
-        scene.AddCamera("view_" + std::to_string(k), args.width, args.height, fovy, 0.01, 100.0);
+        AddCamera(scene, "view_" + std::to_string(k), args.width, args.height, fovy, 0.01, 100.0);
     double half_fov = 0.5 * std::min(cam.GetFovx(), cam.GetFovy());
     double distance = 1.1 * radius / std::sin(half_fov);
     double azimuth = pi / 6 + 2 * pi * k / args.views, elevation = 25 * pi / 180;
@@ -192,7 +193,7 @@ int Render(const RenderArgs& args) {
     cam.SetLocalPose(CameraLookAt(centre + distance * dir, centre));
     cameras.push_back(cam);
   }
-  scene.UpdateRender();
+  UpdateRender(scene);
   std::printf("rendering %s: %d views of %d x %d with %s on %s\n", l.source.c_str(), args.views,
               args.width, args.height, backend.Name().c_str(), backend.Device().c_str());
 
@@ -237,7 +238,7 @@ int Render(const RenderArgs& args) {
   legend["source"] = l.source;
   legend["channel"] = "segmentation_K.png colours actors and links (entity ids)";
   legend["entities"] = nlohmann::ordered_json::array();
-  for (const RenderEntityInfo& e : scene.GetRenderEntities()) {
+  for (const RenderEntityInfo& e : GetRenderEntities(scene)) {
     std::array<uint8_t, 3> c = SegmentationColor(e.id);
     nlohmann::ordered_json j;
     j["id"] = e.id;
@@ -249,7 +250,7 @@ int Render(const RenderArgs& args) {
     legend["entities"].push_back(j);
   }
   legend["visuals"] = nlohmann::ordered_json::array();
-  for (const RenderVisualInfo& v : scene.GetRenderVisuals())
+  for (const RenderVisualInfo& v : GetRenderVisuals(scene))
     legend["visuals"].push_back({{"id", v.id}, {"entity_id", v.entity_id}, {"name", v.name}});
   WriteJsonFile(dir / "segmentation.json", legend);
   nlohmann::ordered_json cams;

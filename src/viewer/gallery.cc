@@ -17,6 +17,7 @@
 #include "partsim/physics/scene.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 #include "viewer/http_util.h"
 #include "viewer/png_encode.h"
 
@@ -227,9 +228,9 @@ void Gallery::Open(int index) {
   }
   // standing 2 mm above the ground, so that no part rubs on it while it moves
   for (Articulation& a : added) PlaceOnGround(a, 0.002);
-  scene->SetAmbientLight(Eigen::Vector3f(0.35f, 0.35f, 0.35f));
-  scene->AddDirectionalLight(Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
-  Camera camera = scene->AddCamera("front", 640, 480, 1.0, 0.05, 20.0);
+  SetAmbientLight(*scene, Eigen::Vector3f(0.35f, 0.35f, 0.35f));
+  AddDirectionalLight(*scene, Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+  Camera camera = AddCamera(*scene, "front", 640, 480, 1.0, 0.05, 20.0);
   Eigen::Vector3d lo, hi;
   const Pose X_WB = added.empty() ? Pose() : added.front().GetRootPose();
   WorldBox(X_WB, bounds_lo_[index], bounds_hi_[index], &lo, &hi);
@@ -295,24 +296,24 @@ std::string Gallery::Thumbnail(int index) {
   if (!thumbs_) {
     // one scene (and one rasterizer) for every thumbnail: lit from the front and above
     thumbs_ = std::make_unique<Scene>();
-    thumbs_->SetRenderBackend("rasterizer");
-    thumbs_->SetAmbientLight(Eigen::Vector3f::Constant(0.35f));
-    thumbs_->AddDirectionalLight(Eigen::Vector3d(1, 0.3, -1.5).normalized(),
-                                 Eigen::Vector3f::Constant(2.2f));
-    thumbs_->AddCamera("thumbnail", w, h, 0.8, 0.01, 100.0);
+    SetRenderBackend(*thumbs_, "rasterizer");
+    SetAmbientLight(*thumbs_, Eigen::Vector3f::Constant(0.35f));
+    AddDirectionalLight(*thumbs_, Eigen::Vector3d(1, 0.3, -1.5).normalized(),
+                        Eigen::Vector3f::Constant(2.2f));
+    AddCamera(*thumbs_, "thumbnail", w, h, 0.8, 0.01, 100.0);
   }
   PartNetMobilityLoader loader(thumbs_.get());
   loader.urdf.load_collisions = false;  // drawn, never stepped
   Articulation a = loader.Load(objects_[index].folder);
   std::string png;
   try {
-    Camera camera = thumbs_->GetCameras().front();
+    Camera camera = GetCameras(*thumbs_).front();
     Eigen::Vector3d lo, hi;
     const Pose X_WB = a.GetRootPose();
     WorldBox(X_WB, bounds_lo_[index], bounds_hi_[index], &lo, &hi);
     camera.SetLocalPose(
         FrameObjectCameraPose(lo, hi, X_WB.q * -Eigen::Vector3d::UnitX(), camera.GetFovy()));
-    thumbs_->UpdateRender();
+    UpdateRender(*thumbs_);
     camera.TakePicture(kColor);
     const std::vector<uint8_t> rgba = camera.GetColorRGBA8();
     png = internal::EncodePng(w, h, 4, rgba.data());

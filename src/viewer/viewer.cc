@@ -30,6 +30,7 @@
 #include "partsim/render/camera.h"
 #include "partsim/render/image_io.h"
 #include "partsim/render/image_read.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/server/sim_server.h"
 #include "server/ros_json.h"
 #include "server/web_security.h"
@@ -352,11 +353,11 @@ struct Viewer::Impl {
 
   Json CameraPicture(Scene& s, const std::string& name, const std::string& picture) {
     std::vector<std::string> names;
-    for (const Camera& cam : s.GetCameras()) {
+    for (const Camera& cam : GetCameras(s)) {
       names.push_back(cam.GetName());
       if (cam.GetName() != name) continue;
       Camera c = cam;
-      s.UpdateRender();
+      UpdateRender(s);
       const int w = c.GetWidth(), h = c.GetHeight();
       Json out = {{"picture", picture}, {"width", w}, {"height", h}};
       std::string png;

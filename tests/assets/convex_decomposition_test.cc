@@ -13,6 +13,7 @@
 
 #include "assets/shape_meshes.h"
 #include "partsim/assets/mesh.h"
+#include "partsim/assets/mesh_builders.h"
 #include "partsim/assets/urdf.h"
 #include "partsim/core/error.h"
 #include "partsim/physics/scene.h"
@@ -255,9 +256,8 @@ TEST(ConvexDecompositionTest, WrittenPiecesLoadAndMakeANonConvexCollisionShape) 
       return pts;
     }())};
     WriteConvexPieces(one, dir.string(), "whole");
-    scene.CreateActorBuilder()
-        .AddConvexCollisionFromFile((dir / "whole_0.obj").string())
-        .BuildStatic();
+    ActorBuilder wall = scene.CreateActorBuilder();
+    AddConvexCollisionFromFile(wall, (dir / "whole_0.obj").string()).BuildStatic();
     Vector3d p = DropBallIntoCorner(scene);
     EXPECT_FALSE(std::abs(p.z() - 0.07) < 0.003 && p.x() > 0.05 && p.x() < 0.3)
         << "ball at " << p.transpose();

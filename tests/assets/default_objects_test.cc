@@ -184,7 +184,7 @@ TEST(DefaultObjectsTest, BadOptionsAreNamed) {
 // the drawer and the door.
 TEST(DefaultObjectsTest, CabinetSimulatesWithoutSelfContactAndOpensUnderDrives) {
   Scene scene;
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   loader.fix_root_link = true;
   Articulation cabinet = loader.LoadFromString(MakeCabinetUrdf());
   ASSERT_EQ(cabinet.Dof(), 2);

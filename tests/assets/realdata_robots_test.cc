@@ -125,7 +125,7 @@ TEST(RealDataRobots, KukaVariantsLoadWithTheFilesJoints) {
   for (const char* variant : {"model.urdf", "model_free_base.urdf", "model_vr_limits.urdf"}) {
     SCOPED_TRACE(variant);
     Scene scene;
-    UrdfLoader loader = scene.CreateUrdfLoader();
+    UrdfLoader loader = CreateUrdfLoader(scene);
     Articulation arm = loader.Load((kRealData / "kuka_iiwa" / variant).string());
     EXPECT_EQ(arm.Dof(), 7);
     ExpectJointsOfFile(arm, kRealData / "kuka_iiwa" / variant);
@@ -178,7 +178,7 @@ TEST(RealDataRobots, KukaHeldByDrivesStaysAndReachesTargets) {
   Scene scene;
   scene.AddGround(0.0);
   Articulation arm =
-      scene.CreateUrdfLoader().Load((kRealData / "kuka_iiwa" / "model.urdf").string());
+      CreateUrdfLoader(scene).Load((kRealData / "kuka_iiwa" / "model.urdf").string());
   Eigen::VectorXd home(7);
   home << 0.0, 0.5, 0.0, -1.2, 0.0, 0.8, 0.0;
   // at its home pose under gravity (the file's 300 N m effort limits stay as force limits)
@@ -196,7 +196,7 @@ TEST(RealDataRobots, KukaHeldByDrivesStaysAndReachesTargets) {
 TEST(RealDataRobots, ShadowHandHasADofPerMovingJointAndHoldsItsPose) {
   SKIP_WITHOUT_REALDATA("shadow_hand");
   Scene scene;
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   const fs::path path = kRealData / "shadow_hand" / "shadow_hand.urdf";
   ArticulationDesc desc = loader.ParseFile(path.string());
   Articulation hand = scene.AddArticulation(desc);
@@ -231,7 +231,7 @@ TEST(RealDataRobots, ShadowHandHasADofPerMovingJointAndHoldsItsPose) {
 TEST(RealDataRobots, AnymalLoadsWithBalancedInertiasNamedByLink) {
   SKIP_WITHOUT_REALDATA("anymal_c");
   Scene scene;
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   const fs::path path = kRealData / "anymal_c" / "urdf" / "anymal_c.urdf";
   Articulation robot = loader.Load(path.string());
   EXPECT_EQ(robot.Dof(), 12);

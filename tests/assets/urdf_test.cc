@@ -1028,7 +1028,7 @@ namespace {
 
 TEST(UrdfSceneTest, ArmLoadsWithItsDofsAndKinematics) {
   Scene scene;
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   Articulation arm = loader.Load(kArmUrdf);
   EXPECT_EQ(arm.GetName(), "panda");
   EXPECT_TRUE(arm.HasFixedRoot());
@@ -1064,7 +1064,7 @@ TEST(UrdfSceneTest, ArmLoadsWithItsDofsAndKinematics) {
 
 TEST(UrdfSceneTest, FloatingWorldJointFallsUnderGravity) {
   Scene scene;
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   Articulation a = loader.LoadFromString(
       Robot("<link name=\"world\"/>" + BoxLink("base") +
             Joint("free", "floating", "world", "base", "<origin xyz=\"0 0 2\"/>")),
@@ -1087,7 +1087,7 @@ TEST(UrdfSceneTest, FlatAndTinyCollisionPiecesStillSimulate) {
   for (bool multiple : {false, true}) {
     Scene scene;
     scene.AddGround(0.0);
-    UrdfLoader loader = scene.CreateUrdfLoader();
+    UrdfLoader loader = CreateUrdfLoader(scene);
     loader.fix_root_link = false;
     loader.load_multiple_collisions_from_file = multiple;
     Articulation plate = loader.LoadFromString(
@@ -1134,7 +1134,7 @@ TEST(UrdfSceneTest, MimicJointIsADofThatFollowsItsSource) {
                   "<limit lower=\"0\" upper=\"0.04\" effort=\"50\" velocity=\"1\"/>"
                   "<mimic joint=\"left_joint\" multiplier=\"1\" offset=\"0\"/>"));
   Scene scene;
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   Articulation g = loader.LoadFromString(urdf, kMeshDir);
   // dof counts every non-fixed joint, as SAPIEN does
   ASSERT_EQ(g.Dof(), 2);
@@ -1161,7 +1161,7 @@ TEST(UrdfSceneTest, MimicJointIsADofThatFollowsItsSource) {
 TEST(UrdfSceneTest, MuJoCoErrorsNameTheUrdfsJoints) {
   // a revolute joint whose limits coincide: MuJoCo refuses it; the message names the URDF joint
   Scene scene;
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   loader.LoadFromString(Robot(BoxLink("a")), kMeshDir);  // so the robot is not the first one
   try {
     loader.LoadFromString(
@@ -1195,7 +1195,7 @@ TEST(UrdfSceneTest, MuJoCoErrorsNameTheUrdfsJoints) {
 
 TEST(UrdfSceneTest, ErrorsLeaveTheSceneUsable) {
   Scene scene;
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   EXPECT_THROW(loader.LoadFromString(Robot(BoxLink("a") + BoxLink("a"))), Error);
   EXPECT_TRUE(scene.GetArticulations().empty());
   loader.LoadFromString(Robot(BoxLink("a")));
@@ -1243,7 +1243,7 @@ TEST(UrdfBoundsTest, ChainDeeperThanTheLimitIsRefusedNamingItsLink) {
 TEST(UrdfBoundsTest, ChainAtTheDepthLimitCompiles) {
   // MuJoCo refuses bodies about 1023 below the world: the limit leaves room for a world link
   Scene scene;
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   loader.fix_root_link = false;
   Articulation chain = loader.LoadFromString(GeneratedRobot(kMaxUrdfChainDepth, true, false));
   EXPECT_EQ(chain.Dof(), kMaxUrdfChainDepth);

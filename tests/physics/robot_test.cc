@@ -14,7 +14,7 @@ const std::string kPanda =
 TEST(RobotTest, ArmHoldsItsPoseUnderGravityWithDrivesOnTheInitialPose) {
   Scene scene;
   scene.AddGround(0.0);
-  UrdfLoader loader = scene.CreateUrdfLoader();
+  UrdfLoader loader = CreateUrdfLoader(scene);
   loader.fix_root_link = true;
   Articulation arm = loader.Load(kPanda);
   // 7 arm joints + 2 fingers (the second a dof of its own that follows the first)
@@ -55,7 +55,7 @@ TEST(RobotTest, ArmHoldsItsPoseUnderGravityWithDrivesOnTheInitialPose) {
 
 TEST(RobotTest, ArmWithoutDrivesFallsUnderGravity) {
   Scene scene;
-  Articulation arm = scene.CreateUrdfLoader().Load(kPanda);
+  Articulation arm = CreateUrdfLoader(scene).Load(kPanda);
   Eigen::VectorXd home(9);
   home << 0.0, -0.4, 0.0, -2.1, 0.0, 1.8, 0.8, 0.03, 0.03;
   arm.SetQpos(home);

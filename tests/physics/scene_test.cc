@@ -573,8 +573,8 @@ TEST(SceneTest, ConvexMeshRestsAtItsExtent) {
                     {-0.1f, 0.1f, -0.05f},
                     {0.1f, 0.1f, -0.05f},
                     {0.0f, 0.0f, 0.15f}};
-  // the shape straight into the description (the builder's AddConvexCollisionFromMesh, which
-  // checks the piece first, belongs to the assets layer)
+  // the shape straight into the description (AddConvexCollisionFromMesh, which checks the
+  // piece first, belongs to the assets layer)
   ActorDesc desc;
   desc.name = "wedge";
   desc.pose = Pose(Eigen::Vector3d(0, 0, 0.5));

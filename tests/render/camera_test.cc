@@ -10,6 +10,7 @@
 
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_io.h"
+#include "partsim/render/scene_render.h"
 #include "render/render_test_util.h"
 
 namespace partsim {
@@ -37,12 +38,12 @@ void ExpectPoseNear(const Pose& a, const Pose& b, double tol = 1e-9) {
 
 class CameraTest : public ::testing::Test {
  protected:
-  void SetUp() override { scene_.SetRenderBackend("null"); }
+  void SetUp() override { SetRenderBackend(scene_, "null"); }
   Scene scene_;
 };
 
 TEST_F(CameraTest, IntrinsicsFromFovy) {
-  Camera cam = scene_.AddCamera("c", 640, 480, 1.0, 0.1, 10.0);
+  Camera cam = AddCamera(scene_, "c", 640, 480, 1.0, 0.1, 10.0);
   Eigen::Matrix3d K = cam.GetIntrinsicMatrix();
   double f = 240.0 / std::tan(0.5);
   EXPECT_NEAR(K(0, 0), f, 1e-9);
@@ -72,7 +73,7 @@ TEST_F(CameraTest, IntrinsicsFromFovy) {
 }
 
 TEST_F(CameraTest, OpenCvProjectionEqualsOpenGlProjectionInPixels) {
-  Camera cam = scene_.AddCamera("c", 320, 240, 0.9, 0.05, 20.0);
+  Camera cam = AddCamera(scene_, "c", 320, 240, 0.9, 0.05, 20.0);
   cam.SetIntrinsics(300, 280, 150.25, 125.75);  // off-centre principal point
   Pose X_WC = LookAt(Eigen::Vector3d(1.0, -2.0, 1.5), Eigen::Vector3d(0.1, 0.2, 0.3));
   cam.SetLocalPose(X_WC);
@@ -110,7 +111,7 @@ TEST_F(CameraTest, OpenCvProjectionEqualsOpenGlProjectionInPixels) {
 }
 
 TEST_F(CameraTest, ModelMatrixAxesFollowConventions) {
-  Camera cam = scene_.AddCamera("c", 64, 48, 1.0, 0.1, 10.0);
+  Camera cam = AddCamera(scene_, "c", 64, 48, 1.0, 0.1, 10.0);
   Pose X_WC = LookAt(Eigen::Vector3d(2, 0, 0), Eigen::Vector3d::Zero());
   cam.SetLocalPose(X_WC);
   Eigen::Matrix4d model = cam.GetModelMatrix();
@@ -130,20 +131,20 @@ TEST_F(CameraTest, MountedCameraFollowsItsLinkAndActor) {
   Link arm = lamp.GetLink(1);
   Pose local(Eigen::Vector3d(0.4, 0, 0.1),
              Eigen::Quaterniond(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY())));
-  Camera cam = scene_.AddMountedCamera("wrist", arm, local, 32, 24, 1.0, 0.01, 5.0);
+  Camera cam = AddMountedCamera(scene_, "wrist", arm, local, 32, 24, 1.0, 0.01, 5.0);
   ExpectPoseNear(cam.GetPose(), arm.GetPose() * local);
   for (double q : {0.0, 0.7, -1.9}) {
     lamp.SetQpos(Eigen::VectorXd::Constant(1, q));
-    scene_.UpdateRender();
+    UpdateRender(scene_);
     ExpectPoseNear(cam.GetPose(), arm.GetPose() * local);
     ExpectPoseNear(cam.GetLocalPose(), local);
   }
   // the camera really moved: the arm turns about world z through the hinge
   lamp.SetQpos(Eigen::VectorXd::Constant(1, 0.0));
-  scene_.UpdateRender();
+  UpdateRender(scene_);
   Pose at0 = cam.GetPose();
   lamp.SetQpos(Eigen::VectorXd::Constant(1, M_PI / 2));
-  scene_.UpdateRender();
+  UpdateRender(scene_);
   EXPECT_GT((cam.GetPose().p - at0.p).norm(), 0.3);
   EXPECT_NEAR(cam.GetPose().p.z(), at0.p.z(), 1e-9);
   // a new local pose applies at once
@@ -153,46 +154,46 @@ TEST_F(CameraTest, MountedCameraFollowsItsLinkAndActor) {
 
   // on an actor that falls
   Actor crate = AddCrate(scene_, Eigen::Vector3d(3, 0, 1));
-  Camera cam2 = scene_.AddMountedCamera("top", crate, local, 16, 16, 1.0, 0.01, 5.0);
+  Camera cam2 = AddMountedCamera(scene_, "top", crate, local, 16, 16, 1.0, 0.01, 5.0);
   scene_.Step(100);
-  scene_.UpdateRender();
+  UpdateRender(scene_);
   EXPECT_LT(crate.GetPose().p.z(), 0.99);
   ExpectPoseNear(cam2.GetPose(), crate.GetPose() * local);
   // the mount goes away: the camera stays where it was, now free
   Pose last = cam2.GetPose();
   scene_.RemoveActor(crate);
-  scene_.UpdateRender();
+  UpdateRender(scene_);
   ExpectPoseNear(cam2.GetPose(), last);
-  EXPECT_EQ(scene_.GetCameras().size(), 2u);
+  EXPECT_EQ(GetCameras(scene_).size(), 2u);
 }
 
 TEST_F(CameraTest, BadCameraArgumentsThrowAndLeaveTheSceneUnchanged) {
   auto expect_error = [&](auto&& f, const std::string& word) {
-    size_t before = scene_.GetCameras().size();
+    size_t before = GetCameras(scene_).size();
     try {
       f();
       ADD_FAILURE() << "no error for " << word;
     } catch (const Error& e) {
       EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what();
     }
-    EXPECT_EQ(scene_.GetCameras().size(), before);
+    EXPECT_EQ(GetCameras(scene_).size(), before);
   };
-  expect_error([&] { scene_.AddCamera("c", 0, 10, 1.0, 0.1, 1.0); }, "width");
-  expect_error([&] { scene_.AddCamera("c", 10, 20000, 1.0, 0.1, 1.0); }, "height");
-  expect_error([&] { scene_.AddCamera("c", 10, -3, 1.0, 0.1, 1.0); }, "height");
-  expect_error([&] { scene_.AddCamera("c", 10, 10, 0.0, 0.1, 1.0); }, "fovy");
-  expect_error([&] { scene_.AddCamera("c", 10, 10, M_PI, 0.1, 1.0); }, "fovy");
-  expect_error([&] { scene_.AddCamera("c", 10, 10, kNaN, 0.1, 1.0); }, "fovy");
-  expect_error([&] { scene_.AddCamera("c", 10, 10, 1.0, 1.0, 1.0); }, "far");
-  expect_error([&] { scene_.AddCamera("c", 10, 10, 1.0, 2.0, 1.0); }, "far");
-  expect_error([&] { scene_.AddCamera("c", 10, 10, 1.0, 0.0, 1.0); }, "near");
-  expect_error([&] { scene_.AddCamera("c", 10, 10, 1.0, kNaN, 1.0); }, "near");
+  expect_error([&] { AddCamera(scene_, "c", 0, 10, 1.0, 0.1, 1.0); }, "width");
+  expect_error([&] { AddCamera(scene_, "c", 10, 20000, 1.0, 0.1, 1.0); }, "height");
+  expect_error([&] { AddCamera(scene_, "c", 10, -3, 1.0, 0.1, 1.0); }, "height");
+  expect_error([&] { AddCamera(scene_, "c", 10, 10, 0.0, 0.1, 1.0); }, "fovy");
+  expect_error([&] { AddCamera(scene_, "c", 10, 10, M_PI, 0.1, 1.0); }, "fovy");
+  expect_error([&] { AddCamera(scene_, "c", 10, 10, kNaN, 0.1, 1.0); }, "fovy");
+  expect_error([&] { AddCamera(scene_, "c", 10, 10, 1.0, 1.0, 1.0); }, "far");
+  expect_error([&] { AddCamera(scene_, "c", 10, 10, 1.0, 2.0, 1.0); }, "far");
+  expect_error([&] { AddCamera(scene_, "c", 10, 10, 1.0, 0.0, 1.0); }, "near");
+  expect_error([&] { AddCamera(scene_, "c", 10, 10, 1.0, kNaN, 1.0); }, "near");
   Actor crate = AddCrate(scene_, Eigen::Vector3d(0, 0, 1));
   Pose bad(Eigen::Vector3d(kNaN, 0, 0));
-  expect_error([&] { scene_.AddMountedCamera("m", crate, bad, 8, 8, 1.0, 0.1, 1.0); },
+  expect_error([&] { AddMountedCamera(scene_, "m", crate, bad, 8, 8, 1.0, 0.1, 1.0); },
                "local_pose");
 
-  Camera cam = scene_.AddCamera("ok", 8, 6, 1.0, 0.1, 1.0);
+  Camera cam = AddCamera(scene_, "ok", 8, 6, 1.0, 0.1, 1.0);
   expect_error([&] { cam.SetNearFar(0.5, 0.5); }, "far");
   expect_error([&] { cam.SetFovy(-1); }, "fovy");
   expect_error([&] { cam.SetIntrinsics(0, 1, 1, 1); }, "fx");
@@ -212,11 +213,11 @@ TEST_F(CameraTest, BadCameraArgumentsThrowAndLeaveTheSceneUnchanged) {
   cam.TakePicture();
   EXPECT_EQ(cam.GetFloatPicture("Color").size(), 8u * 6 * 4);
   scene_.Step(10);
-  scene_.UpdateRender();
+  UpdateRender(scene_);
 }
 
 TEST_F(CameraTest, PicturesHaveTheirSizesAndNamedOutputs) {
-  Camera cam = scene_.AddCamera("c", 7, 5, 1.0, 0.1, 10.0);
+  Camera cam = AddCamera(scene_, "c", 7, 5, 1.0, 0.1, 10.0);
   cam.TakePicture();  // no UpdateRender yet: the picture builds the render world itself
   for (const char* name : {"Color", "Albedo", "Normal", "Position"}) {
     EXPECT_TRUE(IsFloatPictureName(name));
@@ -231,8 +232,8 @@ TEST_F(CameraTest, PicturesHaveTheirSizesAndNamedOutputs) {
 }
 
 TEST_F(CameraTest, ColorIsSrgbEncodedAndDepthIsPositionW) {
-  scene_.SetRenderBackend(std::make_unique<PlaneBackend>(1.5, 0.5f));
-  Camera cam = scene_.AddCamera("c", 6, 4, 1.0, 0.1, 10.0);
+  SetRenderBackend(scene_, std::make_unique<PlaneBackend>(1.5, 0.5f));
+  Camera cam = AddCamera(scene_, "c", 6, 4, 1.0, 0.1, 10.0);
   cam.TakePicture();
   std::vector<uint8_t> rgba = cam.GetColorRGBA8();
   std::vector<float> depth = cam.GetDepth();
@@ -248,8 +249,8 @@ TEST_F(CameraTest, ColorIsSrgbEncodedAndDepthIsPositionW) {
 TEST_F(CameraTest, PictureOfSomeOutputsThrowsNamingAnOutputNotTaken) {
   auto backend = std::make_unique<PlaneBackend>(1.5, 0.5f);
   PlaneBackend* plane = backend.get();
-  scene_.SetRenderBackend(std::move(backend));
-  Camera cam = scene_.AddCamera("c", 6, 4, 1.0, 0.1, 10.0);
+  SetRenderBackend(scene_, std::move(backend));
+  Camera cam = AddCamera(scene_, "c", 6, 4, 1.0, 0.1, 10.0);
   cam.TakePicture(kColor | kPosition);
   // the backend was asked for the mask; what it filled beyond it is dropped
   EXPECT_EQ(plane->last_outputs, unsigned{kColor | kPosition});
@@ -302,8 +303,8 @@ TEST_F(CameraTest, PictureOfSomeOutputsThrowsNamingAnOutputNotTaken) {
 TEST_F(CameraTest, SharedPictureSurvivesTheNextPicture) {
   auto backend = std::make_unique<PlaneBackend>(1.0);
   PlaneBackend* plane = backend.get();
-  scene_.SetRenderBackend(std::move(backend));
-  Camera cam = scene_.AddCamera("c", 4, 4, 1.0, 0.1, 10.0);
+  SetRenderBackend(scene_, std::move(backend));
+  Camera cam = AddCamera(scene_, "c", 4, 4, 1.0, 0.1, 10.0);
   cam.TakePicture();
   std::shared_ptr<const Picture> first = cam.GetSharedPicture();
   const float* first_data = first->position.data();
@@ -338,8 +339,8 @@ class FailingBackend : public PlaneBackend {
 TEST_F(CameraTest, RefusedOutputsKeepTheLastPictureAndAFailedRenderDropsIt) {
   auto backend = std::make_unique<FailingBackend>();
   FailingBackend* failing = backend.get();
-  scene_.SetRenderBackend(std::move(backend));
-  Camera cam = scene_.AddCamera("c", 4, 3, 1.0, 0.1, 10.0);
+  SetRenderBackend(scene_, std::move(backend));
+  Camera cam = AddCamera(scene_, "c", 4, 3, 1.0, 0.1, 10.0);
   cam.TakePicture(kColor);
   const std::vector<float> color = cam.GetFloatPicture("Color");
   // the backend's Render refuses the outputs before it renders: the last picture stays
@@ -362,27 +363,27 @@ TEST_F(CameraTest, RefusedOutputsKeepTheLastPictureAndAFailedRenderDropsIt) {
 }
 
 TEST_F(CameraTest, RemovedCameraHandleThrows) {
-  Camera cam = scene_.AddCamera("c", 4, 4, 1.0, 0.1, 10.0);
-  Camera other = scene_.AddCamera("d", 4, 4, 1.0, 0.1, 10.0);
+  Camera cam = AddCamera(scene_, "c", 4, 4, 1.0, 0.1, 10.0);
+  Camera other = AddCamera(scene_, "d", 4, 4, 1.0, 0.1, 10.0);
   EXPECT_NE(cam.GetId(), other.GetId());
-  scene_.RemoveCamera(cam);
+  RemoveCamera(scene_, cam);
   EXPECT_THROW(cam.GetName(), Error);
-  EXPECT_THROW(scene_.RemoveCamera(cam), Error);
+  EXPECT_THROW(RemoveCamera(scene_, cam), Error);
   EXPECT_THROW(Camera().GetWidth(), Error);
-  ASSERT_EQ(scene_.GetCameras().size(), 1u);
-  EXPECT_EQ(scene_.GetCameras()[0].GetName(), "d");
+  ASSERT_EQ(GetCameras(scene_).size(), 1u);
+  EXPECT_EQ(GetCameras(scene_)[0].GetName(), "d");
 }
 
 TEST_F(CameraTest, CloneKeepsCameras) {
-  Camera cam = scene_.AddCamera("c", 40, 30, 0.8, 0.1, 10.0);
+  Camera cam = AddCamera(scene_, "c", 40, 30, 0.8, 0.1, 10.0);
   cam.SetLocalPose(Pose(Eigen::Vector3d(1, 2, 3)));
   std::unique_ptr<Scene> copy = scene_.Clone();
-  ASSERT_EQ(copy->GetCameras().size(), 1u);
-  Camera c2 = copy->GetCameras()[0];
+  ASSERT_EQ(GetCameras(*copy).size(), 1u);
+  Camera c2 = GetCameras(*copy)[0];
   EXPECT_EQ(c2.GetName(), "c");
   EXPECT_NEAR(c2.GetFovy(), 0.8, 1e-12);
   ExpectPoseNear(c2.GetPose(), cam.GetPose());
-  copy->SetRenderBackend("null");
+  SetRenderBackend(*copy, "null");
   c2.TakePicture();
   EXPECT_EQ(c2.GetDepth().size(), 1200u);
 }
@@ -396,7 +397,7 @@ namespace {
 // LookAt: the view axis goes through the target, z follows `up`, and a mounted camera takes
 // eye and target in its mount's frame.
 TEST_F(CameraTest, LookAtPointsTheCameraAtTheTarget) {
-  Camera cam = scene_.AddCamera("c", 64, 48, 1.0, 0.01, 10.0);
+  Camera cam = AddCamera(scene_, "c", 64, 48, 1.0, 0.01, 10.0);
   const Eigen::Vector3d eye(1.0, -2.0, 1.5), target(0.2, 0.3, 0.4);
   cam.LookAt(eye, target);
   Pose X = cam.GetPose();
@@ -424,7 +425,7 @@ TEST_F(CameraTest, LookAtPointsTheCameraAtTheTarget) {
 
   // mounted: in the mount's frame
   Actor crate = AddCrate(scene_, Eigen::Vector3d(3, 0, 1));
-  Camera wrist = scene_.AddMountedCamera("m", crate, Pose(), 16, 16, 1.0, 0.01, 5.0);
+  Camera wrist = AddMountedCamera(scene_, "m", crate, Pose(), 16, 16, 1.0, 0.01, 5.0);
   wrist.LookAt(Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d::Zero());
   ExpectPoseNear(wrist.GetLocalPose(), LookAt(Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d::Zero()));
   ExpectPoseNear(wrist.GetPose(), crate.GetPose() * wrist.GetLocalPose());

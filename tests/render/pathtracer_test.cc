@@ -18,6 +18,7 @@
 #include "partsim/render/backend.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 #include "render/jpeg_test_util.h"
 #include "render/render_test_util.h"
 
@@ -517,20 +518,20 @@ TEST(PathTracerTest, ThroughTheSceneAndItsCamera) {
   scene.AddGround();
   Articulation lamp = testing::AddLamp(scene);
   testing::AddCrate(scene, {-0.3, 0.3, 0.1});
-  scene.AddDirectionalLight({-0.3, 0.2, -1.0}, {1.5f, 1.5f, 1.5f}, true);
-  scene.AddPointLight({0.5, -0.5, 1.5}, {0.5f, 0.5f, 0.5f});
-  scene.SetAmbientLight({0.2f, 0.2f, 0.2f});
-  scene.SetRenderBackend("pathtracer");
-  EXPECT_EQ(scene.GetRenderBackend().Name(), "pathtracer");
-  partsim::Camera cam = scene.AddCamera("c", 64, 48, 1.0, 0.05, 20.0);
+  AddDirectionalLight(scene, {-0.3, 0.2, -1.0}, {1.5f, 1.5f, 1.5f}, true);
+  AddPointLight(scene, {0.5, -0.5, 1.5}, {0.5f, 0.5f, 0.5f});
+  SetAmbientLight(scene, {0.2f, 0.2f, 0.2f});
+  SetRenderBackend(scene, "pathtracer");
+  EXPECT_EQ(GetRenderBackend(scene).Name(), "pathtracer");
+  partsim::Camera cam = AddCamera(scene, "c", 64, 48, 1.0, 0.05, 20.0);
   cam.SetLocalPose(LookAt({1.4, -1.2, 1.1}, {0.1, 0, 0.3}));
-  scene.UpdateRender();
+  UpdateRender(scene);
   cam.TakePicture();
   const Picture pic = cam.GetPictureData();
 
   // every id seen names a visual of the scene; the lamp's four visuals and the crate are seen
   std::map<uint32_t, RenderVisualInfo> visuals;
-  for (const RenderVisualInfo& v : scene.GetRenderVisuals()) visuals[v.id] = v;
+  for (const RenderVisualInfo& v : GetRenderVisuals(scene)) visuals[v.id] = v;
   std::set<std::string> seen;
   for (int i = 0; i < pic.width * pic.height; ++i) {
     uint32_t id = pic.segmentation[2 * i];
@@ -545,7 +546,7 @@ TEST(PathTracerTest, ThroughTheSceneAndItsCamera) {
 
   // the picture is the backend's picture of the scene's render world
   Picture direct;
-  MakePathTracerBackend()->Render(scene.GetRenderWorld(), cam.GetParams(), &direct);
+  MakePathTracerBackend()->Render(GetRenderWorld(scene), cam.GetParams(), &direct);
   EXPECT_EQ(0,
             std::memcmp(direct.color.data(), pic.color.data(), pic.color.size() * sizeof(float)));
   EXPECT_EQ(direct.segmentation, pic.segmentation);
@@ -558,7 +559,7 @@ TEST(PathTracerTest, ThroughTheSceneAndItsCamera) {
   int n_before, n_after;
   Eigen::Vector2d before = Centroid(pic, bulb, &n_before);
   lamp.SetQpos(Eigen::VectorXd::Constant(1, 1.2));
-  scene.UpdateRender();
+  UpdateRender(scene);
   cam.TakePicture();
   Eigen::Vector2d after = Centroid(cam.GetPictureData(), bulb, &n_after);
   ASSERT_GT(n_before, 0);

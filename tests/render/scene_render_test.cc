@@ -1,4 +1,6 @@
 // The scene's render world, ids, lights and backend choice.
+#include "partsim/render/scene_render.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,17 +23,17 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 class SceneRenderTest : public ::testing::Test {
  protected:
-  void SetUp() override { scene_.SetRenderBackend("null"); }
+  void SetUp() override { SetRenderBackend(scene_, "null"); }
   Scene scene_;
 };
 
 // The pose of every instance is its body's pose composed with the visual's pose.
 void ExpectInstancesFollowBodies(Scene& scene) {
-  const RenderWorld& world = scene.GetRenderWorld();
+  const RenderWorld& world = GetRenderWorld(scene);
   std::map<uint32_t, RenderVisualInfo> visuals;
-  for (const RenderVisualInfo& v : scene.GetRenderVisuals()) visuals[v.id] = v;
+  for (const RenderVisualInfo& v : GetRenderVisuals(scene)) visuals[v.id] = v;
   std::map<uint32_t, RenderEntityInfo> entities;
-  for (const RenderEntityInfo& e : scene.GetRenderEntities()) entities[e.id] = e;
+  for (const RenderEntityInfo& e : GetRenderEntities(scene)) entities[e.id] = e;
   for (const RenderInstance& inst : world.instances) {
     ASSERT_TRUE(entities.count(inst.entity_id)) << inst.entity_id;
     ASSERT_TRUE(visuals.count(inst.visual_id)) << inst.visual_id;
@@ -62,8 +64,8 @@ TEST_F(SceneRenderTest, InstancesFollowBodiesAndIdsNameThem) {
   scene_.AddGround();
   Articulation lamp = AddLamp(scene_);
   Actor crate = AddCrate(scene_, Eigen::Vector3d(1, 1, 0.5));
-  scene_.UpdateRender();
-  const RenderWorld& world = scene_.GetRenderWorld();
+  UpdateRender(scene_);
+  const RenderWorld& world = GetRenderWorld(scene_);
   // ground 1 + crate 1 + lamp 2 + 2
   ASSERT_EQ(world.instances.size(), 6u);
   ExpectInstancesFollowBodies(scene_);
@@ -71,7 +73,7 @@ TEST_F(SceneRenderTest, InstancesFollowBodiesAndIdsNameThem) {
   // move things: the arm turns, the crate falls
   lamp.SetQpos(Eigen::VectorXd::Constant(1, 1.1));
   scene_.Step(50);
-  scene_.UpdateRender();
+  UpdateRender(scene_);
   ExpectInstancesFollowBodies(scene_);
 
   // ids are unique and name the right things
@@ -84,7 +86,7 @@ TEST_F(SceneRenderTest, InstancesFollowBodiesAndIdsNameThem) {
   }
   EXPECT_EQ(entity_ids.size(), 4u);  // ground, base, arm, crate
   std::map<std::string, RenderEntityInfo> by_name;
-  for (const RenderEntityInfo& e : scene_.GetRenderEntities()) by_name[e.name] = e;
+  for (const RenderEntityInfo& e : GetRenderEntities(scene_)) by_name[e.name] = e;
   ASSERT_EQ(by_name.size(), 4u);
   EXPECT_FALSE(by_name["ground"].is_link);
   EXPECT_FALSE(by_name["crate"].is_link);
@@ -97,7 +99,7 @@ TEST_F(SceneRenderTest, InstancesFollowBodiesAndIdsNameThem) {
   EXPECT_EQ(by_name["arm"].semantic_label, "lid");
   EXPECT_EQ(by_name["base"].semantic_label, "body");
   std::map<std::string, RenderVisualInfo> visual_by_name;
-  for (const RenderVisualInfo& v : scene_.GetRenderVisuals()) visual_by_name[v.name] = v;
+  for (const RenderVisualInfo& v : GetRenderVisuals(scene_)) visual_by_name[v.name] = v;
   EXPECT_EQ(visual_by_name["bulb"].entity_id, by_name["arm"].id);
   EXPECT_EQ(visual_by_name["post"].entity_id, by_name["base"].id);
   EXPECT_EQ(visual_by_name["lid_panel"].entity_id, by_name["crate"].id);
@@ -109,8 +111,8 @@ TEST_F(SceneRenderTest, InstancesFollowBodiesAndIdsNameThem) {
 
 TEST_F(SceneRenderTest, GroundIsALargeSquare) {
   scene_.AddGround(0.25);
-  scene_.UpdateRender();
-  const RenderWorld& world = scene_.GetRenderWorld();
+  UpdateRender(scene_);
+  const RenderWorld& world = GetRenderWorld(scene_);
   ASSERT_EQ(world.instances.size(), 1u);
   const MeshData& m = *world.instances[0].mesh;
   ASSERT_EQ(m.faces.size(), 2u);
@@ -126,76 +128,77 @@ TEST_F(SceneRenderTest, GroundIsALargeSquare) {
 
 TEST_F(SceneRenderTest, GeometryVersionChangesOnlyWithMeshesOrMaterials) {
   Actor crate = AddCrate(scene_, Eigen::Vector3d(0, 0, 1));
-  scene_.UpdateRender();
-  const RenderWorld& world = scene_.GetRenderWorld();
+  UpdateRender(scene_);
+  const RenderWorld& world = GetRenderWorld(scene_);
   uint64_t v0 = world.geometry_version;
   std::shared_ptr<const MeshData> mesh = world.instances.at(0).mesh;
   // poses only
   scene_.Step(20);
-  scene_.UpdateRender();
+  UpdateRender(scene_);
   EXPECT_EQ(world.geometry_version, v0);
   // a recompile that changes no geometry (timestep) keeps the version and the mesh
   scene_.SetTimestep(0.001);
-  scene_.UpdateRender();
+  UpdateRender(scene_);
   EXPECT_EQ(world.geometry_version, v0);
   EXPECT_EQ(world.instances.at(0).mesh, mesh);
   // a new actor with the same primitive shares its mesh
   Actor crate2 = AddCrate(scene_, Eigen::Vector3d(2, 0, 1), "crate2");
-  scene_.UpdateRender();
+  UpdateRender(scene_);
   EXPECT_NE(world.geometry_version, v0);
   ASSERT_EQ(world.instances.size(), 2u);
   EXPECT_EQ(world.instances[1].mesh, mesh);
   // removing an actor removes its instances
   uint64_t v1 = world.geometry_version;
   scene_.RemoveActor(crate);
-  scene_.UpdateRender();
+  UpdateRender(scene_);
   EXPECT_NE(world.geometry_version, v1);
   ASSERT_EQ(world.instances.size(), 1u);
-  EXPECT_EQ(world.instances[0].entity_id, scene_.GetRenderEntities().at(0).id);
-  EXPECT_EQ(scene_.GetRenderEntities().at(0).name, "crate2");
+  EXPECT_EQ(world.instances[0].entity_id, GetRenderEntities(scene_).at(0).id);
+  EXPECT_EQ(GetRenderEntities(scene_).at(0).name, "crate2");
   EXPECT_EQ(world.instances[0].mesh, mesh);
 }
 
 TEST_F(SceneRenderTest, LightsAreValidatedAndCopiedIntoTheWorld) {
-  scene_.AddDirectionalLight(Eigen::Vector3d(0, 0, -2), Eigen::Vector3f(1, 1, 1), true);
-  scene_.AddPointLight(Eigen::Vector3d(1, 2, 3), Eigen::Vector3f(2, 2, 2));
-  scene_.AddSpotLight(Eigen::Vector3d(0, 0, 3), Eigen::Vector3d(0, 0, -1), 0.2, 0.4,
-                      Eigen::Vector3f(5, 5, 5));
-  scene_.SetAmbientLight(Eigen::Vector3f(0.3f, 0.3f, 0.3f));
+  AddDirectionalLight(scene_, Eigen::Vector3d(0, 0, -2), Eigen::Vector3f(1, 1, 1), true);
+  AddPointLight(scene_, Eigen::Vector3d(1, 2, 3), Eigen::Vector3f(2, 2, 2));
+  AddSpotLight(scene_, Eigen::Vector3d(0, 0, 3), Eigen::Vector3d(0, 0, -1), 0.2, 0.4,
+               Eigen::Vector3f(5, 5, 5));
+  SetAmbientLight(scene_, Eigen::Vector3f(0.3f, 0.3f, 0.3f));
   // refused: the light list stays as it was
-  EXPECT_THROW(scene_.AddDirectionalLight(Eigen::Vector3d::Zero(), Eigen::Vector3f::Ones()), Error);
-  EXPECT_THROW(scene_.AddPointLight(Eigen::Vector3d(kNaN, 0, 0), Eigen::Vector3f::Ones()), Error);
-  EXPECT_THROW(scene_.AddPointLight(Eigen::Vector3d::Zero(), Eigen::Vector3f(-1, 0, 0)), Error);
-  EXPECT_THROW(scene_.AddSpotLight(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.3,
-                                   Eigen::Vector3f::Ones()),
+  EXPECT_THROW(AddDirectionalLight(scene_, Eigen::Vector3d::Zero(), Eigen::Vector3f::Ones()),
                Error);
-  EXPECT_THROW(scene_.AddSpotLight(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.1, 2.0,
-                                   Eigen::Vector3f::Ones()),
+  EXPECT_THROW(AddPointLight(scene_, Eigen::Vector3d(kNaN, 0, 0), Eigen::Vector3f::Ones()), Error);
+  EXPECT_THROW(AddPointLight(scene_, Eigen::Vector3d::Zero(), Eigen::Vector3f(-1, 0, 0)), Error);
+  EXPECT_THROW(AddSpotLight(scene_, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.3,
+                            Eigen::Vector3f::Ones()),
                Error);
-  EXPECT_THROW(scene_.SetAmbientLight(Eigen::Vector3f(0, -1, 0)), Error);
-  ASSERT_EQ(scene_.GetLights().size(), 3u);
-  EXPECT_EQ(scene_.GetLights()[0].type, LightType::kDirectional);
-  EXPECT_TRUE(scene_.GetLights()[0].shadow);
-  EXPECT_LT((scene_.GetLights()[0].direction - Eigen::Vector3d(0, 0, -1)).norm(), 1e-12);
-  EXPECT_EQ(scene_.GetLights()[2].outer_angle, 0.4);
-  scene_.UpdateRender();
-  EXPECT_EQ(scene_.GetRenderWorld().lights.size(), 3u);
-  EXPECT_EQ(scene_.GetRenderWorld().ambient, Eigen::Vector3f(0.3f, 0.3f, 0.3f));
+  EXPECT_THROW(AddSpotLight(scene_, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.1, 2.0,
+                            Eigen::Vector3f::Ones()),
+               Error);
+  EXPECT_THROW(SetAmbientLight(scene_, Eigen::Vector3f(0, -1, 0)), Error);
+  ASSERT_EQ(GetLights(scene_).size(), 3u);
+  EXPECT_EQ(GetLights(scene_)[0].type, LightType::kDirectional);
+  EXPECT_TRUE(GetLights(scene_)[0].shadow);
+  EXPECT_LT((GetLights(scene_)[0].direction - Eigen::Vector3d(0, 0, -1)).norm(), 1e-12);
+  EXPECT_EQ(GetLights(scene_)[2].outer_angle, 0.4);
+  UpdateRender(scene_);
+  EXPECT_EQ(GetRenderWorld(scene_).lights.size(), 3u);
+  EXPECT_EQ(GetRenderWorld(scene_).ambient, Eigen::Vector3f(0.3f, 0.3f, 0.3f));
 }
 
 TEST_F(SceneRenderTest, BackendsByName) {
-  EXPECT_EQ(scene_.GetRenderBackend().Name(), "null");
+  EXPECT_EQ(GetRenderBackend(scene_).Name(), "null");
   try {
-    scene_.SetRenderBackend("vulkan");
+    SetRenderBackend(scene_, "vulkan");
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("rasterizer, pathtracer or null"), std::string::npos);
   }
   // the refused name kept the backend
-  EXPECT_EQ(scene_.GetRenderBackend().Name(), "null");
-  EXPECT_THROW(scene_.SetRenderBackend(std::unique_ptr<RenderBackend>()), Error);
-  scene_.SetRenderBackend(std::make_unique<testing::PlaneBackend>());
-  EXPECT_EQ(scene_.GetRenderBackend().Name(), "test-plane");
+  EXPECT_EQ(GetRenderBackend(scene_).Name(), "null");
+  EXPECT_THROW(SetRenderBackend(scene_, std::unique_ptr<RenderBackend>()), Error);
+  SetRenderBackend(scene_, std::make_unique<testing::PlaneBackend>());
+  EXPECT_EQ(GetRenderBackend(scene_).Name(), "test-plane");
 }
 
 }  // namespace

@@ -424,7 +424,7 @@ TEST(RobotsUrdfTest, RoundTripKeepsKinematicsMassesLimitsAndDrives) {
     WriteUrdf(robot.articulation, path);
     Scene scene;
     Articulation original = scene.AddArticulation(robot.articulation);
-    Articulation loaded = scene.CreateUrdfLoader().Load(path);
+    Articulation loaded = CreateUrdfLoader(scene).Load(path);
     EXPECT_EQ(loaded.GetName(), robot.articulation.name);
     ExpectSameArticulation(&scene, original, loaded);
     // the pads keep their friction
@@ -440,7 +440,7 @@ TEST(RobotsUrdfTest, FlyingGripperFromUrdfReachesAPoseTarget) {
   RobotModel robot = BuildFlyingGripper();
   WriteUrdf(robot.articulation, dir / "gripper.urdf");
   Scene scene;
-  Articulation art = scene.CreateUrdfLoader().Load(dir / "gripper.urdf");
+  Articulation art = CreateUrdfLoader(scene).Load(dir / "gripper.urdf");
   const Pose target(Vector3d(-0.2, 0.1, 0.3), Quaterniond(AngleAxisd(-0.5, Vector3d::UnitZ()) *
                                                           AngleAxisd(0.3, Vector3d::UnitY()) *
                                                           AngleAxisd(-0.8, Vector3d::UnitX())));
@@ -515,7 +515,7 @@ TEST(RobotsUrdfTest, MeshesOffsetJointsAndFreeRootsRoundTrip) {
   Scene scene;
   scene.SetGravity(Vector3d::Zero());
   Articulation original = scene.AddArticulation(art);
-  Articulation loaded = scene.CreateUrdfLoader().Load(dir / "odd.urdf");
+  Articulation loaded = CreateUrdfLoader(scene).Load(dir / "odd.urdf");
   EXPECT_FALSE(loaded.HasFixedRoot());
   const LinkDesc& b = loaded.FindLinkByName("base").GetDesc();
   ASSERT_EQ(b.collisions.size(), 1u);

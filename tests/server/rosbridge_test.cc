@@ -31,6 +31,7 @@
 
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/robot/robots.h"
 #include "server/wait_for.h"
 #include "server/ws_test_client.h"
@@ -1279,9 +1280,9 @@ class RosbridgeSensorTest : public ::testing::Test {
     RobotModel m = BuildFlyingGripper();
     m.articulation.root_pose = Pose(Eigen::Vector3d(0, 0, 0.5));
     robot_ = scene_->AddArticulation(m.articulation);
-    scene_->SetAmbientLight(Eigen::Vector3f(0.35f, 0.35f, 0.35f));
-    scene_->AddDirectionalLight(Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
-    camera_ = scene_->AddCamera("cam", width, height, 1.0, 0.05, 20.0);
+    SetAmbientLight(*scene_, Eigen::Vector3f(0.35f, 0.35f, 0.35f));
+    AddDirectionalLight(*scene_, Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+    camera_ = AddCamera(*scene_, "cam", width, height, 1.0, 0.05, 20.0);
     camera_.SetLocalPose(CameraLookAt(Eigen::Vector3d(1.2, -0.8, 1.0), Eigen::Vector3d(0, 0, 0.4)));
     loop_ = std::make_unique<ControlLoop>(scene_.get());
     sim_ = std::make_unique<SimServer>(scene_.get(), loop_.get());

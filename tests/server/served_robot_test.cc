@@ -21,6 +21,7 @@
 
 #include "partsim/core/error.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/robot/robots.h"
 #include "server/wait_for.h"
 
@@ -112,7 +113,7 @@ class World {
       robot.SetQpos(q);
     }
     if (o.camera) {
-      camera = scene.AddCamera("cam", 32, 24, 1.0, 0.05, 20.0);
+      camera = AddCamera(scene, "cam", 32, 24, 1.0, 0.05, 20.0);
       camera.SetLocalPose(CameraLookAt(eye, target));
     }
     loop = std::make_unique<ControlLoop>(&scene);

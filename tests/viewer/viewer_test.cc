@@ -34,6 +34,7 @@
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
 #include "partsim/render/image_read.h"
+#include "partsim/render/scene_render.h"
 #include "partsim/server/sim_server.h"
 #include "server/wait_for.h"
 #include "server/ws_test_client.h"
@@ -591,7 +592,7 @@ TEST_F(ViewerTest, ThePageSeesTheStateTheSimulationRestsIn) {
 }
 
 TEST_F(ViewerTest, CameraServiceAnswersAPngThatDecodes) {
-  Camera cam = scene_->AddCamera("front", 64, 48, 1.0, 0.05, 20.0);
+  Camera cam = AddCamera(*scene_, "front", 64, 48, 1.0, 0.05, 20.0);
   cam.SetLocalPose(CameraLookAt(Eigen::Vector3d(2, -2, 1.5), Eigen::Vector3d(0, 0, 0.4)));
   Viewer& v = Start();
   EXPECT_EQ(SceneJson()["cameras"][0]["name"], "front");

@@ -77,4 +77,8 @@ class UrdfLoader {
   mutable LoadReport last_report_;
 };
 
+/// A loader whose Load adds to `scene` (SAPIEN's scene.create_urdf_loader()); the scene must
+/// outlive it.
+UrdfLoader CreateUrdfLoader(Scene& scene);
+
 }  // namespace partsim

@@ -23,15 +23,8 @@ namespace partsim {
 
 class Scene;
 class Shape;
-class Camera;
-class RenderBackend;
-struct RenderWorld;
-struct LightDesc;
-struct RenderEntityInfo;
-struct RenderVisualInfo;
 class ActorBuilder;
 class ArticulationBuilder;
-class UrdfLoader;
 
 /// Numerical integrator of the scene (MuJoCo's). kImplicitFast, the default, integrates joint
 /// damping and the drives' velocity terms implicitly, as kImplicit does, and leaves out the
@@ -376,7 +369,9 @@ struct Warning {
   std::string message;
 };
 
-/// A simulated world. Non-copyable; use Clone().
+/// A simulated world. Non-copyable; use Clone(). Its cameras, lights and rendering are free
+/// functions of the render layer (partsim/render/scene_render.h: AddCamera(scene, ...)), its URDF
+/// loader one of the assets layer (partsim/assets/urdf.h: CreateUrdfLoader(scene)).
 class Scene {
  public:
   explicit Scene(const SceneConfig& config = SceneConfig());
@@ -397,7 +392,6 @@ class Scene {
 
   ActorBuilder CreateActorBuilder();
   ArticulationBuilder CreateArticulationBuilder();
-  UrdfLoader CreateUrdfLoader();
 
   /// Adds a static ground plane at z = altitude. Cameras see a square of `render_half_size`
   /// (m) around the origin with `render_material`, or nothing when `render` is false.
@@ -436,39 +430,6 @@ class Scene {
   std::vector<char> Pack() const;
   /// Restores a state from Pack() of this scene (same actors and articulations).
   void Unpack(const std::vector<char>& state);
-
-  // --- rendering (implemented in src/render) ---
-
-  /// A camera fixed in the world: image size (pixels), vertical field of view (rad), clipping
-  /// distances (m). Place it with Camera::SetLocalPose.
-  Camera AddCamera(const std::string& name, int width, int height, double fovy, double near,
-                   double far);
-  /// A camera that moves with an actor or a link; `local_pose` is X_MC in the mount's frame.
-  Camera AddMountedCamera(const std::string& name, const Actor& mount, const Pose& local_pose,
-                          int width, int height, double fovy, double near, double far);
-  Camera AddMountedCamera(const std::string& name, const Link& mount, const Pose& local_pose,
-                          int width, int height, double fovy, double near, double far);
-  void RemoveCamera(const Camera& camera);
-  std::vector<Camera> GetCameras() const;
-  /// Lights. Directions in the world frame, colours linear RGB, angles in radians.
-  void AddDirectionalLight(const Eigen::Vector3d& direction, const Eigen::Vector3f& color,
-                           bool shadow = false);
-  void AddPointLight(const Eigen::Vector3d& position, const Eigen::Vector3f& color);
-  void AddSpotLight(const Eigen::Vector3d& position, const Eigen::Vector3d& direction,
-                    double inner_angle, double outer_angle, const Eigen::Vector3f& color,
-                    bool shadow = false);
-  void SetAmbientLight(const Eigen::Vector3f& color);
-  const std::vector<LightDesc>& GetLights() const;
-  /// Chooses the backend: "rasterizer" (default), "pathtracer" or "null"; or a given one.
-  void SetRenderBackend(const std::string& name);
-  void SetRenderBackend(std::unique_ptr<RenderBackend> backend);
-  RenderBackend& GetRenderBackend();
-  /// Copies the current poses of everything visible into the render world.
-  void UpdateRender();
-  const RenderWorld& GetRenderWorld() const;
-  /// Render ids of actors and links, and of visual shapes (ids used by "Segmentation").
-  std::vector<RenderEntityInfo> GetRenderEntities() const;
-  std::vector<RenderVisualInfo> GetRenderVisuals() const;
 
   /// The compiled MuJoCo model and data (compiled on demand). Read freely; writing is at your
   /// own risk.
@@ -509,7 +470,8 @@ class Scene {
 };
 
 /// Shape, visual and mass methods shared by actor and link builders (CRTP: each returns the
-/// derived builder so that calls chain).
+/// derived builder so that calls chain). Shapes and visuals read from mesh files are added by
+/// the assets layer (partsim/assets/mesh_builders.h: AddVisualFromFile(builder, ...)).
 template <typename Derived>
 class BodyBuilder {
  public:
@@ -529,22 +491,6 @@ class BodyBuilder {
   Derived& AddCylinderCollision(const Pose& pose, double radius, double half_length,
                                 const std::optional<PhysicalMaterial>& material = {},
                                 double density = 1000.0);
-  /// Convex hull of a mesh file's vertices (scaled). Pieces MuJoCo cannot collide with (flat,
-  /// line-like, under 0.1 mm: CheckConvexPiece) get a thin hull or are dropped, and a non-convex
-  /// file is warned about once (partsim::LogWarning); the same holds for the adders below.
-  Derived& AddConvexCollisionFromFile(const std::string& filename, const Pose& pose = Pose(),
-                                      const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
-                                      const std::optional<PhysicalMaterial>& material = {},
-                                      double density = 1000.0);
-  /// One convex piece per sub-mesh (and connected component) of a mesh file.
-  Derived& AddMultipleConvexCollisionsFromFile(
-      const std::string& filename, const Pose& pose = Pose(),
-      const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
-      const std::optional<PhysicalMaterial>& material = {}, double density = 1000.0);
-  Derived& AddConvexCollisionFromMesh(std::shared_ptr<const MeshData> mesh,
-                                      const Pose& pose = Pose(),
-                                      const std::optional<PhysicalMaterial>& material = {},
-                                      double density = 1000.0);
   /// Visuals with a linear RGBA colour and an optional name (e.g. a part name).
   Derived& AddBoxVisual(const Pose& pose, const Eigen::Vector3d& half_size,
                         const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
@@ -557,10 +503,6 @@ class BodyBuilder {
                             const std::string& name = "");
   Derived& AddCylinderVisual(const Pose& pose, double radius, double half_length,
                              const Eigen::Vector4f& color = Eigen::Vector4f(0.8, 0.8, 0.8, 1),
-                             const std::string& name = "");
-  /// Every sub-mesh of a file as a visual, with the file's materials.
-  Derived& AddVisualFromFile(const std::string& filename, const Pose& pose = Pose(),
-                             const Eigen::Vector3d& scale = Eigen::Vector3d::Ones(),
                              const std::string& name = "");
   /// Number of visuals added so far.
   int GetVisualCount();

@@ -52,7 +52,7 @@ class Camera {
   Eigen::Matrix4d GetProjectionMatrix() const;
 
   /// World pose X_WC (x forward, y left, z up); for a mounted camera, from the mount's pose at
-  /// the last UpdateRender().
+  /// the last UpdateRender(scene).
   Pose GetPose() const;
   /// For a free camera, its world pose; for a mounted one, its pose in the mount's frame.
   void SetLocalPose(const Pose& pose);
@@ -70,7 +70,7 @@ class Camera {
   void SetParent(const Link& parent, bool keep_pose);
   void ClearParent(bool keep_pose);
 
-  /// Renders the scene as of the last Scene::UpdateRender() with the scene's backend.
+  /// Renders the scene as of the last UpdateRender(scene) with the scene's backend.
   /// `outputs` (PictureOutput bits, at least one) names the outputs to render; the others stay
   /// empty and asking for them (GetFloatPicture, GetDepth, ...) throws. Color and Position alone
   /// take the rasterizer's faster forward pass.
