@@ -42,9 +42,15 @@ if [ "${PARTSIM_NO_ROS1:-0}" != "1" ]; then
   )
 fi
 
+# one dpkg-query for all of them (one call per package took 4 s of every run.sh)
+declare -A installed=()
+while read -r p; do
+  installed[$p]=1
+done < <(dpkg-query -W -f='${Package} ${Status}\n' "${PACKAGES[@]}" 2>/dev/null |
+  awk '$2 == "install" && $3 == "ok" && $4 == "installed" { print $1 }' || true)
 missing=()
 for p in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  [ -n "${installed[$p]:-}" ] || missing+=("$p")
 done
 if [ ${#missing[@]} -gt 0 ]; then
   SUDO=""
@@ -78,7 +84,23 @@ if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
   $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends nodejs npm
 fi
-bash scripts/build_web.sh
+# only when its inputs changed: a stamp of their contents in build/ (the bundle took 6 s
+# and, being new, made the Debian package below be built again on every run)
+web_inputs() {
+  { find web/src web/index.html web/viewer.css web/package.json web/package-lock.json \
+    web/node_modules/.package-lock.json scripts/build_web.sh -type f -print0 2>/dev/null || true; } |
+    sort -z | xargs -0 -r sha256sum
+}
+web_stamp=build/.partsim-web-inputs.sha256  # outside build/web, which is installed as it is
+if [ -f build/web/viewer.js ] && [ -f build/web/index.html ] && [ -f build/web/viewer.css ] &&
+    [ -f web/node_modules/.package-lock.json ] && [ -f "$web_stamp" ] &&
+    [ "$(web_inputs)" = "$(cat "$web_stamp")" ]; then
+  echo "partsim setup: web page in build/web is current"
+else
+  rm -f "$web_stamp"
+  bash scripts/build_web.sh
+  web_inputs >"$web_stamp"
+fi
 
 # the Debian package (build/partsim_<version>_<arch>.deb), again only when something in it changed
 deb=$(ls build/partsim_*.deb 2>/dev/null | head -n 1 || true)
