@@ -1,9 +1,12 @@
 // Parsing JSON from outside (network messages, scene files, dataset files) with a bound on its
 // nesting: a deeper document is refused before it is parsed, before a deep tree exists whose
 // copy, serialisation or destruction would recurse that deep and overflow the stack. Both steps
-// are linear in the size of the text.
+// are linear in the size of the text. Also the JSON text helpers every layer shares (DumpJson,
+// Base64).
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -47,6 +50,38 @@ inline nlohmann::json ParseJsonBounded(const std::string& text, int max_depth = 
     throw nlohmann::json::out_of_range::create(
         406, "nested deeper than " + std::to_string(max_depth) + " levels", nullptr);
   return nlohmann::json::parse(text);
+}
+
+/// Text of a JSON value; bytes that are not UTF-8 (a client's string quoted back in an error)
+/// become U+FFFD instead of throwing.
+inline std::string DumpJson(const nlohmann::json& j) {
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+/// Base64 (RFC 4648, padded) of `n` bytes: how rosbridge sends uint8[] fields and the viewer its
+/// pictures as JSON text.
+inline std::string Base64(const uint8_t* data, size_t n) {
+  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((n + 2) / 3 * 4);
+  size_t i = 0;
+  for (; i + 2 < n; i += 3) {
+    uint32_t v = (uint32_t(data[i]) << 16) | (uint32_t(data[i + 1]) << 8) | data[i + 2];
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += kAlphabet[(v >> 6) & 63];
+    out += kAlphabet[v & 63];
+  }
+  // the last one or two bytes, padded with '='
+  if (i < n) {
+    uint32_t v = uint32_t(data[i]) << 16;
+    if (i + 1 < n) v |= uint32_t(data[i + 1]) << 8;
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += i + 1 < n ? kAlphabet[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
 }
 
 }  // namespace partsim::internal

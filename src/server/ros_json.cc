@@ -17,34 +17,6 @@ Json VectorToJson(const Eigen::VectorXd& v) {
 
 }  // namespace
 
-std::string DumpJson(const Json& j) {
-  return j.dump(-1, ' ', false, Json::error_handler_t::replace);
-}
-
-std::string Base64(const uint8_t* data, size_t n) {
-  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((n + 2) / 3 * 4);
-  size_t i = 0;
-  for (; i + 2 < n; i += 3) {
-    uint32_t v = (uint32_t(data[i]) << 16) | (uint32_t(data[i + 1]) << 8) | data[i + 2];
-    out += kAlphabet[(v >> 18) & 63];
-    out += kAlphabet[(v >> 12) & 63];
-    out += kAlphabet[(v >> 6) & 63];
-    out += kAlphabet[v & 63];
-  }
-  // the last one or two bytes, padded with '='
-  if (i < n) {
-    uint32_t v = uint32_t(data[i]) << 16;
-    if (i + 1 < n) v |= uint32_t(data[i + 1]) << 8;
-    out += kAlphabet[(v >> 18) & 63];
-    out += kAlphabet[(v >> 12) & 63];
-    out += i + 1 < n ? kAlphabet[(v >> 6) & 63] : '=';
-    out += '=';
-  }
-  return out;
-}
-
 Json TextForm(Json j) {
   if (j.is_binary()) return Base64(j.get_binary().data(), j.get_binary().size());
   if (j.is_object() || j.is_array())

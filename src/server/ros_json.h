@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/json_parse.h"
 #include "partsim/planning/planner.h"
 #include "partsim/robot/controllers.h"
 #include "partsim/server/served_robot.h"
@@ -31,11 +32,7 @@ constexpr const char* kPointCloud2Type = "sensor_msgs/PointCloud2";
 constexpr const char* kImuType = "sensor_msgs/Imu";
 
 // ---- text ----
-/// Text of a JSON value; bytes that are not UTF-8 (a client's string quoted back in an error)
-/// become U+FFFD instead of throwing.
-std::string DumpJson(const Json& j);
-/// Base64 (RFC 4648, padded) of `n` bytes: how rosbridge sends uint8[] fields as JSON text.
-std::string Base64(const uint8_t* data, size_t n);
+// DumpJson and Base64: core/json_parse.h
 /// The message as JSON text carries it: every binary value becomes its base64 string.
 Json TextForm(Json j);
 

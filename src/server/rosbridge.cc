@@ -13,14 +13,18 @@
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
+#include "core/json_parse.h"
 #include "partsim/core/error.h"
 #include "server/rosbridge_protocol.h"
+#include "server/rosbridge_robot.h"
 #include "server/web_security.h"
 
 // The transport of RosbridgeServer: websocketpp over Boost.Asio on a thread of its own, the
-// accept loop, the handshake checks (origin, connection cap), each client's bounded outgoing
-// queue and the fragmenting of long messages. What the messages mean is the protocol's
-// (rosbridge_protocol.cc); how ROS messages look in JSON is the codecs' (ros_json.cc).
+// accept loop, the handshake checks (origin, connection cap), the login's time limit, each
+// client's bounded outgoing queue, the fragmenting of long messages, and plain HTTP requests
+// handed to an extension. What the messages mean is the protocol's (rosbridge_protocol.cc); what
+// a robot serves is rosbridge_robot.cc's; how ROS messages look in JSON is the codecs'
+// (ros_json.cc).
 
 namespace partsim {
 
@@ -36,9 +40,17 @@ using Hdl = websocketpp::connection_hdl;
 }  // namespace
 
 struct RosbridgeServer::Impl : internal::RosbridgeTransport {
-  ServedRobot* robot;
+  ServedRobot* robot = nullptr;  ///< null: a server of extensions only
   RosbridgeOptions options;
   std::unique_ptr<internal::RosbridgeProtocol> protocol;
+  std::unique_ptr<internal::RosbridgeRobot> robot_part;
+  RosbridgeHttpHandler http_handler;  ///< set before Start
+  struct Periodic {
+    double seconds;
+    std::function<void()> fn;
+    std::unique_ptr<boost::asio::steady_timer> timer;  ///< network thread
+  };
+  std::vector<std::unique_ptr<Periodic>> periodic;  ///< set before Start
 
   WsServer ws;
   std::unique_ptr<boost::asio::steady_timer> accept_timer;  // network thread
@@ -115,6 +127,21 @@ struct RosbridgeServer::Impl : internal::RosbridgeTransport {
     }
   }
 
+  /// Network thread: what waits in the client's queue, then `text` at once (see SendNow).
+  bool SendNow(const ClientPtr& c, const std::string& text, bool droppable) {
+    Flush(c);
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = ws.get_con_from_hdl(c->connection, ec);
+    if (ec || !con || con->get_state() != websocketpp::session::state::open) return false;
+    if (droppable && con->get_buffered_amount() > options.max_client_buffered) {
+      ++dropped;
+      return false;
+    }
+    if (con->send(text, websocketpp::frame::opcode::text)) return false;
+    ++sent;
+    return true;
+  }
+
   void Close(const ClientPtr& c, const std::string& reason) override {
     websocketpp::lib::error_code ec;
     ws.close(c->connection, websocketpp::close::status::policy_violation, reason, ec);
@@ -173,15 +200,92 @@ struct RosbridgeServer::Impl : internal::RosbridgeTransport {
     return true;
   }
 
+  // ---- timers ----
+  void Tick(Periodic* p) {
+    p->timer->expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(p->seconds)));
+    p->timer->async_wait([this, p](const boost::system::error_code& e) {
+      if (e || !started) return;
+      p->fn();
+      Tick(p);
+    });
+  }
+
+  // ---- plain HTTP ----
+  static void FillHttp(const WsServer::connection_ptr& con, const RosbridgeHttpAnswer& a) {
+    con->set_status(static_cast<websocketpp::http::status_code::value>(a.status));
+    con->append_header("Content-Type", a.content_type);
+    con->append_header("Cache-Control", "no-store");
+    con->append_header("X-Content-Type-Options", "nosniff");
+    con->set_body(a.body);
+  }
+
+  /// Network thread: a request from an origin not allowed gets 403; others go to the
+  /// extension's handler, whose answer (or 503 after the time it asked for) is sent later.
+  void HandleHttp(const WsServer::connection_ptr& con) {
+    // (a plain HTTP request has no WebSocket processor: get_origin() is not for it)
+    const std::string origin = con->get_request_header("Origin");
+    if (!internal::OriginAllowed(origin, options.allowed_origins)) {
+      ++refused;
+      FillHttp(con, {403, "text/plain; charset=utf-8", "origin '" + origin + "' is not allowed\n"});
+      return;
+    }
+    if (!http_handler) {
+      FillHttp(con, {426, "text/plain; charset=utf-8",
+                     "this port answers WebSocket handshakes (rosbridge v2) only\n"});
+      return;
+    }
+    RosbridgeHttpRequest req;
+    req.method = con->get_request().get_method();
+    internal::SplitResource(con->get_resource(), &req.path, &req.query);
+    std::string given = internal::QueryValue(req.query, "token");
+    if (given.empty()) given = con->get_request_header("X-Partsim-Token");
+    req.token_ok = internal::SameToken(given, options.auth_token);
+    websocketpp::lib::error_code ec = con->defer_http_response();
+    if (ec) {
+      FillHttp(con, {500, "text/plain; charset=utf-8", "cannot defer the answer\n"});
+      return;
+    }
+    auto once = std::make_shared<std::atomic<bool>>(false);
+    auto timer = std::make_shared<boost::asio::steady_timer>(ws.get_io_service());
+    RosbridgeHttpRespond respond = [this, con, once, timer](RosbridgeHttpAnswer a) {
+      if (once->exchange(true) || !started) return;
+      boost::asio::post(ws.get_io_service(), [con, timer, a = std::move(a)] {
+        timer->cancel();
+        FillHttp(con, a);
+        websocketpp::lib::error_code unused;
+        con->send_http_response(unused);
+      });
+    };
+    double timeout = 30;
+    try {
+      timeout = http_handler(req, respond);
+    } catch (const std::exception& e) {
+      respond({500, "text/plain; charset=utf-8", std::string("error: ") + e.what() + "\n"});
+    }
+    if (!(timeout > 0) || !std::isfinite(timeout)) timeout = 30;
+    timer->expires_after(
+        std::chrono::milliseconds(static_cast<long long>(std::min(timeout, 1e6) * 1000)));
+    timer->async_wait([respond, timeout](const boost::system::error_code& e) {
+      if (e) return;
+      char why[100];
+      std::snprintf(why, sizeof(why), "no answer within %g s; try again\n", timeout);
+      respond({503, "text/plain; charset=utf-8", why});
+    });
+  }
+
   RosbridgeStats Stats() const {
     RosbridgeStats s;
     s.clients = static_cast<long long>(protocol->ClientCount());
+    s.authenticated_clients = static_cast<long long>(protocol->AuthenticatedCount());
     s.messages_sent = sent;
     s.messages_dropped = dropped;
-    CommandStats cs = robot->GetCommandStats();
-    s.commands = cs.commands;
-    s.mean_latency_steps = cs.mean_latency_steps;
-    s.max_latency_steps = cs.max_latency_steps;
+    if (robot) {
+      CommandStats cs = robot->GetCommandStats();
+      s.commands = cs.commands;
+      s.mean_latency_steps = cs.mean_latency_steps;
+      s.max_latency_steps = cs.max_latency_steps;
+    }
     s.errors = protocol->Errors();
     s.refused = refused;
     s.accept_errors = accept_errors;
@@ -191,24 +295,30 @@ struct RosbridgeServer::Impl : internal::RosbridgeTransport {
 };
 
 RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& options)
-    : impl_(std::make_unique<Impl>()) {
+    : RosbridgeServer(options) {
   if (!robot) throw Error("RosbridgeServer: robot is null");
-  if (!(options.auth_timeout >= 0) || !std::isfinite(options.auth_timeout))
-    throw Error("RosbridgeServer: auth_timeout must be finite and >= 0 (0: no limit)");
   Impl& m = *impl_;
   m.robot = robot;
-  m.options = options;
-  m.protocol = std::make_unique<internal::RosbridgeProtocol>(robot, options, &m);
-  m.protocol->stats = [this] { return impl_->Stats(); };
+  m.robot_part = std::make_unique<internal::RosbridgeRobot>(robot, m.protocol.get(),
+                                                            [this] { return impl_->Stats(); });
   robot->GetSim()->AddStepCallback([this](long long steps) {
-    if (impl_->started) impl_->protocol->OnStep(steps);
+    if (impl_->started) impl_->robot_part->OnStep(steps);
   });
+}
 
+RosbridgeServer::RosbridgeServer(const RosbridgeOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  if (!(options.auth_timeout >= 0) || !std::isfinite(options.auth_timeout))
+    throw Error(options.label + ": auth_timeout must be finite and >= 0 (0: no limit)");
+  Impl& m = *impl_;
+  m.options = options;
+  m.protocol = std::make_unique<internal::RosbridgeProtocol>(options, &m);
   m.ws.clear_access_channels(websocketpp::log::alevel::all);
   m.ws.clear_error_channels(websocketpp::log::elevel::all);
   m.ws.init_asio();
   m.ws.set_reuse_addr(true);
   m.ws.set_max_message_size(options.max_message_bytes);
+  m.ws.set_max_http_body_size(64 * 1024);
   // a connection that has not finished its handshake within 2 s is dropped, so that sockets
   // opened and left silent do not pile up towards the descriptor limit
   m.ws.set_open_handshake_timeout(2000);
@@ -247,18 +357,26 @@ RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& opt
     c->address = !ec && con ? con->get_remote_endpoint() : "(unknown address)";
     log_client(*c, "connected", impl_->protocol->AddClient(c));
     // with a token, a client that stays silent would hold its slot for ever: it has
-    // auth_timeout seconds to authenticate
+    // auth_timeout seconds to authenticate; it is told why it is closed
     const double limit = impl_->options.auth_timeout;
     if (impl_->options.auth_token.empty() || limit <= 0) return;
     std::weak_ptr<internal::RosbridgeClient> weak = c;
-    impl_->ws.set_timer(static_cast<long>(std::min(limit, 1e6) * 1000),
-                        [this, weak, limit](const websocketpp::lib::error_code& e) {
-                          ClientPtr cp = weak.lock();
-                          if (e || !cp || cp->authenticated) return;
-                          char why[80];
-                          std::snprintf(why, sizeof(why), "not authenticated within %g s", limit);
-                          impl_->Close(cp, why);
-                        });
+    impl_->ws.set_timer(
+        static_cast<long>(std::min(limit, 1e6) * 1000),
+        [this, weak, limit](const websocketpp::lib::error_code& e) {
+          ClientPtr cp = weak.lock();
+          if (e || !cp || cp->authenticated) return;
+          char why[160];
+          std::snprintf(why, sizeof(why),
+                        "auth: no {\"op\": \"auth\"} with the token within %g s; closing the "
+                        "connection",
+                        limit);
+          impl_->SendNow(cp, internal::DumpJson(internal::StatusToJson("error", why, nullptr)),
+                         false);
+          impl_->protocol->CountError();
+          std::snprintf(why, sizeof(why), "not authenticated within %g s", limit);
+          impl_->Close(cp, why);
+        });
   });
   auto gone = [this, log_client](Hdl h) {
     impl_->slots.erase(h);
@@ -271,6 +389,11 @@ RosbridgeServer::RosbridgeServer(ServedRobot* robot, const RosbridgeOptions& opt
   m.ws.set_message_handler([this](Hdl h, WsServer::message_ptr msg) {
     if (ClientPtr c = impl_->protocol->FindClient(h))
       impl_->protocol->OnMessage(c, msg->get_payload());
+  });
+  m.ws.set_http_handler([this](Hdl h) {
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = impl_->ws.get_con_from_hdl(h, ec);
+    if (!ec && con) impl_->HandleHttp(con);
   });
 }
 
@@ -287,15 +410,16 @@ void RosbridgeServer::Start() {
     boost::asio::ip::tcp::resolver resolver(m.ws.get_io_service());
     auto found = resolver.resolve(m.options.address, "", bec);
     if (bec || found.empty())
-      throw Error("rosbridge: cannot resolve the address '" + m.options.address +
+      throw Error(m.options.label + ": cannot resolve the address '" + m.options.address +
                   "': " + (bec ? bec.message() : "no address"));
     addr = found.begin()->endpoint().address();
   }
   if (!addr.is_loopback())
     std::fprintf(stderr,
-                 "partsim: warning: rosbridge listens on %s (%s), reachable from other machines: "
-                 "anyone who can connect can move the robot and stop the simulation%s\n",
-                 m.options.address.c_str(), addr.to_string().c_str(),
+                 "partsim: warning: %s listens on %s (%s), reachable from other machines: anyone "
+                 "who can connect%s can move what it serves and stop the simulation%s\n",
+                 m.options.label.c_str(), m.options.address.c_str(), addr.to_string().c_str(),
+                 m.options.auth_token.empty() ? "" : " and knows the token",
                  m.options.auth_token.empty() ? "; set a token (--token)" : "");
   boost::asio::ip::tcp::endpoint ep(addr, static_cast<unsigned short>(m.options.port));
   m.ws.listen(ep, ec);
@@ -314,14 +438,29 @@ void RosbridgeServer::Start() {
           "there)";
     else if (bec)
       why = bec.message();
-    throw Error("rosbridge: cannot listen on " + m.options.address + ":" +
+    throw Error(m.options.label + ": cannot listen on " + m.options.address + ":" +
                 std::to_string(m.options.port) + ": " + why);
   }
   m.accept_timer = std::make_unique<boost::asio::steady_timer>(m.ws.get_io_service());
   m.StartAccept();
   m.port = m.ws.get_local_endpoint(bec).port();
-  m.io_thread = std::thread([this] { impl_->ws.run(); });
+  for (auto& p : m.periodic) {
+    p->timer = std::make_unique<boost::asio::steady_timer>(m.ws.get_io_service());
+    m.Tick(p.get());
+  }
   m.started = true;
+  m.io_thread = std::thread([this] {
+    // a handler that throws must not end the network thread
+    while (true) {
+      try {
+        impl_->ws.run();
+        return;
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "partsim %s: network thread: %s (it goes on)\n",
+                     impl_->options.label.c_str(), e.what());
+      }
+    }
+  });
 }
 
 void RosbridgeServer::Stop() {
@@ -331,6 +470,8 @@ void RosbridgeServer::Stop() {
   websocketpp::lib::error_code ec;
   m.ws.stop_listening(ec);
   if (m.accept_timer) m.accept_timer->cancel();
+  for (auto& p : m.periodic)
+    if (p->timer) p->timer->cancel();
   m.ws.stop();
   if (m.io_thread.joinable()) m.io_thread.join();
 }
@@ -338,5 +479,86 @@ void RosbridgeServer::Stop() {
 int RosbridgeServer::GetPort() const { return impl_->port; }
 
 RosbridgeStats RosbridgeServer::GetStats() const { return impl_->Stats(); }
+
+// ---- extensions ----
+
+namespace {
+
+void CheckNotStarted(const RosbridgeServer::Impl& m, const char* what);
+
+}  // namespace
+
+void RosbridgeServer::AddTopic(const std::string& name, const std::string& type,
+                               RosbridgeTopicHooks hooks) {
+  CheckNotStarted(*impl_, "AddTopic");
+  impl_->protocol->AddTopic(name, type, {}, std::move(hooks));
+}
+
+void RosbridgeServer::AddService(const std::string& name, RosbridgeService service) {
+  CheckNotStarted(*impl_, "AddService");
+  if (!service) throw Error(impl_->options.label + ": service " + name + " has no handler");
+  impl_->protocol->AddExtensionService(name, std::move(service));
+}
+
+void RosbridgeServer::SetSimControls(const RosbridgeSimControls& controls) {
+  CheckNotStarted(*impl_, "SetSimControls");
+  impl_->protocol->SetSimControls(controls);
+}
+
+void RosbridgeServer::SetHttpHandler(RosbridgeHttpHandler handler) {
+  CheckNotStarted(*impl_, "SetHttpHandler");
+  impl_->http_handler = std::move(handler);
+}
+
+void RosbridgeServer::OnDisconnect(std::function<void(const RosbridgeClientPtr& client)> hook) {
+  CheckNotStarted(*impl_, "OnDisconnect");
+  impl_->protocol->AddDisconnectHook(std::move(hook));
+}
+
+void RosbridgeServer::Every(double seconds, std::function<void()> fn) {
+  CheckNotStarted(*impl_, "Every");
+  if (!(seconds > 0) || !std::isfinite(seconds))
+    throw Error(impl_->options.label + ": Every needs a finite period > 0 s");
+  impl_->periodic.push_back(
+      std::make_unique<Impl::Periodic>(Impl::Periodic{seconds, std::move(fn), nullptr}));
+}
+
+void RosbridgeServer::Post(std::function<void()> fn) {
+  if (!impl_->started) return;
+  boost::asio::post(impl_->ws.get_io_service(), std::move(fn));
+}
+
+bool RosbridgeServer::SendNow(const RosbridgeClientPtr& client, const std::string& text,
+                              bool droppable) {
+  return client && impl_->SendNow(client, text, droppable);
+}
+
+void RosbridgeServer::Publish(const std::string& topic, const std::string& msg_json) {
+  const Json msg = internal::ParseJsonBounded(msg_json);
+  impl_->protocol->Publish(
+      topic, [&] { return msg; }, internal::WallClock::now());
+}
+
+std::vector<RosbridgeClientPtr> RosbridgeServer::Subscribers(const std::string& topic) const {
+  return impl_->protocol->Subscribers(topic);
+}
+
+bool RosbridgeServer::Subscribes(const RosbridgeClientPtr& client, const std::string& topic) const {
+  return client && impl_->protocol->Subscribes(client, topic);
+}
+
+void RosbridgeServer::SendError(const RosbridgeClientPtr& client, const std::string& message) {
+  if (client) impl_->protocol->SendError(client, message);
+}
+
+std::string RandomAuthToken() { return internal::RandomToken(); }
+
+namespace {
+
+void CheckNotStarted(const RosbridgeServer::Impl& m, const char* what) {
+  if (m.started) throw Error(m.options.label + ": " + what + " must be called before Start()");
+}
+
+}  // namespace
 
 }  // namespace partsim

@@ -73,28 +73,116 @@ void Subscription::Merge() {
   if (!all_fragment) fragment_size = 0;
 }
 
-RosbridgeProtocol::RosbridgeProtocol(ServedRobot* robot, const RosbridgeOptions& options,
-                                     RosbridgeTransport* transport)
-    : robot_(robot),
-      sim_(robot->GetSim()),
-      options_(options),
-      transport_(transport),
-      sensors_(robot) {
-  for (size_t i = 0; i < robot->GetCameras().size(); ++i)
-    camera_topics_.push_back({SensorTopic(*robot, SensorStream::kImage, i),
-                              SensorTopic(*robot, SensorStream::kPoints, i),
-                              SensorTopic(*robot, SensorStream::kCameraInfo, i)});
+RosbridgeProtocol::RosbridgeProtocol(const RosbridgeOptions& options, RosbridgeTransport* transport)
+    : options_(options), transport_(transport) {
   ops_ = {{"subscribe", &RosbridgeProtocol::OpSubscribe},
           {"unsubscribe", &RosbridgeProtocol::OpUnsubscribe},
-          {"advertise", &RosbridgeProtocol::OpAdvertise},
-          {"unadvertise", &RosbridgeProtocol::OpUnadvertise},
-          {"publish", &RosbridgeProtocol::OpPublish},
           {"call_service", &RosbridgeProtocol::OpCallService},
-          {"advertise_service", &RosbridgeProtocol::OpAdvertiseService},
-          {"unadvertise_service", &RosbridgeProtocol::OpUnadvertiseService},
-          {"service_response", &RosbridgeProtocol::OpServiceResponse},
           {"auth", &RosbridgeProtocol::OpAuth}};
-  AddServices();
+  const std::map<std::string, OpHandler> relays = {
+      {"advertise", &RosbridgeProtocol::OpAdvertise},
+      {"unadvertise", &RosbridgeProtocol::OpUnadvertise},
+      {"publish", &RosbridgeProtocol::OpPublish},
+      {"advertise_service", &RosbridgeProtocol::OpAdvertiseService},
+      {"unadvertise_service", &RosbridgeProtocol::OpUnadvertiseService},
+      {"service_response", &RosbridgeProtocol::OpServiceResponse}};
+  for (const auto& [op, handler] : relays)
+    ops_[op] = options_.client_topics ? handler : &RosbridgeProtocol::OpNotSupported;
+  AddRosapiServices();
+}
+
+// ---- what is served ----
+
+void RosbridgeProtocol::AddTopic(const std::string& name, const std::string& type,
+                                 CommandHandler command, RosbridgeTopicHooks hooks) {
+  if (name.empty() || name[0] != '/') throw Error("topic '" + name + "' does not start with '/'");
+  if (!topics_.emplace(name, Topic{type, std::move(command), std::move(hooks)}).second)
+    throw Error("topic " + name + " is served already");
+}
+
+void RosbridgeProtocol::AddService(const std::string& name, ServiceHandler handler) {
+  if (name.empty() || name[0] != '/') throw Error("service '" + name + "' does not start with '/'");
+  for (auto& [n, h] : services_)
+    if (n == name) throw Error("service " + name + " is served already");
+  services_.emplace_back(name, std::move(handler));
+}
+
+void RosbridgeProtocol::AddExtensionService(const std::string& name, RosbridgeService service) {
+  AddService(
+      name,
+      [this, service](const ClientPtr& c, const std::string& name, const Json& args,
+                      const Json& id) -> std::optional<Json> {
+        // a failure, thrown now or replied later, is a failed service response naming the service
+        auto fail = [this, name, id](const ClientPtr& to, const std::string& why) {
+          ++errors_;
+          Reply(to, ServiceResponseToJson(name, name + ": " + why, false, id));
+        };
+        if (!args.is_object() && !args.is_null()) {
+          fail(c, "args must be an object, got " + DumpJson(args));
+          return std::nullopt;
+        }
+        if (static_cast<size_t>(++*c->waiting) > options_.max_waiting_calls) {
+          --*c->waiting;
+          fail(c, "too many calls waiting: at most " + std::to_string(options_.max_waiting_calls) +
+                      " calls of a client wait for their answers; wait for them, then call again");
+          return std::nullopt;
+        }
+        std::weak_ptr<RosbridgeClient> weak = c;
+        auto once = std::make_shared<std::atomic<bool>>(false);
+        RosbridgeServiceReply reply = [this, weak, waiting = c->waiting, name, id, once, fail](
+                                          bool ok, const std::string& text) {
+          if (once->exchange(true)) return;
+          --*waiting;
+          ClientPtr to = weak.lock();
+          if (!to) return;
+          if (!ok) return fail(to, text);
+          Json values;
+          try {
+            values = ParseJsonBounded(text);
+          } catch (const std::exception& e) {
+            return fail(to, std::string("bad answer from the service: ") + e.what());
+          }
+          Reply(to, ServiceResponseToJson(name, values, true, id));
+        };
+        try {
+          service(c, DumpJson(args.is_null() ? Json::object() : args), reply);
+        } catch (const std::exception& e) {
+          reply(false, e.what());
+        }
+        return std::nullopt;
+      });
+}
+
+void RosbridgeProtocol::SetSimControls(const RosbridgeSimControls& controls) {
+  for (const char* name : {"/partsim/pause", "/partsim/resume", "/partsim/step", "/partsim/reset"})
+    services_.erase(std::remove_if(services_.begin(), services_.end(),
+                                   [&](const auto& s) { return s.first == name; }),
+                    services_.end());
+  auto simple = [](const char* name, std::function<void()> f) {
+    return [name, f](const ClientPtr&, const std::string&, const Json& args,
+                     const Json&) -> std::optional<Json> {
+      if (!args.is_object() && !args.is_null())
+        throw Error(std::string(name) + ": args must be an object, got " + DumpJson(args));
+      f();
+      return Json::object();
+    };
+  };
+  if (controls.pause) AddService("/partsim/pause", simple("/partsim/pause", controls.pause));
+  if (controls.resume) AddService("/partsim/resume", simple("/partsim/resume", controls.resume));
+  if (controls.reset) AddService("/partsim/reset", simple("/partsim/reset", controls.reset));
+  if (controls.step)
+    AddService("/partsim/step",
+               [step = controls.step](const ClientPtr&, const std::string&, const Json& args,
+                                      const Json&) -> std::optional<Json> {
+                 if (!args.is_object() && !args.is_null())
+                   throw Error("/partsim/step: args must be an object, got " + DumpJson(args));
+                 step(StepCountFromJson(args));
+                 return Json::object();
+               });
+}
+
+void RosbridgeProtocol::AddDisconnectHook(std::function<void(const ClientPtr& client)> hook) {
+  disconnect_hooks_.push_back(std::move(hook));
 }
 
 // ---- clients ----
@@ -125,8 +213,11 @@ ClientPtr RosbridgeProtocol::RemoveClient(const std::weak_ptr<void>& connection,
     }
     AbandonCalls(c, "", "the provider disconnected");
   }
-  // its plans are dropped, the one running stopped: nobody waits for the answers
-  robot_->CancelPlans(c.get());
+  // what was served to it is told (a robot's plans for it are dropped, a viewer's state of it
+  // forgotten)
+  for (const auto& [name, topic] : topics_)
+    if (topic.hooks.on_unsubscribe && c->subs.count(name)) topic.hooks.on_unsubscribe(c);
+  for (const auto& hook : disconnect_hooks_) hook(c);
   return c;
 }
 
@@ -139,6 +230,13 @@ ClientPtr RosbridgeProtocol::FindClient(const std::weak_ptr<void>& connection) c
 size_t RosbridgeProtocol::ClientCount() const {
   std::lock_guard<std::mutex> lock(clients_mutex_);
   return clients_.size();
+}
+
+size_t RosbridgeProtocol::AuthenticatedCount() const {
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  size_t n = 0;
+  for (const auto& [h, c] : clients_) n += c->authenticated;
+  return n;
 }
 
 void RosbridgeProtocol::Reply(const ClientPtr& c, const Json& j) {
@@ -298,6 +396,11 @@ bool RosbridgeProtocol::Reassemble(const ClientPtr& c, const Json& j, std::strin
 
 void RosbridgeProtocol::OpSubscribe(const ClientPtr& c, const Json& j, const Json& id) {
   const std::string op = "subscribe", topic = Name(j, "topic", op);
+  auto served = topics_.find(topic);
+  // without client topics, nothing but partsim's topics will ever be published
+  if (!options_.client_topics && (served == topics_.end() || served->second.command))
+    throw Error("subscribe: no topic '" + topic + "' (" + options_.label + " publishes " +
+                TopicList() + ")");
   if (j.contains("type") && j["type"].is_string()) {
     const std::string type = Str(j, "type", op);
     std::lock_guard<std::mutex> lock(clients_mutex_);
@@ -327,7 +430,7 @@ void RosbridgeProtocol::OpSubscribe(const ClientPtr& c, const Json& j, const Jso
                   "' is not supported (none, cbor)");
   }
   const std::string sub_id = id.is_null() ? "" : IdKey(id);
-  std::lock_guard<std::mutex> lock(clients_mutex_);
+  std::unique_lock<std::mutex> lock(clients_mutex_);
   if (!c->subs.count(topic) && c->subs.size() >= options_.max_subscriptions)
     throw Error("subscribe " + topic + ": this client already subscribes to " +
                 std::to_string(c->subs.size()) + " topics (at most " +
@@ -347,32 +450,41 @@ void RosbridgeProtocol::OpSubscribe(const ClientPtr& c, const Json& j, const Jso
     throw Error("subscribe " + topic + ": " + std::to_string(sub.requests.size()) +
                 " subscribe requests of this client are open on it (at most " +
                 std::to_string(kMaxRequestsPerTopic) + ")");
+  const bool first = sub.requests.empty();
   sub.requests[sub_id] = s;
   sub.Merge();
+  if (first && served != topics_.end() && served->second.hooks.on_subscribe) {
+    lock.unlock();
+    served->second.hooks.on_subscribe(c);
+  }
 }
 
 void RosbridgeProtocol::OpUnsubscribe(const ClientPtr& c, const Json& j, const Json& id) {
   // with an id: that subscribe request only; without: the whole topic
   const std::string topic = Name(j, "topic", "unsubscribe");
-  std::lock_guard<std::mutex> lock(clients_mutex_);
-  auto it = c->subs.find(topic);
-  if (it == c->subs.end()) return;
-  if (!id.is_null()) {
-    it->second.requests.erase(IdKey(id));
-    if (!it->second.requests.empty()) {
-      it->second.Merge();
-      return;
+  {
+    std::lock_guard<std::mutex> lock(clients_mutex_);
+    auto it = c->subs.find(topic);
+    if (it == c->subs.end()) return;
+    if (!id.is_null()) {
+      it->second.requests.erase(IdKey(id));
+      if (!it->second.requests.empty()) {
+        it->second.Merge();
+        return;
+      }
     }
+    c->subs.erase(it);
   }
-  c->subs.erase(it);
+  auto served = topics_.find(topic);
+  if (served != topics_.end() && served->second.hooks.on_unsubscribe)
+    served->second.hooks.on_unsubscribe(c);
 }
 
 void RosbridgeProtocol::OpAdvertise(const ClientPtr& c, const Json& j, const Json&) {
   const std::string op = "advertise", topic = Name(j, "topic", op), type = Str(j, "type", op);
-  const auto sim_topics = SimTopics();
-  auto it = sim_topics.find(topic);
-  if (it != sim_topics.end() && it->second != type)
-    throw Error("advertise " + topic + ": its type is " + it->second + ", not " + type);
+  auto it = topics_.find(topic);
+  if (it != topics_.end() && it->second.type != type)
+    throw Error("advertise " + topic + ": its type is " + it->second.type + ", not " + type);
   std::lock_guard<std::mutex> lock(clients_mutex_);
   for (auto& [h, other] : clients_) {
     auto o = other->advertised.find(topic);
@@ -395,9 +507,10 @@ void RosbridgeProtocol::OpUnadvertise(const ClientPtr& c, const Json& j, const J
 void RosbridgeProtocol::OpPublish(const ClientPtr& c, const Json& j, const Json& id) {
   const std::string topic = Name(j, "topic", "publish");
   if (!j.contains("msg")) throw Error("publish " + topic + ": no 'msg'");
-  if (Published(topic)) throw Error("publish " + topic + ": the simulation publishes this topic");
-  if (SimTopics().count(topic)) {
-    HandleCommand(c, topic, j["msg"], id);
+  if (auto served = topics_.find(topic); served != topics_.end()) {
+    if (!served->second.command)
+      throw Error("publish " + topic + ": the simulation publishes this topic");
+    served->second.command(c, topic, j["msg"], id);
     return;
   }
   // a client's own topic: relay to its subscribers
@@ -439,7 +552,17 @@ void RosbridgeProtocol::OpCallService(const ClientPtr& c, const Json& j, const J
           Json{{"op", "call_service"}, {"service", service}, {"args", args}, {"id", buf}});
     return;
   }
-  throw Error("call_service: no service '" + service + "'");
+  // answered as a failed call (what roslib's callService reports to its error callback), then
+  // as an error status, as rosbridge does, naming the services there are
+  std::string names;
+  for (const auto& [name, handler] : services_) names += (names.empty() ? "" : ", ") + name;
+  for (auto& [h, provider] : clients_)
+    for (const std::string& name : provider->services) names += ", " + name;
+  const std::string why =
+      "call_service: no service '" + service + "' (" + options_.label + " answers " + names + ")";
+  ++errors_;
+  Reply(c, ServiceResponseToJson(service, why, false, id));
+  Status(c, "error", why, id);
 }
 
 void RosbridgeProtocol::OpAdvertiseService(const ClientPtr& c, const Json& j, const Json&) {
@@ -484,6 +607,11 @@ void RosbridgeProtocol::OpServiceResponse(const ClientPtr& c, const Json& j, con
   pending_calls_.erase(it);
 }
 
+void RosbridgeProtocol::OpNotSupported(const ClientPtr&, const Json& j, const Json&) {
+  throw Error("op '" + j["op"].get<std::string>() + "' is not supported by " + options_.label +
+              " (it answers auth, subscribe, unsubscribe and call_service)");
+}
+
 void RosbridgeProtocol::OpAuth(const ClientPtr& c, const Json&, const Json& id) {
   // already authenticated, or no token is set
   Status(c, "info", options_.auth_token.empty() ? "no token needed" : "authenticated", id);
@@ -491,14 +619,7 @@ void RosbridgeProtocol::OpAuth(const ClientPtr& c, const Json&, const Json& id) 
 
 // ---- services ----
 
-void RosbridgeProtocol::AddServices() {
-  auto empty = [](std::function<void()> f) {
-    return
-        [f](const ClientPtr&, const std::string&, const Json&, const Json&) -> std::optional<Json> {
-          f();
-          return Json::object();
-        };
-  };
+void RosbridgeProtocol::AddRosapiServices() {
   services_ = {
       {"/rosapi/topics",
        [this](const ClientPtr&, const std::string&, const Json&,
@@ -526,31 +647,6 @@ void RosbridgeProtocol::AddServices() {
            for (const std::string& s : cl->services) names.push_back(s);
          return Json{{"services", names}};
        }},
-      {"/partsim/pause", empty([this] { sim_->Pause(); })},
-      {"/partsim/resume", empty([this] { sim_->Resume(); })},
-      {"/partsim/reset", empty([this] { sim_->Reset(); })},
-      {"/partsim/step",
-       [this](const ClientPtr&, const std::string&, const Json& args,
-              const Json&) -> std::optional<Json> {
-         sim_->StepN(StepCountFromJson(args));
-         return Json::object();
-       }},
-      {"/partsim/stats",
-       [this](const ClientPtr&, const std::string&, const Json&,
-              const Json&) -> std::optional<Json> {
-         const RosbridgeStats s = stats();
-         return Json{{"clients", s.clients},
-                     {"messages_sent", s.messages_sent},
-                     {"messages_dropped", s.messages_dropped},
-                     {"commands", s.commands},
-                     {"mean_latency_steps", s.mean_latency_steps},
-                     {"max_latency_steps", s.max_latency_steps},
-                     {"peak_buffered_bytes", s.peak_buffered_bytes},
-                     {"clock_steps", sim_->GetClockSteps()},
-                     {"timestep", sim_->GetTimestep()}};
-       }},
-      {Prefix() + "/plan", [this](const ClientPtr& c, const std::string& service, const Json& args,
-                                  const Json& id) { return CallPlan(c, service, args, id); }},
   };
 }
 
@@ -559,50 +655,6 @@ const RosbridgeProtocol::ServiceHandler* RosbridgeProtocol::FindService(
   for (const auto& [n, handler] : services_)
     if (n == name) return &handler;
   return nullptr;
-}
-
-/// /<robot>/plan: answers once planned, from the planning worker.
-std::optional<Json> RosbridgeProtocol::CallPlan(const ClientPtr& c, const std::string& service,
-                                                const Json& args, const Json& id) {
-  PlanRequest req = PlanRequestFromJson(args, service);
-  req.owner = c.get();  // bounded per client, cancelled when it leaves (RemoveClient)
-  std::weak_ptr<RosbridgeClient> weak = c;
-  robot_->Plan(req, [this, weak, service, id](const PlanResult& r) {
-    if (ClientPtr cp = weak.lock())
-      Reply(cp,
-            ServiceResponseToJson(service, PlanResultToJson(r, robot_->GetJointNames()), true, id));
-  });
-  return std::nullopt;
-}
-
-ServedRobot::ErrorSink RosbridgeProtocol::ErrorsTo(const ClientPtr& client, const Json& id) {
-  std::weak_ptr<RosbridgeClient> weak = client;
-  return [this, weak, id](const std::string& e) {
-    if (ClientPtr c = weak.lock()) Status(c, "error", e, id);
-  };
-}
-
-/// Checks and applies a message published to one of the simulation's command topics (applied
-/// on the simulation thread).
-void RosbridgeProtocol::HandleCommand(const ClientPtr& c, const std::string& topic, const Json& msg,
-                                      const Json& id) {
-  if (!msg.is_object()) throw Error("publish to " + topic + ": msg is not an object");
-  for (const char* kind : {"position", "velocity", "effort"}) {
-    if (topic != Prefix() + "/joint_" + kind + "_controller/command") continue;
-    const std::vector<double> data = Float64MultiArrayFromJson(msg, topic);
-    if (kind[0] == 'p')
-      robot_->CommandPositions(data, topic, ErrorsTo(c, id));
-    else if (kind[0] == 'v')
-      robot_->CommandVelocities(data, topic, ErrorsTo(c, id));
-    else
-      robot_->CommandEfforts(data, topic, ErrorsTo(c, id));
-    return;
-  }
-  const TrajectoryCommand cmd = JointTrajectoryFromJson(msg, topic);
-  auto errors = ErrorsTo(c, id);
-  robot_->CommandTrajectory(cmd, topic, [errors](TrajectoryOutcome o, const std::string& m) {
-    if (o == TrajectoryOutcome::kInvalidGoal) errors(m);
-  });
 }
 
 // ---- calls to client-advertised services ----
@@ -644,63 +696,47 @@ void RosbridgeProtocol::ExpireCalls() {
 
 // ---- topics ----
 
-std::map<std::string, std::string> RosbridgeProtocol::SimTopics() const {
-  std::map<std::string, std::string> t = {
-      {"/clock", kClockType},
-      {"/joint_states", kJointStateType},
-      {"/tf", kTfType},
-      {Prefix() + "/joint_position_controller/command", kFloat64ArrayType},
-      {Prefix() + "/joint_velocity_controller/command", kFloat64ArrayType},
-      {Prefix() + "/joint_effort_controller/command", kFloat64ArrayType},
-      {Prefix() + "/joint_trajectory_controller/command", kTrajectoryType},
-      {"/imu", kImuType}};
-  for (const CameraTopics& c : camera_topics_) {
-    t.emplace(c.image, kImageType);
-    t.emplace(c.info, kCameraInfoType);
-    t.emplace(c.points, kPointCloud2Type);
-  }
-  return t;
-}
-
-bool RosbridgeProtocol::Published(const std::string& topic) const {
-  if (topic == "/clock" || topic == "/joint_states" || topic == "/tf" || topic == "/imu")
-    return true;
-  for (const CameraTopics& c : camera_topics_)
-    if (topic == c.image || topic == c.info || topic == c.points) return true;
-  return false;
+std::string RosbridgeProtocol::TopicList() const {
+  std::string list;
+  for (const auto& [name, topic] : topics_)
+    if (!topic.command) list += (list.empty() ? "" : ", ") + name;
+  return list.empty() ? "no topics" : list;
 }
 
 std::map<std::string, std::string> RosbridgeProtocol::AllTopics() const {
-  std::map<std::string, std::string> t = SimTopics();
+  std::map<std::string, std::string> t;
+  for (const auto& [name, topic] : topics_) t.emplace(name, topic.type);
   for (auto& [h, c] : clients_)
     for (auto& [topic, type] : c->advertised) t.emplace(topic, type);
   return t;
 }
 
 bool RosbridgeProtocol::Wanted(const std::string& topic) const {
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  return WantedLocked(topic);
+}
+
+std::vector<ClientPtr> RosbridgeProtocol::Subscribers(const std::string& topic) const {
+  std::vector<ClientPtr> out;
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  for (auto& [h, c] : clients_)
+    if (c->subs.count(topic)) out.push_back(c);
+  return out;
+}
+
+bool RosbridgeProtocol::Subscribes(const ClientPtr& client, const std::string& topic) const {
+  std::lock_guard<std::mutex> lock(clients_mutex_);
+  return client->subs.count(topic) > 0;
+}
+
+bool RosbridgeProtocol::WantedLocked(const std::string& topic) const {
   for (auto& [h, c] : clients_)
     if (c->subs.count(topic)) return true;
   return false;
 }
 
-// ---- simulation thread ----
+// ---- publishing ----
 
-void RosbridgeProtocol::OnStep(long long steps) {
-  const double t = steps * sim_->GetTimestep();
-  const WallClock::time_point now = WallClock::now();
-  if (ClientCount() == 0) return;
-  Publish(
-      "/clock", [&] { return ClockToJson(t); }, now);
-  Publish(
-      "/joint_states", [&] { return JointStateToJson(robot_->ReadJointStates(), t); }, now);
-  Publish(
-      "/tf", [&] { return TfToJson(robot_->ReadFrames(), t); }, now);
-  PublishSensors(t, now);
-}
-
-/// Sends `make()` (built once, and encoded once per form: JSON text or CBOR) to the clients
-/// subscribed to `topic` that are not throttled. uint8[] fields are json::binary values: base64
-/// strings in JSON, byte strings in CBOR.
 void RosbridgeProtocol::Publish(const std::string& topic, const std::function<Json()>& make,
                                 WallClock::time_point now) {
   Json msg;
@@ -728,59 +764,6 @@ void RosbridgeProtocol::Publish(const std::string& topic, const std::function<Js
     const size_t fragment = text->size() > s.fragment_size ? s.fragment_size : 0;
     transport_->Send(c, text, s.queue_length, false, topic, fragment);
   }
-}
-
-const std::string& RosbridgeProtocol::SensorTopicName(SensorStream stream, size_t camera) const {
-  static const std::string imu = "/imu";
-  switch (stream) {
-    case SensorStream::kImu:
-      return imu;
-    case SensorStream::kImage:
-      return camera_topics_[camera].image;
-    case SensorStream::kPoints:
-      return camera_topics_[camera].points;
-    default:
-      return camera_topics_[camera].info;
-  }
-}
-
-/// Reads the sensors somebody subscribes to, when due (ServedRobot's schedule), and publishes
-/// them.
-void RosbridgeProtocol::PublishSensors(double t, WallClock::time_point now) {
-  const std::vector<CameraSensor>& cams = robot_->GetCameras();
-  SensorSchedule::Output out;
-  out.imu = [&](const ImuReading& r) {
-    Publish(
-        "/imu", [&] { return ImuToJson(r, t, robot_->GetImuFrame()); }, now);
-  };
-  out.picture = [&](size_t i, const Camera& cam, bool image, bool points) {
-    const std::string& frame = cams[i].frame;
-    if (image)
-      Publish(
-          camera_topics_[i].image,
-          [&] { return ImageToJson(cam.GetWidth(), cam.GetHeight(), CameraRgb8(cam), t, frame); },
-          now);
-    if (points)
-      Publish(
-          camera_topics_[i].points,
-          [&] { return PointCloudToJson(CameraOpticalPoints(cam), t, frame); }, now);
-  };
-  out.camera_info = [&](size_t i, const Camera& cam) {
-    Publish(
-        camera_topics_[i].info,
-        [&] {
-          return CameraInfoToJson(cam.GetWidth(), cam.GetHeight(), CameraProjection(cam), t,
-                                  cams[i].frame);
-        },
-        now);
-  };
-  sensors_.Publish(
-      t,
-      [&](SensorStream stream, size_t camera) {
-        std::lock_guard<std::mutex> lock(clients_mutex_);
-        return Wanted(SensorTopicName(stream, camera));
-      },
-      out);
 }
 
 }  // namespace partsim::internal

@@ -1,8 +1,10 @@
-// The rosbridge v2 protocol of RosbridgeServer, apart from its WebSocket transport: the clients'
-// state (subscriptions, advertised topics and services, messages in fragments), the ops
-// (auth, subscribe, publish, call_service, ...) and services by table, the calls relayed to
-// client-advertised services, and what the simulation publishes after each step. Messages are
-// handed to a RosbridgeTransport, which queues and sends them.
+// The rosbridge v2 protocol of RosbridgeServer, apart from its WebSocket transport and from what
+// is served: the clients' state (subscriptions, advertised topics and services, messages in
+// fragments), the ops (auth, subscribe, publish, call_service, ...) by table, partsim's topics and
+// services by table (filled by the served robot, rosbridge_robot.cc, and by extensions such as
+// the browser viewer), the simulation controls, rosapi, and the calls relayed to
+// client-advertised services. Messages are handed to a RosbridgeTransport, which queues and sends
+// them.
 #pragma once
 
 #include <atomic>
@@ -84,7 +86,9 @@ struct RosbridgeClient {
   std::map<std::string, std::string> advertised;  ///< topic -> type
   std::set<std::string> services;                 ///< advertised by this client
   std::map<std::string, Partial> partial;         ///< fragments by message id
-  bool authenticated = false;                     ///< true from the start when no token is set
+  std::atomic<bool> authenticated{false};         ///< true from the start when no token is set
+  /// Calls of this client to extension services not answered yet (any thread).
+  std::shared_ptr<std::atomic<int>> waiting = std::make_shared<std::atomic<int>>(0);
   // the transport's outgoing queue
   std::mutex out_mutex;
   std::deque<Outgoing> out;
@@ -108,9 +112,34 @@ class RosbridgeTransport {
 
 class RosbridgeProtocol {
  public:
-  /// Serves `robot` to the clients of `transport`; both must outlive the protocol.
-  RosbridgeProtocol(ServedRobot* robot, const RosbridgeOptions& options,
-                    RosbridgeTransport* transport);
+  /// An op's handler: (client, whole message, its id or null).
+  using OpHandler = void (RosbridgeProtocol::*)(const ClientPtr&, const Json&, const Json&);
+  /// A built-in service: values to answer with at once, or nullopt when it answers later.
+  using ServiceHandler = std::function<std::optional<Json>(
+      const ClientPtr& client, const std::string& service, const Json& args, const Json& id)>;
+  /// A message a client published to one of partsim's command topics (network thread).
+  using CommandHandler = std::function<void(const ClientPtr& client, const std::string& topic,
+                                            const Json& msg, const Json& id)>;
+
+  /// Serves the clients of `transport`, which must outlive the protocol; what it serves is
+  /// added with AddTopic, AddService and SetSimControls before clients connect.
+  RosbridgeProtocol(const RosbridgeOptions& options, RosbridgeTransport* transport);
+
+  // ---- what is served (before clients connect) ----
+  /// A topic partsim publishes (`command` empty) or one it subscribes to (clients publish
+  /// commands to it, handled by `command`). Throws partsim::Error for a name added already.
+  void AddTopic(const std::string& name, const std::string& type, CommandHandler command = {},
+                RosbridgeTopicHooks hooks = {});
+  /// A service answered by partsim. Throws partsim::Error for a name added already.
+  void AddService(const std::string& name, ServiceHandler handler);
+  /// An extension's service (RosbridgeServer::AddService): its failures, thrown or replied, are
+  /// answered as failed service responses; calls waiting for their answers are bounded per
+  /// client (max_waiting_calls).
+  void AddExtensionService(const std::string& name, RosbridgeService service);
+  /// /partsim/pause, /partsim/resume, /partsim/step and /partsim/reset, each offered when set.
+  void SetSimControls(const RosbridgeSimControls& controls);
+  /// Called on the network thread when a client leaves (after it is forgotten).
+  void AddDisconnectHook(std::function<void(const ClientPtr& client)> hook);
 
   // ---- clients (network thread) ----
   /// Registers a client that connected; returns the number connected then.
@@ -120,25 +149,36 @@ class RosbridgeProtocol {
   ClientPtr RemoveClient(const std::weak_ptr<void>& connection, size_t* count);
   ClientPtr FindClient(const std::weak_ptr<void>& connection) const;
   size_t ClientCount() const;
+  /// Clients connected that have authenticated (all of them when no token is set).
+  size_t AuthenticatedCount() const;
   /// One whole message (or one fragment of one) from a client; never throws: whatever goes
   /// wrong is answered with an error status.
   void OnMessage(const ClientPtr& client, const std::string& payload);
 
-  // ---- simulation thread ----
-  /// After step `steps`: /clock, /joint_states and /tf, then the sensors due.
-  void OnStep(long long steps);
+  // ---- publishing (any thread) ----
+  /// Sends `make()` (built once, and encoded once per form: JSON text or CBOR) to the clients
+  /// subscribed to `topic` that are not throttled. uint8[] fields are json::binary values:
+  /// base64 strings in JSON, byte strings in CBOR.
+  void Publish(const std::string& topic, const std::function<Json()>& make,
+               WallClock::time_point now);
+  /// Whether some client subscribes to `topic`.
+  bool Wanted(const std::string& topic) const;
+  /// The clients subscribed to `topic` now.
+  std::vector<ClientPtr> Subscribers(const std::string& topic) const;
+  bool Subscribes(const ClientPtr& client, const std::string& topic) const;
+  /// Sends an error status to `client` (counted in Errors()).
+  void SendError(const ClientPtr& client, const std::string& message) {
+    Status(client, "error", message);
+  }
+  /// A reply (status, service response) for `client`, queued in order.
+  void Reply(const ClientPtr& c, const Json& j);
+  /// Counts an error answered in a way of the caller's own.
+  void CountError() { ++errors_; }
 
-  /// Error statuses sent.
+  /// Error statuses and failed service responses sent.
   long long Errors() const { return errors_; }
-  /// The counters /partsim/stats answers with (set by the server before clients connect).
-  std::function<RosbridgeStats()> stats;
 
  private:
-  /// An op's handler: (client, whole message, its id or null).
-  using OpHandler = void (RosbridgeProtocol::*)(const ClientPtr&, const Json&, const Json&);
-  /// A built-in service: values to answer with at once, or nullopt when it answers later.
-  using ServiceHandler = std::function<std::optional<Json>(
-      const ClientPtr& client, const std::string& service, const Json& args, const Json& id)>;
   /// A call relayed to a client-advertised service.
   struct PendingCall {
     std::weak_ptr<RosbridgeClient> caller;
@@ -148,7 +188,6 @@ class RosbridgeProtocol {
     WallClock::time_point since;
   };
 
-  void Reply(const ClientPtr& c, const Json& j);
   void Status(const ClientPtr& c, const std::string& level, const std::string& msg,
               const Json& id = nullptr);
   void HandleText(const ClientPtr& c, const std::string& payload);
@@ -165,14 +204,11 @@ class RosbridgeProtocol {
   void OpUnadvertiseService(const ClientPtr& c, const Json& j, const Json& id);
   void OpServiceResponse(const ClientPtr& c, const Json& j, const Json& id);
   void OpAuth(const ClientPtr& c, const Json& j, const Json& id);
+  void OpNotSupported(const ClientPtr& c, const Json& j, const Json& id);
 
   // services
-  void AddServices();
+  void AddRosapiServices();
   const ServiceHandler* FindService(const std::string& name) const;
-  std::optional<Json> CallPlan(const ClientPtr& c, const std::string& service, const Json& args,
-                               const Json& id);
-  void HandleCommand(const ClientPtr& c, const std::string& topic, const Json& msg, const Json& id);
-  ServedRobot::ErrorSink ErrorsTo(const ClientPtr& client, const Json& id);
 
   // calls to client-advertised services (clients_mutex_ held)
   void AbandonCalls(const ClientPtr& provider, const std::string& service, const std::string& why);
@@ -180,27 +216,22 @@ class RosbridgeProtocol {
   void ExpireCalls();
 
   // topics
-  std::string Prefix() const { return "/" + robot_->GetName(); }
-  std::map<std::string, std::string> SimTopics() const;
-  bool Published(const std::string& topic) const;
+  /// partsim's topics by name: type, and the handler of commands for those it subscribes to.
+  struct Topic {
+    std::string type;
+    CommandHandler command;  ///< empty: partsim publishes the topic
+    RosbridgeTopicHooks hooks;
+  };
+  std::string TopicList() const;
   std::map<std::string, std::string> AllTopics() const;  // clients_mutex_ held
-  bool Wanted(const std::string& topic) const;           // clients_mutex_ held
-  void Publish(const std::string& topic, const std::function<Json()>& make,
-               WallClock::time_point now);
-  const std::string& SensorTopicName(SensorStream stream, size_t camera) const;
-  void PublishSensors(double t, WallClock::time_point now);
+  bool WantedLocked(const std::string& topic) const;     // clients_mutex_ held
 
-  ServedRobot* robot_;
-  SimServer* sim_;
   RosbridgeOptions options_;
   RosbridgeTransport* transport_;
   std::map<std::string, OpHandler> ops_;
+  std::map<std::string, Topic> topics_;                           // set before clients connect
   std::vector<std::pair<std::string, ServiceHandler>> services_;  // in the order rosapi lists
-  struct CameraTopics {
-    std::string image, points, info;
-  };
-  std::vector<CameraTopics> camera_topics_;  // one per robot_->GetCameras()
-  SensorSchedule sensors_;                   // simulation thread
+  std::vector<std::function<void(const ClientPtr&)>> disconnect_hooks_;
 
   mutable std::mutex clients_mutex_;
   std::map<std::weak_ptr<void>, ClientPtr, std::owner_less<std::weak_ptr<void>>> clients_;

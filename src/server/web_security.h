@@ -1,6 +1,6 @@
-// Checks shared by partsim's network services (the rosbridge server, the browser viewer): which
-// web pages may connect (the handshake's Origin), comparing tokens, making one, and what an
-// unauthenticated client may send.
+// Checks of partsim's network server (the rosbridge server, which also carries the browser
+// viewer): which web pages may connect (the handshake's Origin), comparing tokens, making one,
+// reading a token from a request's query, and what an unauthenticated client may send.
 #pragma once
 
 #include <cstddef>
@@ -21,6 +21,13 @@ bool SameToken(const std::string& given, const std::string& token);
 
 /// A random token of 32 hexadecimal digits (128 bits from std::random_device).
 std::string RandomToken();
+
+/// "/api/scene.json?token=T" -> path "/api/scene.json", query "token=T".
+void SplitResource(const std::string& resource, std::string* path, std::string* query);
+
+/// The value of `key` in a query "a=1&token=T" ("" when absent). Values are taken as they are
+/// (tokens are hexadecimal: nothing to decode).
+std::string QueryValue(const std::string& query, const std::string& key);
 
 /// Bytes a message may have before its client has authenticated (with a token set): the auth
 /// op needs a few dozen; longer messages are refused before they are parsed.

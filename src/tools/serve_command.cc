@@ -218,6 +218,19 @@ int RunServeCommand(int argc, char** argv) {
       vo.port = viewer_port;
       page = std::make_unique<Viewer>(&scene, vo);
       page->Attach(&sim);
+      // a joint of the robot moved in the page goes through the robot's controllers, as a ROS
+      // client's position command does: the other joints keep their targets
+      page->SetJointCommand(
+          [&served](const Articulation& a, const std::string& joint, double position) {
+            if (!(a == served.GetRobot())) return false;
+            std::vector<double> q;
+            for (const Joint& j : served.GetRobot().GetActiveJoints())
+              q.push_back(j.GetName() == joint        ? position
+                          : j.GetDriveStiffness() > 0 ? j.GetDriveTarget()
+                                                      : j.GetQpos());
+            served.CommandPositions(q, "the viewer's /partsim/set_joint_target");
+            return true;
+          });
       try {
         page->Start();
       } catch (const std::exception& e) {

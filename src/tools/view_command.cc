@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -15,6 +16,7 @@
 #include "arg_parser.h"
 #include "commands.h"
 #include "net_options.h"
+#include "partsim/assets/partnet_mobility.h"
 #include "partsim/physics/scene.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
@@ -25,6 +27,8 @@
 
 namespace partsim::tools {
 namespace {
+
+namespace fs = std::filesystem;
 
 constexpr char kViewUsage[] = R"(usage:
   partsim view [FILE.urdf | FOLDER | FILE.xml | SCENE.json] [--port P] [--address A] [--paused]
@@ -165,10 +169,21 @@ int RunViewCommand(int argc, char** argv) {
     Scene scene(cfg);
     scene.AddGround(0.0);
     AddServedObjects(&scene, file, Pose());
+    // an object (a PartNet-Mobility folder, a URDF) stands on the ground, as in the gallery: its
+    // frame is near its middle, which would sink its lower half; a scene file or MJCF model
+    // keeps the poses it gives
+    const std::string ext = fs::path(file).extension().string();
+    const bool placed = file.empty() || ext == ".json" || ext == ".xml";
+    if (!placed)
+      for (Articulation& a : scene.GetArticulations()) PlaceOnGround(a, 0.002);
     SetAmbientLight(scene, Eigen::Vector3f(0.35f, 0.35f, 0.35f));
     AddDirectionalLight(scene, Eigen::Vector3d(-1, -0.5, -1), Eigen::Vector3f(0.8f, 0.8f, 0.8f));
+    // the camera "front" looks at the front right: PartNet-Mobility objects face -x, the
+    // built-in cabinet +x
     Camera camera = AddCamera(scene, "front", 640, 480, 1.0, 0.05, 20.0);
-    camera.SetLocalPose(CameraLookAt(Eigen::Vector3d(1.8, -1.8, 1.4), Eigen::Vector3d(0, 0, 0.4)));
+    const double side = file.empty() ? 1.0 : -1.0;
+    camera.SetLocalPose(
+        CameraLookAt(Eigen::Vector3d(1.8 * side, -1.8 * side, 1.4), Eigen::Vector3d(0, 0, 0.4)));
 
     SimServer sim(&scene, nullptr);
     ViewerOptions vo;

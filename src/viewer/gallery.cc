@@ -17,9 +17,9 @@
 #include "partsim/physics/scene.h"
 #include "partsim/render/camera.h"
 #include "partsim/render/camera_math.h"
+#include "partsim/render/image_io.h"
 #include "partsim/render/scene_render.h"
 #include "viewer/http_util.h"
-#include "viewer/png_encode.h"
 
 // The gallery lives on two threads: the network thread answers /api/gallery.json from what the
 // scan found (immutable after construction) and hands everything that touches a scene (opening,
@@ -316,7 +316,7 @@ std::string Gallery::Thumbnail(int index) {
     UpdateRender(*thumbs_);
     camera.TakePicture(kColor);
     const std::vector<uint8_t> rgba = camera.GetColorRGBA8();
-    png = internal::EncodePng(w, h, 4, rgba.data());
+    png = EncodePng(w, h, 4, rgba.data(), kFastPngCompression);
   } catch (...) {
     thumbs_->RemoveArticulation(a);
     throw;

@@ -12,25 +12,6 @@
 
 namespace partsim::internal {
 
-void SplitResource(const std::string& resource, std::string* path, std::string* query) {
-  const size_t q = resource.find('?');
-  *path = resource.substr(0, q);
-  *query = q == std::string::npos ? "" : resource.substr(q + 1);
-}
-
-std::string QueryValue(const std::string& query, const std::string& key) {
-  size_t at = 0;
-  while (at <= query.size()) {
-    size_t end = query.find('&', at);
-    if (end == std::string::npos) end = query.size();
-    const std::string item = query.substr(at, end - at);
-    const size_t eq = item.find('=');
-    if (item.substr(0, eq) == key) return eq == std::string::npos ? "" : item.substr(eq + 1);
-    at = end + 1;
-  }
-  return "";
-}
-
 bool SafeBundlePath(const std::string& path) {
   if (path.size() < 2 || path[0] != '/') return false;
   size_t at = 1;

@@ -1,5 +1,5 @@
-// The HTTP side of the viewer, apart from its socket: splitting a request's resource, reading
-// its query, which bundle paths may be served, which files may be read for them, and their
+// The HTTP side of the viewer, apart from its socket (the server's): which bundle paths may be
+// served, which files may be read for them, and their
 // content types.
 #pragma once
 
@@ -7,13 +7,6 @@
 #include <string>
 
 namespace partsim::internal {
-
-/// "/api/scene.json?token=T" -> path "/api/scene.json", query "token=T".
-void SplitResource(const std::string& resource, std::string* path, std::string* query);
-
-/// The value of `key` in a query "a=1&token=T" ("" when absent). Values are taken as they are
-/// (tokens are hexadecimal: nothing to decode).
-std::string QueryValue(const std::string& query, const std::string& key);
 
 /// Whether `path` ("/viewer.js", "/assets/index-3f2a.js") names a file the bundle may serve:
 /// segments of letters, digits, '.', '_' and '-' that do not start with '.', so that no path

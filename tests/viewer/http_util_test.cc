@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "server/web_security.h"
+
 namespace partsim::internal {
 namespace {
 

@@ -1,9 +1,11 @@
 // The viewer in the browser (docs/viewer.md): one port that serves the web page, the scene's
 // content over HTTP (/api/scene.json, /api/mesh/K.bin, /api/texture/K.png) and a rosbridge v2
 // WebSocket (/partsim/poses, /partsim/joint_states, /partsim/status, /partsim/contacts out;
-// /partsim/set_joint_target, pause, resume, reset, step, camera and close in). The network runs
-// on a thread of its own; the scene is read and changed only on the thread that owns it: the
-// caller of Render() (synchronous mode) or a SimServer's thread (served mode, Attach).
+// /partsim/set_joint_target, pause, resume, reset, step, camera and close in). The port is a
+// RosbridgeServer's (partsim/server/rosbridge.h: its accept loop, login, Origin check and op
+// table) to which the viewer adds its topics, services and HTTP routes. The network runs on a
+// thread of its own; the scene is read and changed only on the thread that owns it: the caller
+// of Render() (synchronous mode) or a SimServer's thread (served mode, Attach).
 #pragma once
 
 #include <Eigen/Core>
@@ -14,6 +16,7 @@
 
 namespace partsim {
 
+class Articulation;
 class Scene;
 class SimServer;
 
@@ -45,7 +48,7 @@ struct ViewerOptions {
 
 /// Counters for tests and benchmarks.
 struct ViewerStats {
-  long long clients = 0;           ///< WebSocket clients connected now
+  long long clients = 0;           ///< WebSocket clients connected now that have authenticated
   long long messages_sent = 0;     ///< WebSocket messages handed to sockets
   long long messages_dropped = 0;  ///< publications dropped for slow clients
   long long http_requests = 0;     ///< HTTP requests answered (any status)
@@ -72,6 +75,13 @@ using ViewerServiceReply = std::function<void(bool success, const std::string& t
 /// Handles a call of an extra service on the network thread: `args_json` is its args (a JSON
 /// object's text); it must return quickly and answers through `reply`.
 using ViewerService = std::function<void(const std::string& args_json, ViewerServiceReply reply)>;
+
+/// Moves joint `joint` of `articulation` to `position` the way a network client's command does
+/// (a served robot's controllers); returns false for an articulation it does not serve, which
+/// the viewer then moves with a position controller of its own. Runs on the scene's thread;
+/// throws partsim::Error for a position it refuses.
+using ViewerJointCommand = std::function<bool(const Articulation& articulation,
+                                              const std::string& joint, double position)>;
 
 class Viewer {
  public:
@@ -144,6 +154,12 @@ class Viewer {
   /// Answers the rosbridge service `name` (e.g. "/partsim/open") by `service`. Before Start();
   /// throws partsim::Error for a name the viewer answers itself or one added already.
   void AddService(const std::string& name, ViewerService service);
+  /// How the page's joint commands (/partsim/set_joint_target) reach the articulations
+  /// `command` serves (partsim serve --viewer: the served robot's controllers, the path of a ROS
+  /// client's command). Any other articulation's joint gets a JointPositionController of its own
+  /// (the robot layer's, default gains, at the physics rate), updated at each Render() or, in
+  /// served mode, from the step callback. Before Start().
+  void SetJointCommand(ViewerJointCommand command);
   /// Runs `command` on the scene's thread: synchronous mode, at the next Render() (also while
   /// it blocks paused), which then snapshots the scene; served mode, posted to the SimServer.
   /// What it throws is written to stderr.
