@@ -14,6 +14,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -1088,10 +1089,13 @@ TEST_F(RosbridgeTest, OneCharacterFragmentsCostTheSimulationNothing) {
       << "500 steps (1 s of simulated time) did not pass within 30 s";
   const auto [cpu1, steps1] = sim_thread();
   ASSERT_GE(steps1, steps0 + 500);
-  // the thread's own CPU time, which other work on the machine does not inflate: cutting the
-  // pieces took about 9 ms a step (110 steps/s); a step of real time at 500 Hz is 2 ms
+  // the thread's own CPU time, which other work on the machine hardly changes (0.25-0.36 ms a
+  // step with both cores busy): cutting the pieces took about 9 ms a step (110 steps/s), more
+  // than the 2 ms that a step of real time at 500 Hz leaves
   const double per_step = (cpu1 - cpu0) / static_cast<double>(steps1 - steps0);
-  EXPECT_LT(per_step, 1e-3) << "CPU seconds per step on the simulation thread";
+  std::printf("simulation thread with a one-character subscriber: %.0f us of CPU per step\n",
+              per_step * 1e6);
+  EXPECT_LT(per_step, 2e-3) << "CPU seconds per step on the simulation thread";
 }
 
 // Random and mutated messages from one client (bounded in count and time, loopback only): the
