@@ -74,14 +74,6 @@ CameraEntry MakeEntry(int id, const std::string& name, int width, int height, do
   return c;
 }
 
-// key of a primitive visual in the mesh cache: its type and exact sizes
-std::string PrimitiveKey(const VisualShape& v) {
-  char buf[160];
-  std::snprintf(buf, sizeof(buf), "%d %.17g %.17g %.17g %.17g %.17g", static_cast<int>(v.type),
-                v.half_size.x(), v.half_size.y(), v.half_size.z(), v.radius, v.half_length);
-  return buf;
-}
-
 bool SameMaterial(const RenderMaterial& a, const RenderMaterial& b) {
   return a.base_color == b.base_color && a.roughness == b.roughness && a.metallic == b.metallic &&
          a.diffuse_texture == b.diffuse_texture;
@@ -297,7 +289,7 @@ void UpdateRender(Scene& scene) {
         inst.mesh = v.mesh;
       } else {
         // primitives share one mesh per size, stable across rebuilds
-        std::string key = PrimitiveKey(v);
+        std::string key = internal::PrimitiveKey(v);
         auto it = s.primitive_meshes.find(key);
         std::shared_ptr<const MeshData> mesh =
             it != s.primitive_meshes.end() ? it->second : MakePrimitiveMesh(v);

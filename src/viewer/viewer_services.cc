@@ -198,28 +198,22 @@ void Viewer::Impl::AddServices() {
   });
   // pause, resume and step: the SimServer's in served mode, Render()'s otherwise
   RosbridgeSimControls controls;
-  controls.pause = [this] {
+  auto set_paused = [this](bool pause) {
     if (sim) {
-      sim->Pause();
+      if (pause)
+        sim->Pause();
+      else
+        sim->Resume();
     } else {
       std::lock_guard<std::mutex> lock(mutex);
-      paused = true;
+      paused = pause;
       pending_steps = 0;
     }
     cv.notify_all();
     PublishStatus();
   };
-  controls.resume = [this] {
-    if (sim) {
-      sim->Resume();
-    } else {
-      std::lock_guard<std::mutex> lock(mutex);
-      paused = false;
-      pending_steps = 0;
-    }
-    cv.notify_all();
-    PublishStatus();
-  };
+  controls.pause = [set_paused] { set_paused(true); };
+  controls.resume = [set_paused] { set_paused(false); };
   controls.step = [this](long long n) {
     // while running: pause first, then the n steps
     if (sim) {

@@ -21,11 +21,9 @@ They skip only when Chromium cannot start; a missing page (build/web) fails.
 import json
 import math
 import os
-import queue
 import re
 import subprocess
 import sys
-import time
 import urllib.request
 
 import pytest
@@ -49,17 +47,8 @@ def _serve_and_check(args, out, name, parts):
                               stderr=subprocess.STDOUT, text=True, env=env, cwd=out)
     try:
         lines = Lines(server)
-        url = None
-        deadline = time.time() + 90
-        while url is None and time.time() < deadline:
-            try:
-                line = lines.next(timeout=max(deadline - time.time(), 0.1))
-            except queue.Empty:
-                break
-            if line is None:
-                break
-            m = URL.search(line.get("text", ""))
-            url = m.group(0) if m else None
+        m = lines.wait_for(URL, 90)
+        url = m.group(0) if m else None
         if url is None:
             stop(server)
             text = "\n".join(ln.get("text", json.dumps(ln)) for ln in lines.all)

@@ -15,12 +15,10 @@ PARTSIM_UPDATE_SCREENSHOT=1 copies the gallery's screenshot to docs/images/viewe
 
 import json
 import os
-import queue
 import re
 import shutil
 import subprocess
 import sys
-import time
 import urllib.request
 import xml.etree.ElementTree as ET
 
@@ -79,17 +77,8 @@ def session(tmp_path_factory):
                               env=env, cwd=out)
     try:
         lines = Lines(server)
-        url = None
-        deadline = time.time() + 90
-        while url is None and time.time() < deadline:
-            try:
-                line = lines.next(timeout=max(deadline - time.time(), 0.1))
-            except queue.Empty:
-                break
-            if line is None:
-                break
-            m = URL.search(line.get("text", ""))
-            url = m.group(0) if m else None
+        m = lines.wait_for(URL, 90)
+        url = m.group(0) if m else None
         text = "\n".join(ln.get("text", json.dumps(ln)) for ln in lines.all)
         if url is None:
             stop(server)

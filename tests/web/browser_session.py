@@ -10,6 +10,7 @@ import queue
 import shutil
 import subprocess
 import threading
+import time
 
 import pytest
 
@@ -41,6 +42,22 @@ class Lines:
     def next(self, timeout):
         """The next line (None at the end of the output); raises queue.Empty after `timeout` s."""
         return self.q.get(timeout=timeout)
+
+    def wait_for(self, pattern, seconds):
+        """The first match of the compiled regex `pattern` in a text line of the next `seconds`;
+        None when the output ends or the time runs out first."""
+        deadline = time.time() + seconds
+        while time.time() < deadline:
+            try:
+                line = self.next(timeout=max(deadline - time.time(), 0.1))
+            except queue.Empty:
+                return None
+            if line is None:
+                return None
+            m = pattern.search(line.get("text", ""))
+            if m:
+                return m
+        return None
 
 
 def stop(proc):
