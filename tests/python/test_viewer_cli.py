@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import CABINET_URDF, PYTHON_DIR, REPO
+from conftest import CABINET_URDF, PYTHON_DIR, REPO, require
 
-websocket = pytest.importorskip("websocket")  # Debian's python3-websocket (scripts/setup.sh)
+websocket = require("websocket", "websocket-client (requirements.lock)")
 
 CLI = os.environ.get("PARTSIM_CLI", os.path.join(os.path.dirname(os.path.abspath(PYTHON_DIR)),
                                                  "partsim"))

@@ -11,10 +11,10 @@ import time
 
 import pytest
 
-from conftest import CABINET_URDF
+from conftest import CABINET_URDF, require
 from test_viewer_cli import call, serve  # noqa: F401 (serve: the fixture)
 
-websocket = pytest.importorskip("websocket")
+websocket = require("websocket", "websocket-client (requirements.lock)")
 
 ROSBRIDGE = re.compile(r"rosbridge on ws://127\.0\.0\.1:(\d+), robot /(\S+) ")
 

@@ -11,8 +11,9 @@ import time
 import pytest
 
 import partsim
+from conftest import require
 
-websocket = pytest.importorskip("websocket")  # Debian's python3-websocket (scripts/setup.sh)
+websocket = require("websocket", "websocket-client (requirements.lock)")
 
 
 def _scene(timestep):
