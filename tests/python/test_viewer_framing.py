@@ -171,7 +171,10 @@ def test_first_camera_frames_every_part(view):
 
 def test_front_parts_are_visible_and_clicks_select_them(view):
     if not view["parts"]:
-        pytest.skip("no part to click in this case")
+        # a case with no part named to click (two objects; the real bottle): the page was
+        # asked for no clicks and made none
+        assert not view["page"].get("clicks"), view["page"]["clicks"]
+        return
     clicks = view["page"]["clicks"]
     assert clicks, view["page"]["bodies"]
     for c in clicks:
