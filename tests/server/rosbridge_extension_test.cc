@@ -22,34 +22,7 @@ namespace {
 using json = nlohmann::json;
 using testing::WaitFor;
 
-class Client {
- public:
-  explicit Client(int port)
-      : ws_(
-            port, "",
-            [this](const testing::WsTestClient::Client::message_ptr& m) {
-              log_.Add(json::parse(m->get_payload(), nullptr, false));
-            },
-            "/") {}
-  bool WaitOpen() { return ws_.WaitOpen(); }
-  void Send(const json& j) { ws_.Send(j.dump()); }
-  template <class F>
-  json Wait(F pred) {
-    return log_.Wait(pred);
-  }
-  json Reply(const std::string& id) {
-    return Wait([&](const json& m) { return m.value("id", "") == id; });
-  }
-  int Count(const std::string& topic) {
-    int n = 0;
-    for (const json& m : log_.All()) n += m.value("topic", "") == topic;
-    return n;
-  }
-
- private:
-  testing::MessageLog log_;
-  testing::WsTestClient ws_;  // last: its thread stops before the log goes
-};
+using Client = testing::LoggedWsClient;
 
 TEST(RosbridgeExtensionTest, ServesWhatItsExtensionAdds) {
   RosbridgeOptions o;

@@ -185,4 +185,33 @@ class MessageLog {
   std::vector<json> messages_;
 };
 
+/// A WebSocket client of ws://127.0.0.1:`port`/ that keeps every JSON message it receives.
+class LoggedWsClient {
+ public:
+  using json = nlohmann::json;
+  explicit LoggedWsClient(int port)
+      : ws_(
+            port, "",
+            [this](const WsTestClient::Client::message_ptr& m) {
+              log_.Add(json::parse(m->get_payload(), nullptr, false));
+            },
+            "/") {}
+  bool WaitOpen() { return ws_.WaitOpen(); }
+  void Send(const json& j) { ws_.Send(j.dump()); }
+  std::vector<json> Messages() { return log_.All(); }
+  /// Waits (up to 30 s) for a message satisfying `pred`; returns it, or null.
+  template <class F>
+  json Wait(F pred) {
+    return log_.Wait(pred);
+  }
+  /// The first message with id `id` (up to 30 s), or null.
+  json Reply(const std::string& id) {
+    return Wait([&](const json& m) { return m.value("id", "") == id; });
+  }
+
+ private:
+  MessageLog log_;
+  WsTestClient ws_;  // last: its thread stops before the log goes
+};
+
 }  // namespace partsim::testing

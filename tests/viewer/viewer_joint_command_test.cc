@@ -35,42 +35,30 @@ constexpr char kCabinet[] = R"(<robot name="cabinet">
     <origin xyz="0.3 0 -0.2"/><axis xyz="0 0 1"/><limit lower="0" upper="1.5" effort="100" velocity="1"/></joint>
 </robot>)";
 
-class Client {
+/// A logged client that logs in and moves joints.
+class Client : public testing::LoggedWsClient {
  public:
-  explicit Client(int port)
-      : ws_(
-            port, "",
-            [this](const testing::WsTestClient::Client::message_ptr& m) {
-              log_.Add(json::parse(m->get_payload(), nullptr, false));
-            },
-            "/") {}
+  using LoggedWsClient::LoggedWsClient;
   bool Login(const std::string& token) {
-    if (!ws_.WaitOpen()) return false;
-    ws_.Send(json{{"op", "auth"}, {"mac", token}}.dump());
-    return !log_.Wait([](const json& m) { return m.value("msg", "") == "authenticated"; })
-                .is_null();
+    if (!WaitOpen()) return false;
+    Send(json{{"op", "auth"}, {"mac", token}});
+    return !Wait([](const json& m) { return m.value("msg", "") == "authenticated"; }).is_null();
   }
   /// Calls set_joint_target and renders until the answer comes (30 s at most).
   json Move(Viewer& v, const std::string& joint, double position, const std::string& id) {
-    ws_.Send(json{
-        {"op", "call_service"},
-        {"service", "/partsim/set_joint_target"},
-        {"args", {{"articulation", 0}, {"joint", joint}, {"position", position}}},
-        {"id",
-         id}}.dump());
+    Send(json{{"op", "call_service"},
+              {"service", "/partsim/set_joint_target"},
+              {"args", {{"articulation", 0}, {"joint", joint}, {"position", position}}},
+              {"id", id}});
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
     while (std::chrono::steady_clock::now() < deadline) {
       v.Render();
-      for (const json& m : log_.All())
+      for (const json& m : Messages())
         if (m.value("id", "") == id && m.value("op", "") == "service_response") return m;
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     return json();
   }
-
- private:
-  testing::MessageLog log_;
-  testing::WsTestClient ws_;  // last: its thread stops before the log goes
 };
 
 class ViewerJointCommandTest : public ::testing::Test {
