@@ -130,7 +130,7 @@ struct RosbridgeStats {
   long long commands = 0;               ///< robot commands applied (from any front-end)
   double mean_latency_steps = 0.0;      ///< steps between a command's arrival and its application
   long long max_latency_steps = 0;
-  long long errors = 0;   ///< status errors sent
+  long long errors = 0;   ///< error statuses and failed service responses sent
   long long refused = 0;  ///< handshakes refused (origin, connection cap)
   /// failed accepts (out of file descriptors), each then waits 100 ms
   long long accept_errors = 0;
