@@ -169,6 +169,16 @@ std::pair<int, int> FlagValue::Size(int lo, int hi) const {
   return {static_cast<int>(w), static_cast<int>(h)};
 }
 
+std::pair<int, int> FlagValue::Shard() const {
+  const size_t slash = text_.find('/');
+  long long i = -1, n = -1;
+  if (slash == std::string::npos || !ReadInteger(text_.substr(0, slash), &i) ||
+      !ReadInteger(text_.substr(slash + 1), &n) || n < 1 || n > std::numeric_limits<int>::max() ||
+      i < 0 || i >= n)
+    Fail(flag_ + " wants i/N with 0 <= i < N (e.g. 0/4), got '" + text_ + "'");
+  return {static_cast<int>(i), static_cast<int>(n)};
+}
+
 // ---------------------------------------------------------------------------------------------
 // ArgParser
 

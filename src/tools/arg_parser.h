@@ -49,6 +49,9 @@ class FlagValue {
                      const std::vector<std::string>& hidden = {}) const;
   /// "WxH" with each of W and H from `lo` to `hi`.
   std::pair<int, int> Size(int lo, int hi) const;
+  /// "i/N" of --shard, 0 <= i < N: this process's share of a list, the items whose index % N is
+  /// i. Returns {i, N}.
+  std::pair<int, int> Shard() const;
 
   /// Throws UsageError("<command>: `message`").
   [[noreturn]] void Fail(const std::string& message) const;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "../core/progress.h"
@@ -19,10 +20,11 @@ namespace {
 
 constexpr char kAssetsUsage[] = R"(usage:
   partsim assets generate --out DIR [--categories all|Cat1,Cat2] [--per-category N|paper]
-                          [--seed S] [--jobs J] [--by-category] [--overwrite]
+                          [--seed S] [--jobs J] [--by-category] [--overwrite] [--shard i/N]
   partsim assets categories
   partsim assets check DIR [--jobs J] [--no-visibility] [--backend B] [--report FILE]
-                       [--limit N]
+                       [--limit N] [--shard i/N] [--results FILE]
+  partsim assets check --merge FILE... [--report FILE] [--results FILE]
   partsim assets decompose MESH --out DIR [--concavity C] [--max-pieces N]
 
 generate     writes DIR/<anno_id>/ folders in the PartNet-Mobility format, laid out as the
@@ -38,6 +40,13 @@ generate     writes DIR/<anno_id>/ folders in the PartNet-Mobility format, laid 
   --overwrite             DIR may hold objects of an earlier run: they are replaced (without
                           it a non-empty DIR is refused); other files there are left alone.
                           Each object is written to <anno_id>.partial and renamed when whole.
+  --shard i/N             write only the objects whose index in the whole run's order
+                          (categories, then index) % N is i. Several shards may write into one
+                          DIR, at once or in turn: DIR may hold other objects, and this shard's
+                          objects already whole there are skipped (rewritten with --overwrite,
+                          which then replaces only this shard's objects). The N shards' trees
+                          together are a single run's, byte for byte: generate writes nothing
+                          but the object folders.
 categories   lists the 46 categories with the paper's model and part counts.
 check        runs the quality checks on every object folder under DIR and prints the models and
              movable parts per category beside the paper's (`check --help` for more).
@@ -74,6 +83,10 @@ int Generate(const std::vector<std::string>& args) {
   });
   p.Switch("--by-category", [&] { opt.by_category = true; });
   p.Switch("--overwrite", [&] { opt.overwrite = true; });
+  p.Option("--shard", [&](const FlagValue& v) {
+    std::tie(opt.shard_index, opt.shard_count) = v.Shard();
+    opt.shared_out_dir = true;
+  });
   p.Parse(args);
   if (!have_out) p.Fail("--out DIR is required");
   // unknown categories are a bad command line, refused before anything is written
@@ -86,16 +99,29 @@ int Generate(const std::vector<std::string>& args) {
 
   auto start = std::chrono::steady_clock::now();
   internal::ProgressLine progress(stderr);
-  int written = GenerateDataset(opt, [&](int done, int total, const GeneratedObject& o) {
-    double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    double eta = done > 0 ? t / done * (total - done) : 0.0;
-    progress.Update(done, total,
-                    "[" + std::to_string(done) + "/" + std::to_string(total) + "] " + o.category +
-                        " " + o.anno_id + "  elapsed " + Clock(t) + "  eta " + Clock(eta));
-  });
+  int skipped = 0;
+  int written = GenerateDataset(
+      opt,
+      [&](int done, int total, const GeneratedObject& o) {
+        double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        double eta = done > 0 ? t / done * (total - done) : 0.0;
+        progress.Update(done, total,
+                        "[" + std::to_string(done) + "/" + std::to_string(total) + "] " +
+                            o.category + " " + o.anno_id + "  elapsed " + Clock(t) + "  eta " +
+                            Clock(eta));
+      },
+      &skipped);
   progress.Break();
   double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::fprintf(stderr, "wrote %d objects to %s in %.1f s\n", written, opt.out_dir.c_str(), t);
+  const std::string shard = opt.shared_out_dir ? " (shard " + std::to_string(opt.shard_index) +
+                                                     "/" + std::to_string(opt.shard_count) + ")"
+                                               : "";
+  std::fprintf(stderr, "wrote %d objects to %s%s in %.1f s", written, opt.out_dir.c_str(),
+               shard.c_str(), t);
+  if (opt.shared_out_dir)
+    std::fprintf(stderr, "; skipped %d already there\n", skipped);
+  else
+    std::fprintf(stderr, "\n");
   return 0;
 }
 

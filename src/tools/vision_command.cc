@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "arg_parser.h"
@@ -176,22 +177,8 @@ vision::DatasetOptions ParseDatasetArgs(const std::string& name, vision::Dataset
   p.Option("--seed", [&](const FlagValue& v) { o.seed = v.Unsigned(); });
   p.Option("--split", [&](const FlagValue& v) { o.split = v.Number(0, true, 1); });
   p.Option("--jobs", [&](const FlagValue& v) { o.jobs = static_cast<int>(v.Integer(1, 256)); });
-  p.Option("--shard", [&](const FlagValue& v) {
-    const std::string& t = v.Text();
-    const size_t slash = t.find('/');
-    char* end = nullptr;
-    long i = -1, n = -1;
-    if (slash != std::string::npos) {
-      i = std::strtol(t.c_str(), &end, 10);
-      if (end != t.c_str() + slash) i = -1;
-      n = std::strtol(t.c_str() + slash + 1, &end, 10);
-      if (*end != '\0') n = -1;
-    }
-    if (!(n >= 1 && i >= 0 && i < n))
-      p.Fail("--shard wants i/N with 0 <= i < N (e.g. 0/4), got '" + t + "'");
-    o.shard_index = static_cast<int>(i);
-    o.shard_count = static_cast<int>(n);
-  });
+  p.Option("--shard",
+           [&](const FlagValue& v) { std::tie(o.shard_index, o.shard_count) = v.Shard(); });
   p.Option("--backend", [&](const FlagValue& v) {
     o.backend = v.Choice({"rasterizer", "pathtracer"});
   });

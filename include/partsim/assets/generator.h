@@ -91,6 +91,15 @@ struct GeneratorOptions {
   /// object folders partsim generated there before (meta.json names the generator) and the
   /// leftovers of interrupted runs (*.partial) are removed first, and nothing else is touched.
   bool overwrite = false;
+  /// This run writes only the objects whose index in the whole run's work list (categories in
+  /// order, then index) % shard_count == shard_index; 0 <= shard_index < shard_count.
+  int shard_index = 0;
+  int shard_count = 1;
+  /// out_dir is shared with other runs (shards of one dataset, at once or one after another): a
+  /// non-empty out_dir is not refused and nothing there is removed first; an object of this run
+  /// whose folder is already whole there (same seed and index in its meta.json) is skipped, or
+  /// rewritten with overwrite; a folder of that name holding anything else is refused.
+  bool shared_out_dir = false;
 };
 
 /// Suffix of the folder an object is written into before it is renamed into place: an object
@@ -131,9 +140,12 @@ bool IsGeneratedObjectFolder(const std::string& folder);
 /// Whether `folder` is a staging folder WriteObject left behind (its name ends in kPartialSuffix).
 bool IsPartialObjectFolder(const std::string& folder);
 
-/// Generates and writes the objects of `options` on `options.jobs` threads; calls `progress`
-/// (serialised) after each object. Returns the number of objects written.
+/// Generates and writes the objects of `options` (of its shard) on `options.jobs` threads; calls
+/// `progress` (serialised) after each object written, `total` being the objects to write. Returns
+/// the number of objects written; `skipped`, when given, receives the number of objects that were
+/// already whole in a shared out_dir and were left as they are.
 int GenerateDataset(const GeneratorOptions& options,
-                    const GeneratorProgress& progress = GeneratorProgress());
+                    const GeneratorProgress& progress = GeneratorProgress(),
+                    int* skipped = nullptr);
 
 }  // namespace partsim

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "assets/generator/categories.h"
+#include "core/file_read.h"
 #include "partsim/core/error.h"
 
 namespace partsim {
@@ -157,6 +158,16 @@ std::vector<std::string> GeneratorCategories() {
 int PaperModelCount(const std::string& category) { return Find(category).models; }
 int PaperPartCount(const std::string& category) { return Find(category).parts; }
 
+namespace {
+
+// meta.json's anno_id and the folder name: 1CCIIII with CC the category's place in the table and
+// IIII the index
+std::string AnnoId(const std::string& category, int index) {
+  return std::to_string(1000000 + CategoryIndex(category) * 10000 + index);
+}
+
+}  // namespace
+
 GeneratedObject GenerateObject(const std::string& category, int index, std::uint64_t seed) {
   const CategoryInfo& info = Find(category);
   if (index < 0 || index >= 10000) {
@@ -166,9 +177,8 @@ GeneratedObject GenerateObject(const std::string& category, int index, std::uint
   out.category = info.name;
   out.index = index;
   out.seed = seed;
-  // anno_id: 1CCIIII with CC the category's place in the table and IIII the index
   const std::uint64_t object_seed = ObjectSeed(seed, category, index);
-  out.anno_id = std::to_string(1000000 + CategoryIndex(category) * 10000 + index);
+  out.anno_id = AnnoId(category, index);
   out.model_id = ModelId(object_seed);
   Rng rng(object_seed);
   ObjectBuilder b(&out);
@@ -191,7 +201,8 @@ void PrepareOutDir(const GeneratorOptions& options) {
   if (!fs::exists(out, ec)) return;
   if (!fs::is_directory(out, ec))
     throw Error("GenerateDataset: '" + options.out_dir + "' exists and is not a folder");
-  if (fs::is_empty(out, ec)) return;
+  // other runs' objects are not this run's to refuse or remove
+  if (options.shared_out_dir || fs::is_empty(out, ec)) return;
   if (!options.overwrite)
     throw Error("GenerateDataset: '" + options.out_dir +
                 "' is not empty, and old and new objects would mix: choose an empty folder, or "
@@ -214,19 +225,61 @@ void PrepareOutDir(const GeneratorOptions& options) {
   }
 }
 
+// Whether the folder of object `index` of `category` is already whole in a shared output folder
+// (a folder appears whole or not at all, see WriteObject), written with this seed; throws naming
+// a folder of that name that partsim generated with another seed or index.
+bool AlreadyWritten(const GeneratorOptions& options, const std::string& category, int index) {
+  namespace fs = std::filesystem;
+  fs::path dir(options.out_dir);
+  if (options.by_category) dir /= category;
+  dir /= AnnoId(category, index);
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec) || !IsGeneratedObjectFolder(dir.string())) return false;
+  const std::string meta = internal::ReadWholeFile((dir / "meta.json").string(), "meta.json");
+  const std::string mine =
+      "\"seed\": " + std::to_string(options.seed) + ", \"index\": " + std::to_string(index) + "}";
+  if (meta.find(mine) != std::string::npos) return true;
+  throw Error("GenerateDataset: '" + dir.string() +
+              "' holds an object generated with another seed or index than this run's (its "
+              "meta.json has no '" +
+              mine +
+              "'): choose another folder, or overwrite it "
+              "(--overwrite)");
+}
+
 }  // namespace
 
-int GenerateDataset(const GeneratorOptions& options, const GeneratorProgress& progress) {
-  // the work list, in category then index order
+int GenerateDataset(const GeneratorOptions& options, const GeneratorProgress& progress,
+                    int* skipped) {
+  if (!(options.shard_count >= 1 && options.shard_index >= 0 &&
+        options.shard_index < options.shard_count))
+    throw Error("GenerateDataset: shard " + std::to_string(options.shard_index) + "/" +
+                std::to_string(options.shard_count) + " is not one: it needs 0 <= i < N");
+  // the work list, in category then index order; this shard's share of it
   std::vector<std::string> cats =
       options.categories.empty() ? GeneratorCategories() : options.categories;
   std::vector<std::pair<std::string, int>> work;
+  int position = 0;
   for (const std::string& c : cats) {
     int n = options.per_category > 0 ? options.per_category : PaperModelCount(c);
-    for (int i = 0; i < n; ++i) work.emplace_back(Find(c).name, i);
+    for (int i = 0; i < n; ++i, ++position)
+      if (position % options.shard_count == options.shard_index) work.emplace_back(Find(c).name, i);
   }
   if (options.out_dir.empty()) throw Error("GenerateDataset: out_dir is empty");
   PrepareOutDir(options);
+  // in a shared folder, what this shard wrote before (or another process at once) stays
+  int already = 0;
+  if (options.shared_out_dir && !options.overwrite) {
+    std::vector<std::pair<std::string, int>> todo;
+    for (const auto& w : work) {
+      if (AlreadyWritten(options, w.first, w.second))
+        ++already;
+      else
+        todo.push_back(w);
+    }
+    work = std::move(todo);
+  }
+  if (skipped) *skipped = already;
   const int total = static_cast<int>(work.size());
   std::atomic<int> next{0};
   std::mutex mutex;
