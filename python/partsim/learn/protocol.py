@@ -41,6 +41,7 @@ __all__ = [
     "task_objects",
     "train",
     "evaluate_run",
+    "merge_evaluations",
     "table",
     "plot_curves",
     "main",
@@ -357,8 +358,115 @@ def _score(task: str, opened: np.ndarray, progress: np.ndarray) -> float:
     return float(np.mean(progress >= DRAWER_SUCCESS))
 
 
+def _parse_shard(shard) -> tuple:
+    """(i, N) from "i/N" or a pair; ValueError unless 0 <= i < N."""
+    try:
+        i, n = (int(x) for x in (shard.split("/") if isinstance(shard, str) else shard))
+    except (ValueError, TypeError):
+        raise ValueError(f"--shard wants i/N with 0 <= i < N (e.g. 0/4), got {shard!r}") from None
+    if not 0 <= i < n:
+        raise ValueError(f"--shard wants i/N with 0 <= i < N (e.g. 0/4), got '{i}/{n}'")
+    return i, n
+
+
+def _evaluate_objects(run: str, doc: dict, episodes: int, seed: int, which, policy: str,
+                      shard, quiet: bool) -> list:
+    """Plays the episodes of the objects of ``which`` (training, then test objects, in the run's
+    order) whose index in that order is i modulo N for ``shard`` = (i, N); returns one record
+    per object: its set, its index in the set, its name and its episodes as [return, length,
+    opened, progress, success] rows. An object's episodes depend on nothing but the run, the
+    seed and the object's place, so any shard plays them as one run does."""
+    from .trainer import evaluate as run_episodes
+
+    config = RunConfig.from_json(doc["config"])
+    agent = None
+    records, index = [], 0
+    for s, name in enumerate(which):
+        for k, obj in enumerate(doc[name]):
+            index += 1
+            if (index - 1) % shard[1] != shard[0]:
+                continue
+            env = _make_env(config, [obj], min(episodes, config.num_envs))
+            try:
+                if agent is None and policy == "agent":
+                    agent = _load_agent(run, config, env)
+                random_policy = None
+                if policy == "random":
+                    rng = np.random.default_rng([seed, s, k])  # the object's own stream
+                    random_policy = lambda o: rng.uniform(-1, 1, (len(_first(o)), 7))  # noqa: E731
+                ev = run_episodes(env, agent, episodes, seed=seed + 1000 * k,
+                                  policy=random_policy)
+            finally:
+                env.close()
+            rows = [[float(ev.returns[j]), int(ev.lengths[j]), float(ev.infos[j]["opened"]),
+                     float(ev.infos[j]["progress"]), bool(ev.infos[j]["success"])]
+                    for j in range(len(ev.returns))]
+            records.append({"set": name, "index": k, "object": obj, "episodes": rows})
+            if not quiet:
+                opened = np.array([r[2] for r in rows])
+                progress = np.array([r[3] for r in rows])
+                print(f"{name} object {obj}: {_score(config.task, opened, progress):.3f}",
+                      file=sys.stderr)
+    return records
+
+
+def _write_evaluation(run: str, doc: dict, episodes: int, seed: int, which, policy: str,
+                      records: list) -> dict:
+    """eval.json (or eval_random.json) and its CSV from every object's record, as one run of
+    :func:`evaluate_run` writes them; returns the summary."""
+    config = RunConfig.from_json(doc["config"])
+    result = {"episodes": int(episodes), "seed": int(seed), "policy": policy,
+              "task": config.task, "obs": config.obs, "train_objects": config.train_objects,
+              "steps": config.steps, "metric": "final angle (degrees)" if config.task == "door"
+              else f"success rate at {int(DRAWER_SUCCESS * 100)}% of the range"}
+    by_place = {(r["set"], r["index"]): r for r in records}
+    rows = []
+    for name in which:
+        per_object, episodes_all = [], []
+        for k in range(len(doc[name])):
+            eps = by_place[(name, k)]["episodes"]
+            opened = np.array([e[2] for e in eps], dtype=float)
+            progress = np.array([e[3] for e in eps], dtype=float)
+            per_object.append({"object": doc[name][k],
+                               "metric": _score(config.task, opened, progress),
+                               "mean_return": float(np.mean([e[0] for e in eps]))})
+            rows += [[name, doc[name][k], j] + list(e) for j, e in enumerate(eps)]
+            episodes_all += eps
+        result[name] = {
+            "metric": _score(config.task, np.array([e[2] for e in episodes_all], dtype=float),
+                             np.array([e[3] for e in episodes_all], dtype=float)),
+            "mean_return": float(np.mean([e[0] for e in episodes_all])),
+            "success_rate": float(np.mean([bool(e[4]) for e in episodes_all])),
+            "objects": per_object,
+        }
+    stem = "eval" if policy == "agent" else "eval_random"
+    _write_atomic(os.path.join(run, stem + ".json"), json.dumps(result, indent=1))
+    lines = [["set", "object", "episode", "return", "length", "opened", "progress", "success"]]
+    text = _csv_text(lines + rows)
+    _write_atomic(os.path.join(run, stem + ".csv"), text)
+    return result
+
+
+def _csv_text(rows) -> str:
+    import io
+
+    buf = io.StringIO(newline="")
+    csv.writer(buf).writerows(rows)
+    return buf.getvalue()
+
+
+def _write_atomic(path: str, text: str) -> None:
+    """Writes ``text`` to a temporary file beside ``path`` and renames it: a reader (or a run
+    killed half-way) never sees half a file."""
+    tmp = f"{path}.tmp{os.getpid()}"
+    with open(tmp, "w", encoding="utf-8", newline="") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
 def evaluate_run(run: str, episodes: int = 20, seed: int = 1000, which=("train", "test"),
-                 policy: str = "agent", quiet: bool = False) -> dict:
+                 policy: str = "agent", quiet: bool = False, shard=None,
+                 results: str | None = None) -> dict:
     """Evaluates a run's last checkpoint: ``episodes`` deterministic episodes on each training
     and each test object (``which``), seeds ``seed``, ``seed + 1``, ... per object. Writes
     ``eval.json`` (with ``policy="agent"``) and ``eval.csv`` (one row per episode) into the
@@ -366,68 +474,75 @@ def evaluate_run(run: str, episodes: int = 20, seed: int = 1000, which=("train",
     (the task's own, 90% of the range) and the per-object metric.
 
     ``policy="random"`` plays uniform random actions instead (a baseline; written to
-    ``eval_random.json`` / ``.csv``).
-    """
-    from .trainer import evaluate as run_episodes
+    ``eval_random.json`` / ``.csv``), each object's from its own seeded stream.
 
+    ``shard="i/N"`` plays only the objects whose index (training objects first, then test
+    objects) is i modulo N and writes their episodes to ``results`` (a JSON file; nothing is
+    written into the run); :func:`merge_evaluations` makes the N shards' files into the files
+    one run writes, byte for byte. Returns the shard's file's content then.
+    """
     if episodes < 1:
         raise ValueError(f"episodes must be at least 1, got {episodes}")
     if policy not in ("agent", "random"):
         raise ValueError(f"policy must be 'agent' or 'random', got {policy!r}")
     doc = _read_run(run)
-    config = RunConfig.from_json(doc["config"])
-    agent = None
-    rng = np.random.default_rng(seed)
-    result = {"episodes": int(episodes), "seed": int(seed), "policy": policy,
-              "task": config.task, "obs": config.obs, "train_objects": config.train_objects,
-              "steps": config.steps, "metric": "final angle (degrees)" if config.task == "door"
-              else f"success rate at {int(DRAWER_SUCCESS * 100)}% of the range"}
-    rows = []
-    for name in which:
-        objects = doc[name]
-        per_object = []
-        opened_all, progress_all, returns_all, success_all = [], [], [], []
-        for k, obj in enumerate(objects):
-            env = _make_env(config, [obj], min(episodes, config.num_envs))
-            try:
-                if agent is None and policy == "agent":
-                    agent = _load_agent(run, config, env)
-                random_policy = (lambda o: rng.uniform(-1, 1, (len(_first(o)), 7))) \
-                    if policy == "random" else None
-                ev = run_episodes(env, agent, episodes, seed=seed + 1000 * k,
-                                  policy=random_policy)
-            finally:
-                env.close()
-            opened = np.array([i["opened"] for i in ev.infos], dtype=float)
-            progress = np.array([i["progress"] for i in ev.infos], dtype=float)
-            success = np.array([bool(i["success"]) for i in ev.infos])
-            per_object.append({"object": obj, "metric": _score(config.task, opened, progress),
-                               "mean_return": float(np.mean(ev.returns))})
-            for j in range(len(ev.returns)):
-                rows.append([name, obj, j, float(ev.returns[j]), int(ev.lengths[j]),
-                             float(opened[j]), float(progress[j]), bool(success[j])])
-            opened_all += list(opened)
-            progress_all += list(progress)
-            returns_all += list(ev.returns)
-            success_all += list(success)
-            if not quiet:
-                print(f"{name} object {obj}: {per_object[-1]['metric']:.3f}", file=sys.stderr)
-        result[name] = {
-            "metric": _score(config.task, np.array(opened_all), np.array(progress_all)),
-            "mean_return": float(np.mean(returns_all)),
-            "success_rate": float(np.mean(success_all)),
-            "objects": per_object,
-        }
-    stem = "eval" if policy == "agent" else "eval_random"
-    with open(os.path.join(run, stem + ".json.tmp"), "w", encoding="utf-8") as f:
-        json.dump(result, f, indent=1)
-    os.replace(os.path.join(run, stem + ".json.tmp"), os.path.join(run, stem + ".json"))
-    with open(os.path.join(run, stem + ".csv"), "w", newline="", encoding="utf-8") as f:
-        w = csv.writer(f)
-        w.writerow(["set", "object", "episode", "return", "length", "opened", "progress",
-                    "success"])
-        w.writerows(rows)
-    return result
+    which = tuple(which)
+    part = (0, 1) if shard is None else _parse_shard(shard)
+    if shard is not None and not results:
+        raise ValueError("--shard needs --results FILE (the shard's episodes)")
+    records = _evaluate_objects(run, doc, episodes, seed, which, policy, part, quiet)
+    if shard is None and not results:
+        return _write_evaluation(run, doc, episodes, seed, which, policy, records)
+    out = {"kind": "partsim learn evaluate shard", "run_config": doc["config"],
+           "episodes": int(episodes), "seed": int(seed), "policy": policy,
+           "which": list(which), "shard": list(part), "objects": records}
+    _write_atomic(results, json.dumps(out, indent=1))
+    if shard is None:
+        return _write_evaluation(run, doc, episodes, seed, which, policy, records)
+    return out
+
+
+def merge_evaluations(run: str, files) -> dict:
+    """Writes the run's eval.json and eval.csv (eval_random.* for a random policy) from the
+    shards' results files of :func:`evaluate_run`, the same bytes as one unsharded run; every
+    object must be in exactly one file, and the files must be of this run and of one
+    evaluation (episodes, seed, policy, sets). Returns the summary."""
+    files = list(files)
+    if not files:
+        raise ValueError("--merge needs the shards' results files")
+    doc = _read_run(run)
+    first, records, seen = None, [], {}
+    for path in files:
+        try:
+            with open(path, encoding="utf-8") as f:
+                part = json.load(f)
+        except (OSError, ValueError) as e:
+            raise ValueError(f"{path}: cannot be read: {e}") from None
+        if not isinstance(part, dict) or part.get("kind") != "partsim learn evaluate shard":
+            raise ValueError(f"{path}: not a results file of 'partsim learn evaluate --shard'")
+        if part.get("run_config") != doc["config"]:
+            raise ValueError(f"{path}: evaluates another run than {run!r}")
+        key = {k: part.get(k) for k in ("episodes", "seed", "policy", "which")}
+        if first is None:
+            first = (path, key)
+        elif key != first[1]:
+            differ = ", ".join(k for k in key if key[k] != first[1][k])
+            raise ValueError(f"{path} and {first[0]} are of different evaluations ({differ})")
+        for r in part.get("objects", []):
+            place = (r["set"], r["index"])
+            if place in seen:
+                raise ValueError(f"{path} and {seen[place]} both hold {r['set']} object "
+                                 f"{r['index']} ({r['object']}): overlapping shards")
+            seen[place] = path
+            records.append(r)
+    which = first[1]["which"]
+    missing = [f"{name} object {k} ({obj})" for name in which
+               for k, obj in enumerate(doc[name]) if (name, k) not in seen]
+    if missing:
+        raise ValueError(f"the files lack {len(missing)} object(s): {', '.join(missing[:5])}"
+                         + (" ..." if len(missing) > 5 else "") + " (a shard missing?)")
+    return _write_evaluation(run, doc, first[1]["episodes"], first[1]["seed"], which,
+                             first[1]["policy"], records)
 
 
 def _first(obs):
@@ -545,6 +660,10 @@ USAGE = """usage:
   partsim learn train --task door|drawer --obs raw|mobility|visual --train-objects N
                       --steps S --seed K --out RUN [--dataset ROOT] [options]
   partsim learn evaluate RUN [--episodes 20] [--seed E] [--random] [--quiet]
+                         [--shard i/N --results FILE | --merge FILE...]
+  partsim learn sweep --out SWEEP [--tasks door,drawer] [--obs raw,mobility,visual]
+                      [--train-objects 2,4,8,16] [--seeds 0,1,2] --steps S [train options]
+                      [--episodes E] [--ray auto|ADDRESS]
   partsim learn table RUN... [--csv]
   partsim learn curves RUN [--out FILE.png]
 
@@ -557,6 +676,13 @@ evaluate   plays the run's policy deterministically, --episodes per object, on i
            and its unseen test objects; writes RUN/eval.json and RUN/eval.csv and prints the
            paper's metric (door: final angle, degrees; drawer: success at 80% of the range).
            --random plays uniform random actions instead (eval_random.json), a baseline.
+           --shard i/N plays only the objects whose index (training ones first) is i mod N
+           and writes their episodes to --results FILE; --merge FILE... writes eval.json and
+           eval.csv from all shards' files, the bytes of one run (docs/distributed.md).
+sweep      the paper's grid (task x state x training objects x seed) as training runs
+           SWEEP/<task>-<state>-n<N>-s<seed>, each resumable, then evaluates them and prints
+           Table 3; with --ray, the runs are tasks on a Ray cluster (SWEEP on a path every node
+           sees). Run it again to continue: finished runs and evaluations are skipped.
 table      prints the SAPIEN paper's Table 3 layout from evaluated runs (means over seeds),
            each cell beside the paper's number.
 curves     draws RUN/progress.csv into a PNG (default RUN/curves.png).
@@ -651,19 +777,36 @@ def main(argv=None) -> int:
             return 0
         if command == "evaluate":
             opts, positional = _parse_options(
-                args, {"episodes": int, "seed": int, "random": bool, "quiet": bool})
-            if len(positional) != 1:
-                raise ValueError("evaluate takes one RUN folder")
-            result = evaluate_run(positional[0], episodes=opts.get("episodes", 20),
-                                  seed=opts.get("seed", 1000),
-                                  policy="random" if opts.get("random") else "agent",
-                                  quiet=opts.get("quiet", False))
+                args, {"episodes": int, "seed": int, "random": bool, "quiet": bool,
+                       "shard": str, "results": str, "merge": bool})
+            if opts.get("merge"):
+                if len(positional) < 2:
+                    raise ValueError("evaluate RUN --merge needs the shards' results files")
+                if set(opts) - {"merge", "quiet"}:
+                    raise ValueError("--merge takes the RUN folder and the shards' files only")
+                result = merge_evaluations(positional[0], positional[1:])
+            else:
+                if len(positional) != 1:
+                    raise ValueError("evaluate takes one RUN folder")
+                result = evaluate_run(positional[0], episodes=opts.get("episodes", 20),
+                                      seed=opts.get("seed", 1000),
+                                      policy="random" if opts.get("random") else "agent",
+                                      quiet=opts.get("quiet", False), shard=opts.get("shard"),
+                                      results=opts.get("results"))
+            if "shard" in opts:
+                print(f"shard {opts['shard']}: {len(result['objects'])} objects into "
+                      f"{opts['results']}")
+                return 0
             for part in ("train", "test"):
                 r = result[part]
                 print(f"{part}: {result['metric']} {r['metric']:.3f}, mean return "
                       f"{r['mean_return']:.2f}, success (90%) {r['success_rate']:.2f} over "
                       f"{len(r['objects'])} objects x {result['episodes']} episodes")
             return 0
+        if command == "sweep":
+            from ..distributed._sweep import sweep_main
+
+            return sweep_main(args)
         if command == "table":
             opts, positional = _parse_options(args, {"csv": bool})
             if not positional:
@@ -676,8 +819,8 @@ def main(argv=None) -> int:
                 raise ValueError("curves takes one RUN folder")
             print(plot_curves(positional[0], opts.get("out")))
             return 0
-        print(f"partsim learn: unknown command {command!r} (expected train, evaluate, table or "
-              "curves)", file=sys.stderr)
+        print(f"partsim learn: unknown command {command!r} (expected train, evaluate, sweep, "
+              "table or curves)", file=sys.stderr)
         return 2
     except ValueError as e:
         print(f"partsim learn {command}: {e}", file=sys.stderr)
@@ -685,6 +828,9 @@ def main(argv=None) -> int:
     except ImportError as e:
         if getattr(e, "name", None) in ("torch", "matplotlib"):
             e = f"needs {e.name}: install Debian's python3-{e.name}"
+        print(f"partsim learn {command}: {e}", file=sys.stderr)
+        return 1
+    except RuntimeError as e:  # a sweep's unit that failed, Ray missing
         print(f"partsim learn {command}: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
