@@ -57,6 +57,9 @@ int RunVisionCommand(int argc, char** argv);
 /// `python3 -m partsim.learn` with the arguments after "learn"; returns only when that cannot
 /// start (exit code 1).
 int RunLearnCommand(int argc, char** argv);
+/// Runs `python3 -m MODULE ARGS...` with the partsim package that goes with this program (an
+/// exec: returns 1 only when the interpreter cannot start; `what` names the command then).
+int RunPythonModule(const char* module, const char* what, int argc, char** argv);
 
 /// Removes the files of `dir` that an earlier run of the same command wrote: names starting with
 /// one of `prefixes` and ending with the matching entry of `suffixes` ("color_" + ".png"), so

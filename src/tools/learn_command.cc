@@ -1,6 +1,8 @@
-// `partsim learn ...`: SAC on the door and drawer tasks, the SAPIEN paper's protocol. The
-// command is Python (partsim.learn, on PyTorch); this runs `python3 -m partsim.learn` with the
-// arguments as they are, with the package that goes with this program on the path (PackageParent).
+// The commands that are Python: `partsim learn ...` (SAC on the door and drawer tasks, the SAPIEN
+// paper's protocol; partsim.learn, on PyTorch) and any list-shaped command given `--ray`
+// (partsim.distributed, which runs its shards as Ray tasks). This runs `python3 -m MODULE` with
+// the arguments as they are, with the package that goes with this program on the path
+// (PackageParent).
 #include <unistd.h>
 
 #include <cerrno>
@@ -19,7 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The folder to put on PYTHONPATH so that `python3 -m partsim.learn` imports the partsim that
+// The folder to put on PYTHONPATH so that `python3 -m partsim.<module>` imports the partsim that
 // goes with the program `exe`, or "" when the interpreter's own path has it: the build tree
 // (build/partsim beside build/python/partsim), an install prefix (PREFIX/bin/partsim and
 // PREFIX/<PARTSIM_PYTHON_INSTALL_DIR>/partsim, any prefix) or a wheel (site-packages/partsim/
@@ -41,7 +43,7 @@ std::string PackageParent(const fs::path& exe) {
 
 }  // namespace
 
-int RunLearnCommand(int argc, char** argv) {
+int RunPythonModule(const char* module, const char* what, int argc, char** argv) {
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   std::string pythonpath = ec ? std::string() : PackageParent(exe);
@@ -60,7 +62,7 @@ int RunLearnCommand(int argc, char** argv) {
     pythonpath = pythonpath.empty() ? std::string(old) : pythonpath + ":" + old;
   if (!pythonpath.empty()) setenv("PYTHONPATH", pythonpath.c_str(), 1);
 
-  std::vector<std::string> args = {python, "-m", "partsim.learn"};
+  std::vector<std::string> args = {python, "-m", module};
   for (int i = 0; i < argc; ++i) args.emplace_back(argv[i]);
   std::vector<char*> cargs;
   for (std::string& a : args) cargs.push_back(a.data());
@@ -68,11 +70,14 @@ int RunLearnCommand(int argc, char** argv) {
   std::fflush(stdout);
   execv(python.c_str(), cargs.data());
   std::fprintf(stderr,
-               "partsim learn: cannot run the Python interpreter '%s' (%s); partsim learn needs "
-               "python3 with PyTorch and Gymnasium (set PARTSIM_PYTHON to use another "
-               "interpreter)\n",
-               python.c_str(), std::strerror(errno));
+               "partsim: cannot run the Python interpreter '%s' (%s); %s needs python3 with "
+               "its modules (set PARTSIM_PYTHON to use another interpreter)\n",
+               python.c_str(), std::strerror(errno), what);
   return 1;
+}
+
+int RunLearnCommand(int argc, char** argv) {
+  return RunPythonModule("partsim.learn", "partsim learn (PyTorch, Gymnasium)", argc, argv);
 }
 
 }  // namespace partsim::tools

@@ -26,9 +26,14 @@ usage:
   partsim view [OBJECT | SCENE] [options]       (see partsim view --help)
   partsim vision detection-dataset|motion-dataset|evaluate-detection|evaluate-motion|show
                  [options]                      (see partsim vision --help)
-  partsim learn train|evaluate|table|curves [options]
+  partsim learn train|evaluate|sweep|table|curves [options]
                                                 (see partsim learn --help)
   partsim --help | --version
+
+assets generate, assets check, vision detection-dataset and motion-dataset, tasks evaluate and
+learn evaluate take --shard i/N (one part of the list; merged, one run's bytes), and --ray
+auto|ADDRESS to run their parts as tasks on a Ray cluster (docs/distributed.md; `partsim
+assets generate --ray --help` for the options).
 
 OBJECT is a URDF file or a PartNet-Mobility folder (mobility.urdf with mobility_v2.json,
 semantics.txt, meta.json, as `partsim assets generate` writes them); a folder's mobility.urdf
@@ -92,6 +97,12 @@ int main(int argc, char** argv) {
     std::printf("partsim %s (MuJoCo %s)\n", partsim::Version(), mj_versionString());
     return 0;
   }
+  // any list-shaped command given --ray runs through partsim.distributed, which submits its
+  // shards as Ray tasks (each one this program without --ray) and merges them
+  for (const std::string& a : args)
+    if (a == "--ray" || a.rfind("--ray=", 0) == 0)
+      return partsim::tools::RunPythonModule("partsim.distributed", "--ray (Ray)", argc - 1,
+                                             argv + 1);
   if (command == "assets") return partsim::tools::RunAssetsCommand(argc - 2, argv + 2);
   if (command == "tasks") return partsim::tools::RunTasksCommand(argc - 2, argv + 2);
   if (command == "serve") return partsim::tools::RunServeCommand(argc - 2, argv + 2);
