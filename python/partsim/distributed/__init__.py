@@ -32,6 +32,7 @@ def main(argv=None) -> int:
     import sys
 
     argv = list(sys.argv[1:] if argv is None else argv)
+    name = " ".join(a for a in argv[:2] if not a.startswith("-"))
     try:
         rest, opts = split_options(argv)
         if not rest or "--help" in rest or "-h" in rest:
@@ -55,12 +56,12 @@ def main(argv=None) -> int:
                    shared=bool(opts.get("--shared")), retries=int(retries),
                    state=opts.get("--state"), quiet="--quiet" in rest)
     except ValueError as e:
-        print(f"partsim {' '.join(argv[:2])}: {e}", file=sys.stderr)
+        print(f"partsim {name}: {e}", file=sys.stderr)
         return 2
     except (RuntimeError, OSError) as e:
-        print(f"partsim {' '.join(argv[:2])}: {e}", file=sys.stderr)
+        print(f"partsim {name}: {e}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print(f"partsim {' '.join(argv[:2])}: interrupted (the same command continues where "
+        print(f"partsim {name}: interrupted (the same command continues where "
               "it stopped)", file=sys.stderr)
         return 130

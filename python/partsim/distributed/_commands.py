@@ -43,24 +43,24 @@ makes their outputs one run's, byte for byte: COMMAND is one of
   --state DIR         where the finished units are recorded (default ~/.cache/partsim/ray/
                       <hash of the command>), removed when the run completes: the same
                       command started again after a crash skips them
-Inputs (--dataset ROOT, assets check's DIR, learn evaluate's RUN) must be at the same path on
-every node. docs/distributed.md has the local, Ray-cluster and Slurm recipes.
+Units run in this program's working folder, so relative paths work as they do here: inputs
+(--dataset ROOT, assets check's DIR, learn evaluate's RUN) and that folder must be at the same
+path on every node (a shared file system), or give absolute paths. docs/distributed.md has the
+local, Ray-cluster and Slurm recipes.
 """
 
 
 class Spec:
-    """One command: ``switches``, its options without a value; ``paths``, options whose value
-    is a path (made absolute: workers have another working folder); ``positional_path``,
-    whether its one positional argument is a path; ``out``, the folder option a unit's tree
+    """One command: ``switches``, its options without a value; ``positional_path``, whether it
+    takes one positional argument, a folder; ``out``, the folder option a unit's tree
     lands in (tree commands), or ``result``, the option a unit writes its results file with;
     ``drop``, options of the whole run the units leave out (the merge gets them); ``ok``, a
     unit's exit codes that are results; ``merge``, how the parts become one run."""
 
-    def __init__(self, switches=(), paths=(), positional_path=False, out=None, result=None,
+    def __init__(self, switches=(), positional_path=False, out=None, result=None,
                  drop=(), ok=(0,), merge=None, quiet=False):
         self.quiet = quiet  # the command has a --quiet switch, which units get
         self.switches = set(switches) | {"--quiet"}
-        self.paths = set(paths)
         self.positional_path = positional_path
         self.out = out
         self.result = result
@@ -79,7 +79,8 @@ def _check_merge(cmd, args, files, cli):
 
 
 def _tasks_merge(cmd, args, files, cli):
-    return [cli, "tasks", "evaluate", "--merge"] + files + _keep(args, ("--csv",), COMMANDS[tuple(cmd)])
+    keep = _keep(args, ("--csv",), COMMANDS[tuple(cmd)])
+    return [cli, "tasks", "evaluate", "--merge"] + files + keep
 
 
 def _learn_merge(cmd, args, files, cli):
@@ -88,22 +89,18 @@ def _learn_merge(cmd, args, files, cli):
 
 
 COMMANDS = {
-    ("assets", "generate"): Spec(switches={"--by-category", "--overwrite"}, paths={"--out"},
-                                 out="--out"),
-    ("assets", "check"): Spec(switches={"--no-visibility"}, paths={"--report", "--results"},
-                              positional_path=True, result="--results",
-                              drop={"--report", "--results"}, ok=(0, 1), merge=_check_merge),
+    ("assets", "generate"): Spec(switches={"--by-category", "--overwrite"}, out="--out"),
+    ("assets", "check"): Spec(switches={"--no-visibility"}, positional_path=True,
+                              result="--results", drop={"--report", "--results"}, ok=(0, 1),
+                              merge=_check_merge),
     ("vision", "detection-dataset"): Spec(switches={"--no-point-clouds", "--merge-only"},
-                                          paths={"--dataset", "--out"}, out="--out",
-                                          merge=_dataset_merge, quiet=True),
+                                          out="--out", merge=_dataset_merge, quiet=True),
     ("vision", "motion-dataset"): Spec(switches={"--no-point-clouds", "--merge-only"},
-                                       paths={"--dataset", "--out"}, out="--out",
-                                       merge=_dataset_merge, quiet=True),
-    ("tasks", "evaluate"): Spec(switches={"--no-cameras"}, paths={"--dataset", "--csv"},
-                                result="--csv", drop={"--csv"}, merge=_tasks_merge),
+                                       out="--out", merge=_dataset_merge, quiet=True),
+    ("tasks", "evaluate"): Spec(switches={"--no-cameras"}, result="--csv", drop={"--csv"},
+                                merge=_tasks_merge),
     ("learn", "evaluate"): Spec(switches={"--random"}, positional_path=True,
-                                paths={"--results"}, result="--results", merge=_learn_merge,
-                                quiet=True),
+                                result="--results", merge=_learn_merge, quiet=True),
 }
 
 
@@ -167,15 +164,6 @@ def split_options(argv):
     return rest, opts
 
 
-def _absolute(items, spec):
-    out = []
-    for name, value in items:
-        if value is not None and ((name is None and spec.positional_path) or name in spec.paths):
-            value = os.path.abspath(value)
-        out.append((name, value))
-    return out
-
-
 def _extract(payload: bytes, out: str) -> int:
     """Writes a unit's tar into ``out``, each file to a temporary name beside it and renamed
     (a reader, or a driver killed half-way, never sees half a file); returns the file count."""
@@ -227,7 +215,6 @@ def run(argv, ray: str | None = "auto", units: int | None = None, shared: bool =
         raise ValueError("--ray merges the shards itself: leave --merge/--merge-only out")
     if spec.positional_path and _positional(argv[2:], spec) is None:
         raise ValueError(f"{' '.join(cmd)} needs its folder argument")
-    items = _absolute(items, spec)
     cli = cli or _cli.find_cli()
     if not cli:
         raise RuntimeError("cannot find the partsim command line (set PARTSIM_CLI)")
@@ -259,7 +246,7 @@ def run(argv, ray: str | None = "auto", units: int | None = None, shared: bool =
                     [(spec.result, f"{UNIT_TMP}/result")]
             collect = "file:result" if spec.result else None if shared else "tree:out"
             specs.append({"key": f"{i}-of-{n}", "cli": cli, "args": list(cmd) + _join(unit),
-                          "collect": collect, "ok": spec.ok, "cpus": jobs})
+                          "collect": collect, "ok": spec.ok, "cpus": jobs, "cwd": os.getcwd()})
 
         def take(unit, result):
             if unit["collect"] == "tree:out":

@@ -67,7 +67,10 @@ def run_unit(spec: dict) -> dict:
     with tempfile.TemporaryDirectory(prefix="partsim-unit-") as tmp:
         args = [a.replace(UNIT_TMP, tmp) for a in spec["args"]]
         env = dict(os.environ, **spec.get("env", {}))
-        p = subprocess.run([cli] + args, capture_output=True, text=True, env=env,
+        # the driver's working folder when this node has it (a shared file system), so that
+        # relative paths mean what they mean there
+        cwd = spec.get("cwd") if os.path.isdir(spec.get("cwd") or "") else tmp
+        p = subprocess.run([cli] + args, capture_output=True, text=True, env=env, cwd=cwd,
                            preexec_fn=_die_with_parent, check=False)
         result = {"key": spec["key"], "rc": p.returncode, "stdout": p.stdout[-20000:],
                   "stderr": p.stderr[-4000:], "host": socket.gethostname(), "pid": os.getpid(),
