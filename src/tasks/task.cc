@@ -1,13 +1,18 @@
 // ArticulationTask: a generated cabinet, the flying gripper and three cameras.
+#include <pthread.h>
+
 #include <algorithm>
 #include <cmath>
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <memory>
+#include <mutex>
 #include <random>
-#include <thread>
 
 #include "core/atomic_file.h"
+#include "core/worker_pool.h"
 #include "partsim/assets/generator.h"
 #include "partsim/assets/partnet_mobility.h"
 #include "partsim/core/check.h"
@@ -237,6 +242,71 @@ Eigen::VectorXd ArticulationTask::GetMobilityObservation() const {
 }
 double ArticulationTask::GetReward() const { return impl_->last_reward; }
 
+namespace {
+
+// The threads StepTasks runs tasks 1 ... n-1 on, kept between calls: a task's step takes about
+// 0.4 ms, and a thread started and joined per task and call would add its start-up and the
+// caller's wait for it to every step. One pool for the process, used by one call at a time (a
+// second caller waits on `call`), grown to the largest number of tasks seen less one, its threads
+// joined when the process exits (after a call in progress, which holds `call`).
+//
+// fork() copies only the thread that forks, so a child of a process that has the pool would wait
+// for workers it does not have (Gymnasium's AsyncVectorEnv and multiprocessing fork). The fork
+// handlers hold `call` across the fork, so that no call is running and every worker is parked
+// with the work handed out done; the child then drops the pool without touching it (its threads
+// and their locks are not there) and makes a new one on its first call.
+class StepPool {
+ public:
+  static StepPool& Get() {
+    static StepPool pool;
+    return pool;
+  }
+
+  // Runs part(0) on the calling thread and part(1) ... part(n - 1) on the workers; returns when
+  // all are done. `part` must not throw.
+  void Run(int n, const std::function<void(int)>& part) {
+    if (n < 2) {
+      if (n == 1) part(0);
+      return;
+    }
+    std::lock_guard<std::mutex> lock(call_);
+    if (!workers_ || workers_->size() < n - 1) {
+      workers_.reset();  // joins the smaller pool's threads first
+      workers_ = std::make_unique<internal::WorkerPool>(n - 1);
+    }
+    workers_->Start(n - 1, [&part](int k) { part(k + 1); });
+    part(0);
+    workers_->Wait();  // also runs any part that no worker has begun
+  }
+
+ private:
+  StepPool() {
+    if (int err = pthread_atfork(&Prepare, &Parent, &Child); err != 0)
+      throw Error("step_tasks: could not register the fork handlers of its thread pool (error " +
+                  std::to_string(err) + ")");
+  }
+
+  // at exit: after a call still running on another thread, joins the workers
+  ~StepPool() {
+    std::lock_guard<std::mutex> lock(call_);
+    workers_.reset();
+  }
+
+  static void Prepare() { Get().call_.lock(); }
+  static void Parent() { Get().call_.unlock(); }
+  static void Child() {
+    StepPool& p = Get();
+    // left unfreed: its destructor would join threads that the child does not have
+    static_cast<void>(p.workers_.release());
+    p.call_.unlock();  // locked by Prepare on this very thread
+  }
+
+  std::mutex call_;
+  std::unique_ptr<internal::WorkerPool> workers_;
+};
+
+}  // namespace
+
 void StepTasks(const std::vector<ArticulationTask*>& tasks, const Eigen::MatrixXd& actions) {
   const size_t n = tasks.size();
   if (actions.rows() != static_cast<Eigen::Index>(n) || actions.cols() != 7)
@@ -251,20 +321,16 @@ void StepTasks(const std::vector<ArticulationTask*>& tasks, const Eigen::MatrixX
                     " again");
   }
   std::vector<std::exception_ptr> errors(n);
-  auto run = [&](size_t i) {
+  StepPool::Get().Run(static_cast<int>(n), [&](int i) {
     try {
       const Scene::Use use(tasks[i]->GetScene());
-      tasks[i]->ApplyAction(actions.row(static_cast<Eigen::Index>(i)).transpose());
+      tasks[i]->ApplyAction(actions.row(i).transpose());
       tasks[i]->Step();
     } catch (...) {
       errors[i] = std::current_exception();
     }
-  };
-  std::vector<std::thread> threads;
-  threads.reserve(n > 0 ? n - 1 : 0);
-  for (size_t i = 1; i < n; ++i) threads.emplace_back(run, i);
-  if (n > 0) run(0);
-  for (std::thread& t : threads) t.join();
+  });
+  // the first error, once every task has finished its step
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
 }

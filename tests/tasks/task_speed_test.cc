@@ -6,6 +6,8 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "partsim/core/error.h"
 #include "partsim/tasks/tasks.h"
@@ -130,6 +132,66 @@ TEST(TaskSpeedTest, StepTasksEqualsSteppingOneByOne) {
   EXPECT_THROW(StepTasks({&a, &a}, actions), Error);
   EXPECT_EQ(a.GetMobilityObservation(), before);
   StepTasks({}, Eigen::MatrixXd(0, 7));
+}
+
+// StepTasks' threads stay between calls and grow to the most tasks seen: calls with 2, then 4,
+// then 3 and 1 tasks (fewer than the pool's workers) step each task as stepping it alone does
+TEST(TaskSpeedTest, StepTasksOnChangingNumbersOfTasksEqualsSteppingOneByOne) {
+  TaskOptions o = Options(TaskType::kPullDrawer);
+  o.control_rate = 25.0;
+  std::vector<std::unique_ptr<ArticulationTask>> together, alone;
+  for (int i = 0; i < 4; ++i) {
+    together.push_back(std::make_unique<ArticulationTask>(o));
+    alone.push_back(std::make_unique<ArticulationTask>(o));
+    together.back()->Reset(i);
+    alone.back()->Reset(i);
+  }
+  int k = 0;
+  for (int n : {2, 4, 3, 1, 4}) {
+    Eigen::MatrixXd actions(n, 7);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < 7; ++j) actions(i, j) = 0.1 * std::sin(1.3 * (++k));
+    std::vector<ArticulationTask*> tasks;
+    for (int i = 0; i < n; ++i) tasks.push_back(together[i].get());
+    StepTasks(tasks, actions);
+    for (int i = 0; i < n; ++i) {
+      alone[i]->ApplyAction(actions.row(i).transpose());
+      alone[i]->Step();
+    }
+  }
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(together[i]->GetMobilityObservation(), alone[i]->GetMobilityObservation())
+        << "task " << i;
+    EXPECT_EQ(together[i]->GetReward(), alone[i]->GetReward()) << "task " << i;
+  }
+}
+
+// two threads that call StepTasks at the same time on tasks of their own share the one pool:
+// each call waits for the other's and both step their tasks as stepping them alone does
+TEST(TaskSpeedTest, StepTasksFromTwoThreadsAtOnce) {
+  TaskOptions o = Options(TaskType::kPullDrawer);
+  o.control_rate = 25.0;
+  std::vector<std::unique_ptr<ArticulationTask>> tasks;
+  for (int i = 0; i < 6; ++i) {
+    tasks.push_back(std::make_unique<ArticulationTask>(o));
+    tasks.back()->Reset(7);
+  }
+  Eigen::MatrixXd actions(2, 7);
+  actions << 0.2, -0.1, 0.05, 0.3, 0.0, -0.4, 0.5, -0.1, 0.2, 0.0, 0.0, 0.6, 0.1, -1.0;
+  auto steps = [&](ArticulationTask* a, ArticulationTask* b) {
+    for (int k = 0; k < 8; ++k) StepTasks({a, b}, actions);
+  };
+  std::thread other(steps, tasks[2].get(), tasks[3].get());
+  steps(tasks[0].get(), tasks[1].get());
+  other.join();
+  for (int k = 0; k < 8; ++k)
+    for (int i = 0; i < 2; ++i) {
+      tasks[4 + i]->ApplyAction(actions.row(i).transpose());
+      tasks[4 + i]->Step();
+    }
+  for (int i = 0; i < 4; ++i)
+    EXPECT_EQ(tasks[i]->GetMobilityObservation(), tasks[4 + i % 2]->GetMobilityObservation())
+        << "task " << i;
 }
 
 }  // namespace
