@@ -77,9 +77,12 @@ def cluster(tmp_path_factory):
     os.environ["PYTHONPATH"] = os.path.abspath(PYTHON_DIR)
     c = None
     try:
+        # a small object store each: Ray's default is 30% of the memory, in /dev/shm
+        store = 200 * 1024 * 1024
         c = Cluster(initialize_head=True, head_node_args={
-            "num_cpus": 1, "include_dashboard": False, "node_ip_address": "127.0.0.1"})
-        c.add_node(num_cpus=1, node_ip_address="127.0.0.1")
+            "num_cpus": 1, "include_dashboard": False, "node_ip_address": "127.0.0.1",
+            "object_store_memory": store})
+        c.add_node(num_cpus=1, node_ip_address="127.0.0.1", object_store_memory=store)
         c.wait_for_nodes()
         assert c.address.startswith("127.0.0.1:")
         yield c.address
@@ -123,13 +126,16 @@ def test_check_on_ray_equals_one_run(cluster, single, tmp_path):
         assert (tmp_path / f"one.{name}").read_bytes() == (tmp_path / f"ray.{name}").read_bytes()
 
 
-def test_detection_dataset_on_ray_equals_one_run(cluster, single, tmp_path):
+@pytest.mark.parametrize("shared", [False, True], ids=["sent-back", "shared"])
+def test_detection_dataset_on_ray_equals_one_run(cluster, single, tmp_path, shared):
     args = ["vision", "detection-dataset", "--dataset", single / "objects", "--views", "2",
             "--size", "64"]
     partsim(*args, "--out", tmp_path / "one", "--quiet")
-    # --shared: the workers write into the folder themselves
-    r = partsim(*args, "--out", tmp_path / "ray", "--ray", cluster, "--units", "3", "--shared")
-    assert "3/3 units done" in r.stderr
+    # --shared: the workers write into the folder themselves; else the driver writes what
+    # they send back; 8 units for 6 objects: some have nothing to do
+    r = partsim(*args, "--out", tmp_path / "ray", "--ray", cluster, "--units", "8",
+                *(["--shared"] if shared else []))
+    assert "8/8 units done" in r.stderr
     assert_same_tree(tmp_path / "one", tmp_path / "ray")
 
 

@@ -33,16 +33,19 @@ def main(argv=None) -> int:
 
     argv = list(sys.argv[1:] if argv is None else argv)
     name = " ".join(a for a in argv[:2] if not a.startswith("-"))
+    if not argv or "--help" in argv or "-h" in argv:
+        print(USAGE, end="")
+        return 0 if argv else 2
     try:
         rest, opts = split_options(argv)
-        if not rest or "--help" in rest or "-h" in rest:
-            print(USAGE, end="")
-            return 0 if rest else 2
         if rest[:2] == ["learn", "sweep"]:
             from ._sweep import sweep_main
 
-            args = rest[2:] + [x for k, v in opts.items() if k != "--units"
-                               for x in ((k,) if v is True else (k, v))]
+            extra = sorted(set(opts) - {"--ray", "--retries"})
+            if extra:
+                raise ValueError(f"learn sweep runs one training run per unit on a path every "
+                                 f"node sees: {', '.join(extra)} does not apply")
+            args = rest[2:] + [x for k, v in opts.items() for x in (k, v)]
             return sweep_main(args)
         if "--ray" not in opts:
             raise ValueError("--ray auto|ADDRESS is missing")

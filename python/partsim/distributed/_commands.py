@@ -168,6 +168,8 @@ def _extract(payload: bytes, out: str) -> int:
     """Writes a unit's tar into ``out``, each file to a temporary name beside it and renamed
     (a reader, or a driver killed half-way, never sees half a file); returns the file count."""
     n = 0
+    if not payload:  # a unit with nothing to do (more units than objects) made no folder
+        return n
     with tarfile.open(fileobj=io.BytesIO(payload), mode="r") as tar:
         for m in tar:
             if not m.isfile():
@@ -229,7 +231,8 @@ def run(argv, ray: str | None = "auto", units: int | None = None, shared: bool =
         n = units or 2 * executor.cpus()
         if n < 1:
             raise ValueError(f"--units must be at least 1, got {n}")
-        key = hashlib.sha256(json.dumps([list(cmd), _join(items), n, shared]).encode())
+        key = hashlib.sha256(json.dumps([os.getcwd(), list(cmd), _join(items), n,
+                                         shared]).encode())
         state = state or os.path.join(os.environ.get("XDG_CACHE_HOME") or
                                       os.path.expanduser("~/.cache"), "partsim", "ray",
                                       key.hexdigest()[:16])

@@ -15,7 +15,7 @@ __all__ = ["grid", "sweep", "sweep_main"]
 # the sweep's own options (value options; --quiet is a switch); the others go to `learn train`
 GRID = {"--tasks": "door,drawer", "--obs": "raw,mobility,visual",
         "--train-objects": "2,4,8,16", "--seeds": "0,1,2"}
-OWN = {"--out", "--episodes", "--eval-seed", "--ray", "--retries", "--state"} | set(GRID)
+OWN = {"--out", "--episodes", "--eval-seed", "--ray", "--retries"} | set(GRID)
 
 
 def grid(tasks, obs, train_objects, seeds) -> list:

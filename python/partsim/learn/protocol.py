@@ -696,6 +696,13 @@ train options (defaults in brackets):
   --buffer-size B [1000000; visual 20000]  --batch-size 256 --lr 3e-4 --hidden 256,256
   --init-alpha A [0.1]        the entropy coefficient's start (it is then tuned)
   --checkpoint-interval C [10000] --log-interval L [2000] --quiet
+
+sweep options (the train options above go to every run):
+  --tasks, --obs, --train-objects, --seeds   the grid, comma-separated (defaults: the paper's
+                              door,drawer x raw,mobility,visual x 2,4,8,16 x 0,1,2)
+  --episodes E [20] --eval-seed S [1000]     the evaluation of each run
+  --ray auto|ADDRESS          run the runs as Ray tasks (default: one after another here)
+  --retries R [3]             times a run is submitted again when its worker is lost
 """
 
 
