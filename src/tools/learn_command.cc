@@ -61,6 +61,9 @@ int RunPythonModule(const char* module, const char* what, int argc, char** argv)
   if (const char* old = std::getenv("PYTHONPATH"); old != nullptr && *old != '\0')
     pythonpath = pythonpath.empty() ? std::string(old) : pythonpath + ":" + old;
   if (!pythonpath.empty()) setenv("PYTHONPATH", pythonpath.c_str(), 1);
+  // `python3 -m` puts the working folder first on the module path: a stray ray.py or torch.py
+  // there would shadow the real module. Python 3.11 leaves it out with this (older ones ignore it)
+  setenv("PYTHONSAFEPATH", "1", 0);
 
   std::vector<std::string> args = {python, "-m", module};
   for (int i = 0; i < argc; ++i) args.emplace_back(argv[i]);

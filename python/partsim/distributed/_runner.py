@@ -56,12 +56,13 @@ class RayExecutor:
     def __init__(self, address: str = "auto", quiet: bool = False):
         try:
             import ray
+            from ray import cloudpickle
         except ImportError as e:
             raise RuntimeError("--ray needs the ray package (in requirements.lock; "
                                "pip install 'ray==2.60.0')") from e
         self.ray = ray
         # the worker's function goes by value: a node needs the command line, not this package
-        ray.cloudpickle.register_pickle_by_value(_unit)
+        cloudpickle.register_pickle_by_value(_unit)
         kwargs = {"log_to_driver": False, "logging_level": "ERROR", "configure_logging": True}
         started = False
         if address == "auto":
