@@ -21,18 +21,39 @@ HEADER = """\
 """
 
 
+NO_DEPS = "# lock: no-deps"
+
+
+def resolve(requirements: list, tmp: str, no_deps: bool) -> list:
+    """pip's install report for ``requirements`` (lines of a requirements file), resolved for
+    this platform as if nothing were installed; with ``no_deps``, the packages alone."""
+    req = os.path.join(tmp, "no-deps.in" if no_deps else "requirements.in")
+    with open(req, "w", encoding="utf-8") as f:
+        f.write("\n".join(requirements) + "\n")
+    report = os.path.join(tmp, "report-no-deps.json" if no_deps else "report.json")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "--dry-run", "--ignore-installed",
+         "--quiet", "--disable-pip-version-check", "--report", report, "-r", req]
+        + (["--no-deps"] if no_deps else []),
+        check=True,
+    )
+    with open(report, encoding="utf-8") as f:
+        return json.load(f)["install"]
+
+
 def main() -> int:
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    with open(os.path.join(root, "requirements.in"), encoding="utf-8") as f:
+        lines_in = [line.rstrip("\n") for line in f]
+    # a pin marked "# lock: no-deps" is locked alone: its declared dependencies are not
+    # resolved (they are pinned on their own lines, or come from Debian); the lock is installed
+    # with --no-deps, so pip never checks them
+    alone = [line.split("#")[0].strip() for line in lines_in if NO_DEPS in line]
+    rest = [line for line in lines_in if NO_DEPS not in line]
     with tempfile.TemporaryDirectory() as tmp:
-        report = os.path.join(tmp, "report.json")
-        subprocess.run(
-            [sys.executable, "-m", "pip", "install", "--dry-run", "--ignore-installed",
-             "--quiet", "--disable-pip-version-check", "--report", report,
-             "-r", os.path.join(root, "requirements.in")],
-            check=True,
-        )
-        with open(report, encoding="utf-8") as f:
-            items = json.load(f)["install"]
+        items = resolve(rest, tmp, no_deps=False)
+        if alone:
+            items += resolve(alone, tmp, no_deps=True)
     lines = [HEADER]
     for item in sorted(items, key=lambda i: i["metadata"]["name"].lower()):
         name, version = item["metadata"]["name"], item["metadata"]["version"]

@@ -2,15 +2,17 @@
 suite's budget: a planar arm of one or two links turning about vertical joints, driven by joint
 velocity targets, has to bring its tip to a target drawn per episode.
 
-It follows partsim.envs' conventions (``reset(seed=...) -> (obs, info)``, ``step(action) ->
-(obs, reward, terminated, truncated, info)``, ``observation_space`` and ``action_space`` as
-gymnasium.spaces.Box), and :func:`make_reach_vector_env` batches copies of it with the trainer's
+It is a Gymnasium environment, with partsim.envs' conventions (``reset(seed=...) -> (obs,
+info)``, ``step(action) -> (obs, reward, terminated, truncated, info)``, ``observation_space``
+and ``action_space`` as gymnasium.spaces.Box), so other learners (Stable-Baselines3's SAC in
+the tests) train on it as they are, and :func:`make_reach_vector_env` batches copies of it with the trainer's
 :class:`~.trainer.SyncVectorEnv` (next-step autoreset, as VectorOpenCabinetEnv), so that the
 trainer runs here on the code path of the real tasks.
 """
 
 from __future__ import annotations
 
+import gymnasium
 import numpy as np
 from gymnasium.spaces import Box
 
@@ -23,7 +25,7 @@ __all__ = ["ReachEnv", "make_reach_vector_env"]
 _X_TO_Z = _ps.Pose([0, 0, 0], [0.7071067811865476, 0, -0.7071067811865476, 0])
 
 
-class ReachEnv:
+class ReachEnv(gymnasium.Env):
     """Tip reaching with a planar arm of ``dof`` (1 or 2) links of ``link_length`` m on
     continuous joints about the world's z axis (no gravity along them; no collisions).
 
