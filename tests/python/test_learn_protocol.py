@@ -237,6 +237,12 @@ def test_the_last_row_of_a_short_run_gives_way_when_it_is_continued(tmp_path):
     (["evaluate", "NOWHERE", "--episodes", "0"], "episodes must be at least 1"),
     (["table"], "at least one RUN"),
     (["frob"], "unknown command 'frob'"),
+    (["train", "--device", "tpu", "--out", "X"], "--device wants auto, cpu or cuda"),
+    (["evaluate", "NOWHERE", "--shard", "2/2", "--results", "F"], "--shard wants i/N"),
+    (["evaluate", "NOWHERE", "--merge"], "needs the shards' results files"),
+    (["sweep", "--out", "X", "--tasks", "lid", "--steps", "10"], "unknown task 'lid'"),
+    (["sweep", "--out", "X"], "sweep needs --steps"),
+    (["sweep", "--out", "X", "--task", "door", "--steps", "10"], "takes the grid as --tasks"),
 ])
 def test_bad_command_lines_are_refused_by_name(tmp_path, args, message):
     args = [str(tmp_path / a) if a in ("X", "NOWHERE") else a for a in args]
@@ -244,6 +250,14 @@ def test_bad_command_lines_are_refused_by_name(tmp_path, args, message):
     assert result.returncode == 2, result.stdout + result.stderr
     assert message in result.stderr
     assert not (tmp_path / "X").exists()
+
+
+def test_device_cuda_without_a_gpu_is_refused_before_training(tmp_path):
+    if torch.cuda.is_available():
+        pytest.skip("this torch sees a GPU: --device cuda is valid here")
+    result = learn("train", "--device", "cuda", "--out", tmp_path / "run", *SHORT, check=False)
+    assert result.returncode == 2 and "PyTorch sees no GPU" in result.stderr
+    assert not (tmp_path / "run" / "progress.csv").exists()
 
 
 def test_table_refuses_an_unevaluated_or_broken_run(tmp_path):

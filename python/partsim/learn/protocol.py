@@ -226,13 +226,29 @@ def _read_run(run: str) -> dict:
     return doc
 
 
-def _make_agent(config: RunConfig, env):
-    """A fresh SAC agent for the run's options and the environment's spaces."""
+def _make_agent(config: RunConfig, env, device: str = "cpu"):
+    """A fresh SAC agent for the run's options and the environment's spaces, on ``device``."""
     from .sac import SAC, SACConfig
 
     sac = SACConfig(hidden_sizes=tuple(config.hidden_sizes), lr=config.lr,
                     batch_size=config.batch_size, init_alpha=config.init_alpha)
-    return SAC(env.single_observation_space, env.single_action_space, sac, seed=config.seed)
+    return SAC(env.single_observation_space, env.single_action_space, sac, seed=config.seed,
+               device=device)
+
+
+def resolve_device(device: str) -> str:
+    """"auto": "cuda" when PyTorch sees a GPU, else "cpu"; "cpu" and "cuda" as they are (a
+    ValueError for "cuda" without one, or anything else)."""
+    import torch
+
+    if device == "auto":
+        return "cuda" if torch.cuda.is_available() else "cpu"
+    if device == "cuda" and not torch.cuda.is_available():
+        raise ValueError("--device cuda: PyTorch sees no GPU (this torch is "
+                         f"{torch.__version__}; Debian's is built for the CPU only)")
+    if device not in ("cpu", "cuda"):
+        raise ValueError(f"--device wants auto, cpu or cuda, got {device!r}")
+    return device
 
 
 def _make_buffer(config: RunConfig, env, action_dim: int):
@@ -243,7 +259,7 @@ def _make_buffer(config: RunConfig, env, action_dim: int):
     return ReplayBuffer(capacity, env.single_observation_space, action_dim, seed=config.seed)
 
 
-def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
+def train(config: RunConfig, out: str, quiet: bool = False, device: str = "auto") -> dict:
     """Trains SAC on the run's training objects into the folder ``out`` and returns a summary
     (steps, seconds, environment steps/s, updates/s).
 
@@ -255,13 +271,16 @@ def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
     at once, changing nothing, with ``already_finished`` True in the summary. A folder holding a
     different run, or one that has trained more steps than ``steps`` and than its own
     configuration asks, is refused with a ValueError. Torch runs on one thread per process
-    unless ``torch.set_num_threads`` was called before.
+    unless ``torch.set_num_threads`` was called before. ``device`` (see
+    :func:`resolve_device`) is where the agent's networks and updates run; it is not part of
+    the run, which may continue on another device.
     """
     import torch
 
     from .trainer import TrainConfig, Trainer
 
     config.check()
+    device = resolve_device(device)
     out = os.fspath(out)
     train_objs, test_objs = task_objects(config)
     doc = {"config": config.to_json(), "train": train_objs, "test": test_objs}
@@ -295,7 +314,7 @@ def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
         torch.set_num_threads(1)
     env = _make_env(config, train_objs, config.num_envs)
     try:
-        agent = _make_agent(config, env)
+        agent = _make_agent(config, env, device)
         buffer = _make_buffer(config, env, agent.action_dim)
         loop = TrainConfig(total_steps=config.steps, warmup_steps=config.warmup_steps,
                            updates_per_step=config.updates_per_step,
@@ -313,6 +332,7 @@ def train(config: RunConfig, out: str, quiet: bool = False) -> dict:
         pass
     summary = dict(summary or {})
     summary.setdefault("seconds", seconds)
+    summary["device"] = device
     return summary
 
 
@@ -485,11 +505,11 @@ def evaluate_run(run: str, episodes: int = 20, seed: int = 1000, which=("train",
         raise ValueError(f"episodes must be at least 1, got {episodes}")
     if policy not in ("agent", "random"):
         raise ValueError(f"policy must be 'agent' or 'random', got {policy!r}")
-    doc = _read_run(run)
-    which = tuple(which)
     part = (0, 1) if shard is None else _parse_shard(shard)
     if shard is not None and not results:
         raise ValueError("--shard needs --results FILE (the shard's episodes)")
+    doc = _read_run(run)
+    which = tuple(which)
     records = _evaluate_objects(run, doc, episodes, seed, which, policy, part, quiet)
     if shard is None and not results:
         return _write_evaluation(run, doc, episodes, seed, which, policy, records)
@@ -696,6 +716,8 @@ train options (defaults in brackets):
   --buffer-size B [1000000; visual 20000]  --batch-size 256 --lr 3e-4 --hidden 256,256
   --init-alpha A [0.1]        the entropy coefficient's start (it is then tuned)
   --checkpoint-interval C [10000] --log-interval L [2000] --quiet
+  --device auto|cpu|cuda [auto]  where the networks and updates run (auto: a GPU when PyTorch
+                              sees one); not part of the run, which may continue elsewhere
 
 sweep options (the train options above go to every run):
   --tasks, --obs, --train-objects, --seeds   the grid, comma-separated (defaults: the paper's
@@ -745,7 +767,7 @@ TRAIN_SPEC = {
     "dataset": str, "dataset-seed": int, "split-seed": int, "test-objects": int,
     "num-envs": int, "max-episode-steps": int, "warmup-steps": int, "updates-per-step": float,
     "buffer-size": int, "batch-size": int, "lr": float, "hidden": _hidden, "init-alpha": float,
-    "checkpoint-interval": int, "log-interval": int, "quiet": bool,
+    "checkpoint-interval": int, "log-interval": int, "quiet": bool, "device": str,
 }
 
 
@@ -767,14 +789,15 @@ def main(argv=None) -> int:
                 raise ValueError(f"train takes no positional arguments ({positional[0]!r})")
             if "out" not in opts:
                 raise ValueError("train needs --out RUN")
-            fields = {k.replace("-", "_"): v for k, v in opts.items() if k not in ("out",
-                                                                                   "quiet")}
+            fields = {k.replace("-", "_"): v for k, v in opts.items()
+                      if k not in ("out", "quiet", "device")}
             if "hidden" in fields:
                 fields["hidden_sizes"] = fields.pop("hidden")
             if "dataset" in fields:
                 fields["dataset"] = os.path.abspath(fields["dataset"])
             config = RunConfig(**fields)
-            summary = train(config, opts["out"], quiet=opts.get("quiet", False))
+            summary = train(config, opts["out"], quiet=opts.get("quiet", False),
+                            device=opts.get("device", "auto"))
             if summary.get("already_finished"):
                 print(f"partsim learn train: {opts['out']!r} is already finished "
                       f"({summary['env_steps']} environment steps for --steps "
