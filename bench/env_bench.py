@@ -10,7 +10,16 @@ Measures, on the drawer task with the gripper starting on the handle:
 * ``OpenCabinetEnv.step`` with mobility, raw and visual observations (visual: the front camera
   at 128 x 96, rasterizer backend);
 * ``VectorOpenCabinetEnv`` with 1, 2 and 4 environments (mobility), counted in environment
-  steps (``num_envs`` per call).
+  steps (``num_envs`` per call);
+* ``step_tasks`` (the vector environment's parallel step, in C++ without the GIL) on 1, 2 and 4
+  tasks, no observation: the C++ side of the vector rows, so that the difference is the share
+  of Python per environment step.
+
+``--vector`` measures only the bare task, the vector environments and ``step_tasks`` (no single
+environments, no visual). Every run also prints the speed-ups from 1 to 2 and 4 copies (the
+median of each repeat's ratio, and the fastest repeat's rate over the fastest repeat's: on a
+shared machine, the repeats that the neighbours disturbed least), and the Python share of the
+vector environment's step; ``--samples FILE`` writes every repeat's numbers as JSON.
 
 Each measurement runs ``--steps`` environment steps (``--visual-steps`` for visual; after an
 untimed warm-up step, with random actions in [-0.3, 0.3], reset whenever an episode ends) and
@@ -20,9 +29,11 @@ of each median to the bare task's, and the process CPU time per environment step
 summed; less sensitive to other jobs on a shared machine).
 
 Usage: PARTSIM_PYTHON_DIR=build/python python3 bench/env_bench.py [--steps N] [--repeats R]
+       [--vector] [--samples FILE]
 """
 
 import argparse
+import json
 import os
 import platform
 import statistics
@@ -128,10 +139,39 @@ class Vector:
         self.env.close()
 
 
+class StepTasks:
+    """partsim._partsim.step_tasks on ``n`` tasks per call (the actions scaled as the vector
+    environment scales them), no observation, reward or info: what the vector environment's
+    step costs in C++."""
+
+    def __init__(self, n):
+        self.name = f"step_tasks x{n} (C++ only)"
+        self.num_envs = n
+        self.envs = [
+            envs.OpenCabinetEnv(objects=OBJECT, max_episode_steps=EPISODE) for _ in range(n)
+        ]
+        for e in self.envs:
+            e.reset(seed=0)
+        self.tasks = [e.task for e in self.envs]
+        self.k = 0
+
+    def step(self, a):
+        partsim._partsim.step_tasks(self.tasks, envs._task_action(a.astype(np.float64)))
+        self.k += 1
+        if self.k % EPISODE == 0:
+            for t in self.tasks:
+                t.reset(self.k)
+
+    def close(self):
+        for e in self.envs:
+            e.close()
+
+
 def measure(runner, steps, seed):
     """(environment steps per second of wall time, process CPU ms per environment step)."""
     calls = max(1, steps // runner.num_envs)
-    shape = (calls + 1, runner.num_envs, 7) if isinstance(runner, Vector) else (calls + 1, 7)
+    batched = isinstance(runner, (Vector, StepTasks))
+    shape = (calls + 1, runner.num_envs, 7) if batched else (calls + 1, 7)
     acts = np.random.default_rng(seed).uniform(-0.3, 0.3, shape).astype(np.float32)
     runner.step(acts[0])  # untimed
     t, c = time.perf_counter(), time.process_time()
@@ -147,6 +187,12 @@ def main():
     ap.add_argument("--steps", type=int, default=200, help="environment steps per measurement")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--visual-steps", type=int, default=100, help="steps of the visual runs")
+    ap.add_argument("--samples", help="also write every repeat's (steps/s, CPU ms) as JSON here")
+    ap.add_argument(
+        "--vector",
+        action="store_true",
+        help="only the bare task, the vector environments and step_tasks, with speed-ups",
+    )
     args = ap.parse_args()
 
     print(
@@ -154,8 +200,12 @@ def main():
         f"{np.__version__}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}"
     )
     t0 = time.perf_counter()
-    runners = [Bare(), Physics(), Single("mobility"), Single("raw"), Single("visual")]
+    if args.vector:
+        runners = [Bare()]
+    else:
+        runners = [Bare(), Physics(), Single("mobility"), Single("raw"), Single("visual")]
     runners += [Vector(n) for n in (1, 2, 4)]
+    runners += [StepTasks(n) for n in (1, 2, 4)]
     print(f"built {len(runners)} configurations in {time.perf_counter() - t0:.0f} s", flush=True)
     # the configurations take turns within each repeat, so that changes of the machine's load
     # spread over all of them
@@ -167,6 +217,9 @@ def main():
         print(f"  repeat {rep + 1}/{args.repeats} done", flush=True)
     for r in runners:
         r.close()
+    if args.samples:
+        with open(args.samples, "w") as f:
+            json.dump(samples, f)
 
     print(
         f"\nload average at the end {os.getloadavg()[0]:.2f}; "
@@ -186,6 +239,34 @@ def main():
         print(
             f"| {r.name} | {med:.0f} | {min(rate):.0f}-{max(rate):.0f} | {med / bare:.2f} "
             f"| {statistics.median(cpu):.2f} |"
+        )
+
+    # speed-ups from 1 copy to n, per repeat (the copies ran one after the other, so each
+    # repeat's ratio cancels some of the machine's drift), then their median; and the share of
+    # Python: the vector environment's wall time per environment step minus step_tasks'
+    print(
+        "\n| speed-up | median of the repeats' ratios | min-max "
+        "| fastest repeat / fastest repeat |"
+    )
+    print("|---|---:|---:|---:|")
+    for kind, name in (("VectorOpenCabinetEnv", "VectorOpenCabinetEnv x{}, mobility"),
+                       ("step_tasks", "step_tasks x{} (C++ only)")):
+        for n in (2, 4):
+            one, many = samples[name.format(1)], samples[name.format(n)]
+            ratios = [b[0] / a[0] for a, b in zip(one, many)]
+            best = max(x[0] for x in many) / max(x[0] for x in one)
+            print(
+                f"| {kind} 1 -> {n} copies | {statistics.median(ratios):.2f} "
+                f"| {min(ratios):.2f}-{max(ratios):.2f} | {best:.2f} |"
+            )
+    for n in (1, 2, 4):
+        vec = samples[f"VectorOpenCabinetEnv x{n}, mobility"]
+        cpp = samples[f"step_tasks x{n} (C++ only)"]
+        vec = statistics.median(1000.0 / x[0] for x in vec)
+        cpp = statistics.median(1000.0 / x[0] for x in cpp)
+        print(
+            f"x{n}: wall ms per env step: vector env {vec:.3f}, step_tasks {cpp:.3f}, "
+            f"Python's share {vec - cpp:.3f} ({100 * (vec - cpp) / vec:.0f}%)"
         )
 
 
