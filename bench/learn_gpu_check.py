@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""SAC's update on a GPU: the device check of the learning protocol, for a lent GPU machine.
+"""SAC's update on a GPU: the learning protocol's check of a GPU machine.
 
 Times SAC updates (batch 256; both critics, the actor, the entropy coefficient and the target
 networks) for the raw, mobility and visual observations (RGB-D and the target mask at 128 x 96
@@ -10,10 +10,10 @@ It needs only PyTorch and NumPy: partsim.learn's `sac` and `replay` modules are 
 tree without the partsim package (whose C++ extension is built for the build VM's Python), so
 the environment steps of a real visual run are not part of it.
 
-Sized for the device's 15-minute budget: the defaults should take a few minutes on an H200 (not
-yet run on one); on the build VM's 2 cores, --device cpu --updates 3 --train-updates 3 takes
-30 s (a visual update there is about 3 s). On the GPU machine, whose Python has PyTorch but not
-Gymnasium, carry Gymnasium's wheels (bench/README.md, "SAC's update on a GPU").
+The defaults should take a few minutes on a data-centre GPU (not yet run on one); on the build
+VM's 2 cores, --device cpu --updates 3 --train-updates 3 takes 30 s (a visual update there is
+about 3 s). Where the GPU machine's Python lacks Gymnasium, copy its wheels along
+(bench/README.md, "SAC's update on a GPU").
 
 Usage: python3 bench/learn_gpu_check.py [--device auto|cpu|cuda] [--updates 200]
        [--train-updates 2000] [--out FILE.json]

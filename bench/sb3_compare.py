@@ -16,7 +16,7 @@ episodes, the same seeds) on the training and the unseen objects.
 
 Prints the paper's metric for both (door: final angle, degrees; drawer: success at 80% of the
 range) and the mean training return over the run's last 10% of episodes; OUT/compare.json
-holds it all. The two learners can run side by side: `--only partsim` and `--only sb3` in two
+holds it all, OUT/curves.png the two training curves. The two learners can run side by side: `--only partsim` and `--only sb3` in two
 processes, then `--only report`.
 
 Usage: PYTHONPATH=build/python .venv/bin/python bench/sb3_compare.py --task drawer
@@ -115,6 +115,51 @@ def sb3_returns(out):
     return rows
 
 
+def sb3_curve(out, every=2000):
+    """SB3's training episodes binned by environment steps: (steps, mean return, success)."""
+    eps = []
+    for name in sorted(os.listdir(out)):
+        if name.startswith("monitor_") and name.endswith(".monitor.csv"):
+            with open(os.path.join(out, name), encoding="utf-8") as f:
+                lines = [line for line in f if not line.startswith("#")]
+            eps += [(float(r["t"]), float(r["r"]), r["success"] == "True", int(r["l"]))
+                    for r in csv.DictReader(lines)]
+    eps.sort()  # by wall time: the four environments' episodes interleaved
+    curve, steps, chunk = [], 0, []
+    for _, ret, ok, length in eps:
+        steps += length
+        chunk.append((ret, ok))
+        if steps >= (len(curve) + 1) * every:
+            curve.append((steps, np.mean([c[0] for c in chunk]), np.mean([c[1] for c in chunk])))
+            chunk = []
+    return curve
+
+
+def plot(a, run, out, path):
+    """The two learners' training curves, return and success rate, in one PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with open(os.path.join(run, "progress.csv"), encoding="utf-8") as f:
+        rows = [r for r in csv.DictReader(f) if r.get("mean_return") not in (None, "", "nan")]
+    ours = [(float(r["env_steps"]), float(r["mean_return"]), float(r["success_rate"]))
+            for r in rows]
+    theirs = sb3_curve(out)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.5))
+    for k, label in ((1, "mean episode return"), (2, "success rate (90% of the range)")):
+        for name, curve in (("partsim SAC", ours), ("SB3 SAC", theirs)):
+            axes[k - 1].plot([c[0] for c in curve], [c[k] for c in curve], label=name)
+        axes[k - 1].set_xlabel("environment steps")
+        axes[k - 1].set_title(label)
+    axes[0].legend()
+    fig.suptitle(f"{a.task}, {a.obs}, {a.train_objects} training objects, seed {a.seed}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    return path
+
+
 def partsim_returns(run):
     with open(os.path.join(run, "progress.csv"), encoding="utf-8") as f:
         return [(float(r["env_steps"]), float(r["mean_return"])) for r in csv.DictReader(f)
@@ -170,6 +215,11 @@ def main() -> int:
                             "steps_per_s": a.steps / secs}
         with open(os.path.join(a.out, "compare.json"), "w", encoding="utf-8") as f:
             json.dump(report, f, indent=1)
+        try:
+            print("curves:", plot(a, run, os.path.join(a.out, "sb3"),
+                                  os.path.join(a.out, "curves.png")))
+        except ImportError:  # matplotlib is optional: the CSVs hold the curves
+            pass
         metric = "final angle (deg)" if a.task == "door" else "success at 80%"
         print(f"{a.task}, {a.obs}, {a.train_objects} objects, {a.steps:,} steps, seed {a.seed}")
         print(f"| learner | train, {metric} | test | late training return | env steps/s |")
