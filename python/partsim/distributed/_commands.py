@@ -12,6 +12,7 @@ import subprocess
 import sys
 import tarfile
 
+from .._files import atomic_write
 from . import _runner
 from ._unit import UNIT_TMP
 
@@ -179,11 +180,11 @@ def _extract(payload: bytes, out: str) -> int:
                 raise RuntimeError(f"a unit sent a file outside its folder: {m.name!r}")
             dest = os.path.join(out, rel)
             os.makedirs(os.path.dirname(dest), exist_ok=True)
-            tmp = f"{dest}.part{os.getpid()}"
-            with tar.extractfile(m) as src, open(tmp, "wb") as f:
-                shutil.copyfileobj(src, f)
-            os.chmod(tmp, m.mode & 0o777)
-            os.replace(tmp, dest)
+            with tar.extractfile(m) as src:
+                def write(f, src=src, mode=m.mode & 0o777):
+                    shutil.copyfileobj(src, f)
+                    os.fchmod(f.fileno(), mode)
+                atomic_write(dest, write, sync=False)
             n += 1
     return n
 
@@ -255,10 +256,8 @@ def run(argv, ray: str | None = "auto", units: int | None = None, shared: bool =
             if unit["collect"] == "tree:out":
                 _extract(result["payload"], out)
             elif unit["collect"]:
-                path = os.path.join(state, unit["key"] + ".result")
-                with open(path + ".tmp", "wb") as f:
-                    f.write(result["payload"])
-                os.replace(path + ".tmp", path)
+                atomic_write(os.path.join(state, unit["key"] + ".result"),
+                             lambda f: f.write(result["payload"]), sync=False)
 
         summary = _runner.run_units(specs, executor, state, take, retries=retries,
                                     quiet=quiet, label="partsim " + " ".join(cmd))

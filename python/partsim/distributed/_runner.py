@@ -8,6 +8,7 @@ import os
 import sys
 import time
 
+from .._files import atomic_write
 from . import _unit
 
 __all__ = ["LocalExecutor", "RayExecutor", "UnitFailed", "run_units"]
@@ -118,17 +119,17 @@ def run_units(units: list, executor, state_dir: str, on_result, retries: int = 3
     ``retries`` times; a unit whose command fails raises :class:`UnitFailed` (after the other
     running units finished and were taken in). Returns counts and times."""
     os.makedirs(state_dir, exist_ok=True)
-    todo, skipped = [], 0
+    pending, skipped = [], 0
     for spec in units:
         if os.path.exists(os.path.join(state_dir, spec["key"] + ".done")):
             skipped += 1
         else:
-            todo.append(spec)
-    by_key = {spec["key"]: spec for spec in todo}
+            pending.append(spec)
+    by_key = {spec["key"]: spec for spec in pending}
     attempts = {k: 0 for k in by_key}
-    for spec in todo:
+    for spec in pending:
         executor.submit(spec, spec.get("cpus", 1))
-    running, done, lost, failure = len(todo), 0, 0, None
+    running, done, lost, failure = len(pending), 0, 0, None
     start = time.monotonic()
     seconds = []
     if not quiet:
@@ -155,15 +156,14 @@ def run_units(units: list, executor, state_dir: str, on_result, retries: int = 3
             failure = failure or UnitFailed(key, result)
             continue
         on_result(spec, result)
-        with open(os.path.join(state_dir, key + ".done.tmp"), "w", encoding="utf-8") as f:
-            json.dump({"host": result["host"], "seconds": result["seconds"]}, f)
-        os.replace(os.path.join(state_dir, key + ".done.tmp"),
-                   os.path.join(state_dir, key + ".done"))
+        record = json.dumps({"host": result["host"], "seconds": result["seconds"]})
+        atomic_write(os.path.join(state_dir, key + ".done"),
+                     lambda f: f.write(record.encode("utf-8")), sync=False)
         done += 1
         seconds.append(result["seconds"])
         if not quiet:
             elapsed = time.monotonic() - start
-            eta = elapsed / done * (len(todo) - done)
+            eta = elapsed / done * (len(pending) - done)
             print(f"{label}: {done + skipped}/{len(units)} units done, {running} in flight, "
                   f"{_clock(elapsed)} elapsed, ETA {_clock(eta)}", file=sys.stderr)
     if failure is not None:

@@ -34,6 +34,8 @@ import time
 
 import numpy as np
 
+from .._files import atomic_write
+
 __all__ = [
     "PAPER_TABLE3",
     "TRAIN_SIZES",
@@ -305,10 +307,7 @@ def train(config: RunConfig, out: str, quiet: bool = False, device: str = "auto"
             return {"env_steps": done, "already_finished": True}
     if not resume or doc != old:
         os.makedirs(out, exist_ok=True)
-        tmp = run_file + ".tmp"
-        with open(tmp, "w", encoding="utf-8") as f:
-            json.dump(doc, f, indent=1)
-        os.replace(tmp, run_file)
+        _write_atomic(run_file, json.dumps(doc, indent=1))
 
     if torch.get_num_threads() > 1 and "OMP_NUM_THREADS" not in os.environ:
         torch.set_num_threads(1)
@@ -476,12 +475,8 @@ def _csv_text(rows) -> str:
 
 
 def _write_atomic(path: str, text: str) -> None:
-    """Writes ``text`` to a temporary file beside ``path`` and renames it: a reader (or a run
-    killed half-way) never sees half a file."""
-    tmp = f"{path}.tmp{os.getpid()}"
-    with open(tmp, "w", encoding="utf-8", newline="") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    """Writes ``text`` (UTF-8) whole or not at all (partsim._files.atomic_write)."""
+    atomic_write(path, lambda f: f.write(text.encode("utf-8")))
 
 
 def evaluate_run(run: str, episodes: int = 20, seed: int = 1000, which=("train", "test"),

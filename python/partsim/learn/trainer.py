@@ -44,6 +44,7 @@ import time
 import numpy as np
 import torch
 
+from .._files import atomic_write as _atomic_write
 from ..envs import _stack, _stack_infos, _vector_seeds
 
 __all__ = ["TrainConfig", "Trainer", "SyncVectorEnv", "Evaluation", "evaluate",
@@ -101,17 +102,6 @@ def _scale_action(a, space):
     if np.all(low == -1.0) and np.all(high == 1.0):
         return a
     return low + (np.asarray(a, np.float64) + 1.0) * 0.5 * (high - low)
-
-
-def _atomic_write(path, write):
-    """Calls write(file) on a temporary file beside ``path``, flushes it to disk, then renames
-    it onto ``path`` (os.replace): readers see the old file or the new one, never a part."""
-    tmp = path + ".tmp"
-    with open(tmp, "wb") as f:
-        write(f)
-        f.flush()
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
 
 
 def _fmt(x):
