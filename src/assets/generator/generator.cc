@@ -270,14 +270,14 @@ int GenerateDataset(const GeneratorOptions& options, const GeneratorProgress& pr
   // in a shared folder, what this shard wrote before (or another process at once) stays
   int already = 0;
   if (options.shared_out_dir && !options.overwrite) {
-    std::vector<std::pair<std::string, int>> todo;
+    std::vector<std::pair<std::string, int>> to_write;
     for (const auto& w : work) {
       if (AlreadyWritten(options, w.first, w.second))
         ++already;
       else
-        todo.push_back(w);
+        to_write.push_back(w);
     }
-    work = std::move(todo);
+    work = std::move(to_write);
   }
   if (skipped) *skipped = already;
   const int total = static_cast<int>(work.size());
