@@ -242,6 +242,7 @@ def test_the_last_row_of_a_short_run_gives_way_when_it_is_continued(tmp_path):
     (["evaluate", "NOWHERE", "--merge"], "needs the shards' results files"),
     (["sweep", "--out", "X", "--tasks", "lid", "--steps", "10"], "unknown task 'lid'"),
     (["sweep", "--out", "X"], "sweep needs --steps"),
+    (["sweep", "--out", "X", "--steps", "10", "--frob", "1"], "unknown option --frob"),
     (["sweep", "--out", "X", "--task", "door", "--steps", "10"], "takes the grid as --tasks"),
 ])
 def test_bad_command_lines_are_refused_by_name(tmp_path, args, message):

@@ -12,7 +12,7 @@ from . import _runner
 
 __all__ = ["grid", "sweep", "sweep_main"]
 
-# the sweep's own options (value options; --quiet is a switch); the others go to `learn train`
+# the sweep's own options (value options; --quiet is a switch); `learn train`'s go to every run
 GRID = {"--tasks": "door,drawer", "--obs": "raw,mobility,visual",
         "--train-objects": "2,4,8,16", "--seeds": "0,1,2"}
 OWN = {"--out", "--episodes", "--eval-seed", "--ray", "--retries"} | set(GRID)
@@ -105,27 +105,26 @@ def _ints(text, what):
 
 
 def sweep_main(args) -> int:
-    """``partsim learn sweep ...``: prints the table; returns the exit code."""
-    opts, train_args, i = dict(GRID), [], 0
-    quiet = False
-    while i < len(args):
-        a = args[i]
-        name, eq, value = a.partition("=")
-        if name == "--quiet":
-            quiet = True
-        elif name in OWN or name == "--steps":
-            if not eq:
-                if i + 1 >= len(args):
-                    raise ValueError(f"option {name} needs a value")
-                value = args[i + 1]
-                i += 1
-            opts[name] = value
-        elif name in ("--task", "--obs", "--train-objects", "--seed", "--out"):
+    """``partsim learn sweep ...``: prints the table; returns the exit code. The options are
+    the sweep's own (OWN, --steps, --quiet) and `learn train`'s, which go to every run; those
+    that name one run (--task, --seed) are refused."""
+    from ..learn import protocol
+
+    for a in args:
+        if a in ("--task", "--seed"):
             raise ValueError(f"sweep takes the grid as --tasks, --obs, --train-objects, "
-                             f"--seeds, not {name}")
-        else:
-            train_args.append(a)
-        i += 1
+                             f"--seeds, not {a}")
+    per_run = {"task", "obs", "train-objects", "seed", "out", "steps", "quiet"}
+    spec = {k: str for k in protocol.TRAIN_SPEC if k not in per_run}
+    spec.update({k[2:]: str for k in OWN | {"--steps"}})
+    spec["quiet"] = bool
+    parsed, positional = protocol._parse_options(args, spec)
+    if positional:
+        raise ValueError(f"sweep takes no positional arguments ({positional[0]!r})")
+    opts = dict(GRID)
+    opts.update({f"--{k}": v for k, v in parsed.items() if f"--{k}" in OWN | {"--steps"}})
+    train_args = [x for k, v in parsed.items() if f"--{k}" not in OWN | {"--steps"}
+                  and k != "quiet" for x in (f"--{k}", v)]
     if "--out" not in opts:
         raise ValueError("sweep needs --out SWEEP")
     if "--steps" not in opts:
@@ -137,6 +136,7 @@ def sweep_main(args) -> int:
                  episodes=_ints(opts.get("--episodes", "20"), "--episodes")[0],
                  eval_seed=_ints(opts.get("--eval-seed", "1000"), "--eval-seed")[0],
                  ray=opts.get("--ray"), retries=_ints(opts.get("--retries", "3"),
-                                                      "--retries")[0], quiet=quiet)
+                                                      "--retries")[0],
+                 quiet=parsed.get("quiet", False))
     sys.stdout.write(text)
     return 0
