@@ -149,6 +149,23 @@ def test_train_evaluate_table_through_the_command_line(tmp_path):
     assert rows[0] == "obs,task,set,train_objects,ours,runs,paper"
     assert "mobility,drawer,test,2," in "\n".join(rows)
 
+    # hostile shard files for --merge: refused, naming the file; the run's eval files stay
+    saved = (run / "eval.json").read_bytes()
+    shard = json.loads(learn("evaluate", run, "--episodes", "2", "--shard", "0/2", "--results",
+                             tmp_path / "s0.json", "--quiet").stdout and
+                       (tmp_path / "s0.json").read_text())
+    huge = dict(shard, objects=[dict(shard["objects"][0], index=10**30)])
+    hostile = {"garbage.json": "\u00e9\u6f22\x00\ufffd{[".encode("utf-8", "surrogatepass"),
+               "deep.json": b"[" * 100_000 + b"]" * 100_000,
+               "huge.json": json.dumps(huge).encode()}
+    for name, data in hostile.items():
+        (tmp_path / name).write_bytes(data)
+        bad = learn("evaluate", run, "--merge", tmp_path / name, tmp_path / "s0.json",
+                    check=False)
+        assert bad.returncode == 2 and name in bad.stderr, (name, bad.stderr)
+        assert "Traceback" not in bad.stderr
+        assert (run / "eval.json").read_bytes() == saved
+
 
 def test_resume_after_an_interruption_continues_the_same_run(tmp_path):
     straight, cut = tmp_path / "straight", tmp_path / "cut"

@@ -531,19 +531,31 @@ def merge_evaluations(run: str, files) -> dict:
         try:
             with open(path, encoding="utf-8") as f:
                 part = json.load(f)
-        except (OSError, ValueError) as e:
+        except (OSError, ValueError, RecursionError) as e:  # RecursionError: nested too deep
             raise ValueError(f"{path}: cannot be read: {e}") from None
         if not isinstance(part, dict) or part.get("kind") != "partsim learn evaluate shard":
             raise ValueError(f"{path}: not a results file of 'partsim learn evaluate --shard'")
         if part.get("run_config") != doc["config"]:
             raise ValueError(f"{path}: evaluates another run than {run!r}")
+        if not (isinstance(part.get("which"), list) and
+                all(w in ("train", "test") for w in part["which"])):
+            raise ValueError(f"{path}: its 'which' is not a list of train and test")
         key = {k: part.get(k) for k in ("episodes", "seed", "policy", "which")}
         if first is None:
             first = (path, key)
         elif key != first[1]:
             differ = ", ".join(k for k in key if key[k] != first[1][k])
             raise ValueError(f"{path} and {first[0]} are of different evaluations ({differ})")
-        for r in part.get("objects", []):
+        objects = part.get("objects")
+        if not isinstance(objects, list):
+            raise ValueError(f"{path}: its 'objects' is not a list")
+        for r in objects:
+            if not (isinstance(r, dict) and r.get("set") in key["which"] and
+                    type(r.get("index")) is int and 0 <= r["index"] < len(doc[r["set"]]) and
+                    isinstance(r.get("episodes"), list)):
+                what = {k: r.get(k) for k in ("set", "index")} if isinstance(r, dict) else r
+                raise ValueError(f"{path}: holds an object this run does not have, or one "
+                                 f"without its episodes ({str(what)[:80]})")
             place = (r["set"], r["index"])
             if place in seen:
                 raise ValueError(f"{path} and {seen[place]} both hold {r['set']} object "
