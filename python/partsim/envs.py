@@ -80,8 +80,9 @@ class OpenCabinetEnv(gymnasium.Env):
       metres, the target part's ``mask`` (h, w) uint8 and the robot ``state`` (14).
 
     Reward (dense, as in the paper): 10 x the fraction of the range opened in the step, +1 per
-    step once 90% is reached, -0.1 when a held grasp is lost, and -0.5 x the TCP's distance to
-    the handle until the target is first touched. ``terminated`` on success (90% of the range) or
+    step once 90% is reached, -0.1 per step that the fingers are off the target after touching
+    it (the gripper fell off the handle), and -0.5 x the TCP's distance to the handle until the
+    target is first touched. ``terminated`` on success (90% of the range) or
     failure (the part pushed the wrong way); ``truncated`` after ``max_episode_steps``.
 
     Made by ``gymnasium.make`` (which sets ``spec``), the environment leaves truncation to the

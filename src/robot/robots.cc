@@ -189,7 +189,7 @@ RobotModel BuildFlyingGripper(const FlyingGripperOptions& options) {
   PhysicalMaterial pad_material;
   pad_material.static_friction = 1.8;
   pad_material.dynamic_friction = 1.5;
-  const double finger_k = 1000, finger_d = 30, finger_mass = 0.05, finger_armature = 0.2;
+  const double finger_k = 5000, finger_d = 70, finger_mass = 0.05, finger_armature = 0.2;
   for (int side = 0; side < 2; ++side) {
     const bool left = side == 0;
     LinkDesc f = ChildLink(left ? "left_finger" : "right_finger", hand,

@@ -538,7 +538,6 @@ void TaskImpl::Reset(std::uint64_t seed) {
     for (int i = 0; i < 25; ++i) StepControl();
     start_time = scene->GetTime();
   }
-  had_grasp = TouchesTarget();
   last_reward = 0.0;
 }
 
@@ -717,10 +716,11 @@ void TaskImpl::StepControl() {
   const bool touching = TouchesTarget();
   double r = 10.0 * (p - before);
   if (p >= options.success_fraction) r += 1.0;
-  if (had_grasp && !touching) r -= 0.1;
+  // the paper's "negative rewards when the gripper falls off the handle": every step off the
+  // target once it has been held, not only the step it was lost
+  if (grasped_once && !touching) r -= 0.1;
   if (!grasped_once) r -= 0.5 * (TcpPose().p - HandleCentre()).norm();
   grasped_once = grasped_once || touching;
-  had_grasp = touching;
   last_reward = r;
 }
 

@@ -128,7 +128,7 @@ struct TaskImpl {
   bool velocity_mode = false;
   double gripper_fraction = 1.0;
   double last_reward = 0.0;
-  bool had_grasp = false, grasped_once = false;
+  bool grasped_once = false;
 };
 
 }  // namespace partsim::internal

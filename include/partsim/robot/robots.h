@@ -35,9 +35,12 @@ struct FlyingGripperOptions {
   double workspace = 5.0;       ///< limits of the x, y, z slides: +-workspace (m)
   double finger_travel = 0.05;  ///< each finger slides from 0 (closed) to this (m)
   double finger_length = 0.06;  ///< (m)
-  double finger_force = 60.0;   ///< force limit of each finger drive (N)
-  double arm_force = 400.0;     ///< force limit of the x, y, z slides (N)
-  double arm_torque = 60.0;     ///< torque limit of the three rotations (N m)
+  /// Force limit of each finger drive (N). The drive's stiffness is 5000 N/m: a finger stopped
+  /// 12 mm short of its target pushes with this force, one stopped 6 mm short (a 13 mm handle
+  /// in the closed hand) with about 30 N.
+  double finger_force = 60.0;
+  double arm_force = 400.0;  ///< force limit of the x, y, z slides (N)
+  double arm_torque = 60.0;  ///< torque limit of the three rotations (N m)
 };
 
 /// A parallel-jaw hand that flies freely: a fixed root, three prismatic joints x, y, z along the

@@ -160,8 +160,9 @@ class ArticulationTask {
   /// in raw.
   Eigen::VectorXd GetMobilityObservation() const;
   /// Dense reward of the last Step: 10 x progress gained, +1 per step at success, -0.1 per step
-  /// when a grasp held since the last step was lost, minus 0.5 x the TCP's distance to the handle
-  /// while it has not been grasped.
+  /// that the fingers do not touch the target after they have touched it in this episode (the
+  /// gripper fell off the handle), minus 0.5 x the TCP's distance to the handle while it has not
+  /// been touched.
   double GetReward() const;
 
   // Internals used by the solvers; not part of the stable API.
