@@ -239,6 +239,24 @@ def test_the_last_row_of_a_short_run_gives_way_when_it_is_continued(tmp_path):
     assert json.loads((run / "run.json").read_text())["config"]["steps"] == 20
 
 
+def test_curves_of_several_runs_are_drawn_over_each_other(tmp_path):
+    runs = [tmp_path / f"s{seed}" for seed in (0, 1)]
+    for seed, run in enumerate(runs):
+        learn("train", "--steps", "20", "--log-interval", "8", "--seed", str(seed), "--out", run,
+              *SHORT)
+    out = tmp_path / "both.png"
+    done = learn("curves", *runs, "--out", out, "--labels", "seed 0,seed 1")
+    assert done.stdout.strip() == str(out)
+    with open(out, "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+    assert out.read_bytes() != (runs[0] / "curves.png").read_bytes()
+    # several runs need a file to go to, and as many labels as runs
+    bad = learn("curves", *runs, check=False)
+    assert bad.returncode == 2 and "need --out" in bad.stderr
+    bad = learn("curves", *runs, "--out", out, "--labels", "one", check=False)
+    assert bad.returncode == 2 and "1 labels for 2 runs" in bad.stderr
+
+
 @pytest.mark.parametrize("args, message", [
     (["train", "--task", "window", "--out", "X"], "task must be 'door' or 'drawer'"),
     (["train", "--obs", "depth", "--out", "X"], "obs must be"),

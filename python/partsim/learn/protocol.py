@@ -638,44 +638,72 @@ def table(runs, fmt: str = "markdown") -> str:
 # --- curves --------------------------------------------------------------------------------
 
 
-def plot_curves(run: str, out: str | None = None) -> str:
-    """Draws a run's learning curves from progress.csv (mean episode return, success rate,
-    critic and policy losses, entropy coefficient against environment steps) into a PNG
-    (``out``, default RUN/curves.png) and returns its path. Needs matplotlib."""
+def plot_curves(run, out: str | None = None, labels=None) -> str:
+    """Draws learning curves from progress.csv (mean episode return, success rate, critic and
+    policy losses, entropy coefficient against environment steps) into a PNG and returns its
+    path. Needs matplotlib.
+
+    ``run``: one run folder (``out`` defaults to RUN/curves.png), or a list of them, drawn over
+    each other in the same panels (seeds of one setting, or settings side by side; ``out`` is
+    then required), each named in the legend by ``labels`` or its folder's name."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    path = os.path.join(run, "progress.csv")
-    with open(path, newline="", encoding="utf-8") as f:
-        rows = list(csv.DictReader(f))
-    if not rows:
-        raise ValueError(f"{path} has no rows yet")
+    runs = [run] if isinstance(run, (str, os.PathLike)) else list(run)
+    if not runs:
+        raise ValueError("curves needs at least one RUN folder")
+    if len(runs) > 1 and not out:
+        raise ValueError("curves of several runs need --out FILE.png")
+    labels = list(labels) if labels else [os.path.basename(os.path.normpath(r)) for r in runs]
+    if len(labels) != len(runs):
+        raise ValueError(f"{len(labels)} labels for {len(runs)} runs")
+    tables, configs = [], []
+    for r in runs:
+        path = os.path.join(r, "progress.csv")
+        with open(path, newline="", encoding="utf-8") as f:
+            rows = list(csv.DictReader(f))
+        if not rows:
+            raise ValueError(f"{path} has no rows yet")
+        tables.append(rows)
+        configs.append(_read_run(r)["config"])
 
-    def col(name):
+    def col(rows, name):
         return np.array([float(r[name]) if r.get(name) not in (None, "") else np.nan
                          for r in rows])
 
-    steps = col("env_steps")
-    doc = _read_run(run)
-    title = (f"{doc['config']['task']}, {doc['config']['obs']}-exp, "
-             f"{doc['config']['train_objects']} objects, seed {doc['config']['seed']}")
+    def describe(c, seed=True):
+        text = f"{c['task']}, {c['obs']}-exp, {c['train_objects']} objects"
+        return text + (f", seed {c['seed']}" if seed else "")
+
+    if len(runs) == 1:
+        title = describe(configs[0])
+    elif len({describe(c, seed=False) for c in configs}) == 1:
+        title = describe(configs[0], seed=False) + f", {len(runs)} runs"
+    else:
+        title = f"{len(runs)} runs"
     fig, axes = plt.subplots(2, 2, figsize=(10, 7))
     panels = [("mean_return", "mean episode return"), ("success_rate", "success rate (90%)"),
               ("q1_loss", "loss"), ("alpha", "entropy coefficient")]
     for ax, (name, label) in zip(axes.flat, panels):
-        y = col(name)
-        ax.plot(steps, y, marker=".", lw=1)
+        for k, rows in enumerate(tables):
+            steps = col(rows, "env_steps")
+            line, = ax.plot(steps, col(rows, name), marker="." if len(runs) == 1 else None,
+                            lw=1, label=labels[k] if len(runs) > 1 else None)
+            if name == "q1_loss":
+                ax.plot(steps, col(rows, "policy_loss"), lw=1, ls="--", color=line.get_color(),
+                        label="policy" if len(runs) == 1 else None)
         ax.set_xlabel("environment steps")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
         if name == "q1_loss":
-            ax.plot(steps, col("policy_loss"), lw=1, label="policy loss")
-            ax.legend(["critic (Q1)", "policy"])
+            ax.set_ylabel("loss: critic (Q1) solid, policy dashed")
+        if len(runs) > 1 and name == "success_rate":
+            ax.legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    out = out or os.path.join(run, "curves.png")
+    out = out or os.path.join(runs[0], "curves.png")
     fig.savefig(out, dpi=80)
     plt.close(fig)
     return out
@@ -692,7 +720,7 @@ USAGE = """usage:
                       [--train-objects 2,4,8,16] [--seeds 0,1,2] --steps S [train options]
                       [--episodes E] [--ray auto|ADDRESS]
   partsim learn table RUN... [--csv]
-  partsim learn curves RUN [--out FILE.png]
+  partsim learn curves RUN... [--out FILE.png] [--labels A,B,...]
 
 train      trains SAC on N training objects (generated StorageFurniture, or the PartNet-Mobility
            folders under ROOT) into the folder RUN: run.json, progress.csv (returns, success,
@@ -712,7 +740,8 @@ sweep      the paper's grid (task x state x training objects x seed) as training
            sees). Run it again to continue: finished runs and evaluations are skipped.
 table      prints the SAPIEN paper's Table 3 layout from evaluated runs (means over seeds),
            each cell beside the paper's number.
-curves     draws RUN/progress.csv into a PNG (default RUN/curves.png).
+curves     draws RUN/progress.csv into a PNG (default RUN/curves.png); several runs are
+           drawn over each other (seeds, settings side by side) into --out.
 
 train options (defaults in brackets):
   --num-envs E [4]            environments stepped together, one shared replay buffer
@@ -851,10 +880,12 @@ def main(argv=None) -> int:
             print(table(positional, "csv" if opts.get("csv") else "markdown"), end="")
             return 0
         if command == "curves":
-            opts, positional = _parse_options(args, {"out": str})
-            if len(positional) != 1:
-                raise ValueError("curves takes one RUN folder")
-            print(plot_curves(positional[0], opts.get("out")))
+            opts, positional = _parse_options(args, {"out": str, "labels": str})
+            if not positional:
+                raise ValueError("curves takes one or more RUN folders")
+            labels = opts["labels"].split(",") if opts.get("labels") else None
+            print(plot_curves(positional[0] if len(positional) == 1 else positional,
+                              opts.get("out"), labels))
             return 0
         print(f"partsim learn: unknown command {command!r} (expected train, evaluate, sweep, "
               "table or curves)", file=sys.stderr)
