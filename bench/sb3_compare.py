@@ -49,6 +49,7 @@ def train_sb3(a, config, train_objects, out):
     def make(i):
         def thunk():
             env = envs.OpenCabinetEnv(task=a.task, obs_mode=a.obs, objects=train_objects,
+                                      gripper_action=config.gripper == "free",
                                       max_episode_steps=config.max_episode_steps)
             return Monitor(env, os.path.join(out, f"monitor_{i}"), info_keywords=("success",))
         return thunk
@@ -176,9 +177,10 @@ def main() -> int:
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--out", required=True)
     ap.add_argument("--only", choices=("partsim", "sb3", "report"))
+    ap.add_argument("--gripper", default="closed", choices=("closed", "free"))
     a = ap.parse_args()
     config = protocol.RunConfig(task=a.task, obs=a.obs, train_objects=a.train_objects,
-                                steps=a.steps, seed=a.seed)
+                                steps=a.steps, seed=a.seed, gripper=a.gripper)
     train_objects, test_objects = protocol.task_objects(config)
     doc = {"config": config.to_json(), "train": train_objects, "test": test_objects}
     os.makedirs(a.out, exist_ok=True)
@@ -188,7 +190,8 @@ def main() -> int:
         start = time.monotonic()
         subprocess.run([cli, "learn", "train", "--task", a.task, "--obs", a.obs,
                         "--train-objects", str(a.train_objects), "--steps", str(a.steps),
-                        "--seed", str(a.seed), "--out", run, "--quiet"], check=True)
+                        "--seed", str(a.seed), "--gripper", a.gripper, "--out", run,
+                        "--quiet"], check=True)
         with open(os.path.join(a.out, "partsim_seconds.json"), "w", encoding="utf-8") as f:
             json.dump({"seconds": time.monotonic() - start}, f)
         subprocess.run([cli, "learn", "evaluate", run, "--episodes", str(a.episodes),

@@ -66,9 +66,11 @@ class OpenCabinetEnv(gymnasium.Env):
     object's task is built at its first episode and kept.
 
     Action: 7 values in [-1, 1]: the gripper's TCP twist in the world frame, scaled by 0.5 m/s
-    (linear) and 1.5 rad/s (angular), then the gripper command (-1 close, 1 open). Actions outside
-    [-1, 1] are clipped (a documented clamp); NaN or infinite actions, or a wrong shape, raise
-    ``ValueError`` and leave the simulation untouched.
+    (linear) and 1.5 rad/s (angular), then the gripper command (-1 close, 1 open). With
+    ``gripper_action=False``, 6 values, the twist alone: the fingers stay closed on the handle
+    the episode starts on (a policy cannot let go of it). Actions outside [-1, 1] are clipped (a
+    documented clamp); NaN or infinite actions, or a wrong shape, raise ``ValueError`` and leave
+    the simulation untouched.
 
     Observation modes (the SAPIEN paper's):
 
@@ -107,6 +109,7 @@ class OpenCabinetEnv(gymnasium.Env):
         camera_size=(128, 96),
         render_backend: str = "rasterizer",
         pool_size: int = 16,
+        gripper_action: bool = True,
     ):
         if obs_mode not in OBS_MODES:
             raise ValueError(f"obs_mode must be one of {OBS_MODES}, got {obs_mode!r}")
@@ -161,7 +164,8 @@ class OpenCabinetEnv(gymnasium.Env):
         self._truncate_at = self.max_episode_steps
         self._closed = False
 
-        self.action_space = spaces.Box(-1.0, 1.0, (7,), np.float32)
+        self.gripper_action = bool(gripper_action)
+        self.action_space = spaces.Box(-1.0, 1.0, (7 if self.gripper_action else 6,), np.float32)
         state = spaces.Box(-np.inf, np.inf, (ROBOT_STATE_SIZE,), np.float32)
         if obs_mode == "raw":
             self.observation_space = spaces.Box(
@@ -232,7 +236,7 @@ class OpenCabinetEnv(gymnasium.Env):
         return self._observation(), self._info()
 
     def step(self, action):
-        """Applies a (7,) action for one control period (1 / control_rate s) and returns
+        """Applies a (7,) action ((6,) without ``gripper_action``) for one control period (1 / control_rate s) and returns
         ``(obs, reward, terminated, truncated, info)``: the observation of ``obs_mode``, the
         dense reward (float), ``terminated`` on success or failure, ``truncated`` after
         ``max_episode_steps`` steps (see the class's note on ``gymnasium.make``), and ``info``
@@ -245,8 +249,9 @@ class OpenCabinetEnv(gymnasium.Env):
         if self._task is None:
             raise RuntimeError("step called before reset")
         a = np.asarray(action, dtype=np.float64)
-        if a.shape != (7,):
-            raise ValueError(f"action must have shape (7,), got {a.shape}")
+        if a.shape != self.action_space.shape:
+            raise ValueError(
+                f"action must have shape {self.action_space.shape}, got {a.shape}")
         if not np.all(np.isfinite(a)):
             bad = int(np.flatnonzero(~np.isfinite(a))[0])
             raise ValueError(f"action entry {bad} is not finite ({a[bad]})")
@@ -424,7 +429,10 @@ def _autoreset_mode(mode) -> AutoresetMode:
 
 def _task_action(a):
     """The task's action for actions in [-1, 1] (clipped), one per row: TCP twist in m/s and
-    rad/s, gripper command."""
+    rad/s, gripper command. Rows of 6 (the twist of ``gripper_action=False``) get the command
+    that keeps the fingers closed."""
+    if a.shape[-1] == 6:
+        a = np.concatenate([a, np.full(a.shape[:-1] + (1,), -1.0)], axis=-1)
     # np.minimum / np.maximum: np.clip's Python wrapper costs more than the rest of this
     return np.minimum(np.maximum(a, -1.0), 1.0) * _ACTION_SCALE
 
@@ -451,7 +459,7 @@ class VectorOpenCabinetEnv(gymnasium.vector.VectorEnv):
     workers.
 
     ``reset`` returns batched observations and an info dict of arrays; ``step(actions)`` with
-    actions of shape (num_envs, 7) returns batched ``(obs, rewards, terminations, truncations,
+    actions of shape (num_envs, 7) (6 without ``gripper_action``) returns batched ``(obs, rewards, terminations, truncations,
     infos)``. ``autoreset_mode`` (a ``gymnasium.vector.AutoresetMode`` or its value or name as a
     string; also in ``metadata["autoreset_mode"]``) says what happens after a copy's episode
     ends, as Gymnasium 1.x documents:
@@ -568,8 +576,9 @@ class VectorOpenCabinetEnv(gymnasium.vector.VectorEnv):
         return _stack(self._env_obs), infos
 
     def step(self, actions):
-        """Steps every sub-environment with its row of ``actions`` (num_envs, 7) and returns
-        batched ``(obs, rewards, terminations, truncations, infos)``: observations stacked
+        """Steps every sub-environment with its row of ``actions`` (num_envs, 7; 6 without
+        ``gripper_action``) and returns batched ``(obs, rewards, terminations, truncations,
+        infos)``: observations stacked
         along a first axis of num_envs, rewards float64 (num_envs,), terminations and
         truncations bool (num_envs,), infos a dict of arrays (each key ``k`` with a bool mask
         ``_k``). Episodes that end are reset as ``autoreset_mode`` says (see the class).
@@ -578,8 +587,9 @@ class VectorOpenCabinetEnv(gymnasium.vector.VectorEnv):
         reset."""
         self._check_open()
         actions = np.asarray(actions, dtype=np.float64)
-        if actions.shape != (self.num_envs, 7):
-            raise ValueError(f"actions must have shape ({self.num_envs}, 7), got {actions.shape}")
+        want = (self.num_envs,) + self.single_action_space.shape
+        if actions.shape != want:
+            raise ValueError(f"actions must have shape {want}, got {actions.shape}")
         if not np.all(np.isfinite(actions)):
             raise ValueError("actions hold NaN or infinite values")
         # which copies start a new episode instead of stepping (next-step autoreset)

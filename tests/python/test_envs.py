@@ -223,6 +223,35 @@ def test_terminated_on_success():
     e.close()
 
 
+def test_without_the_gripper_action_the_fingers_keep_the_handle():
+    # the same episode twice: the 6-value twist, and the 7-value action with the fingers told
+    # to open; only the second lets go of the handle
+    held = make(init_on_handle=True, gripper_action=False, max_episode_steps=20)
+    free = make(init_on_handle=True, max_episode_steps=20)
+    assert held.action_space.shape == (6,) and free.action_space.shape == (7,)
+    held.reset(seed=SEED)
+    free.reset(seed=SEED)
+    twist = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0], dtype=np.float32)
+    for _ in range(10):
+        _, _, _, _, h = held.step(twist)
+        _, _, _, _, f = free.step(np.append(twist, 1.0).astype(np.float32))
+    assert h["touching"] and not f["touching"]
+    assert held.task.get_gripper_opening() < 0.5 < free.task.get_gripper_opening()
+    with pytest.raises(ValueError, match=r"shape \(6,\)"):
+        held.step(np.zeros(7, dtype=np.float32))
+    held.close()
+    free.close()
+
+    vec = make_vec(2, gripper_action=False)
+    assert vec.single_action_space.shape == (6,) and vec.action_space.shape == (2, 6)
+    vec.reset(seed=0)
+    _, _, _, _, infos = vec.step(np.zeros((2, 6)))
+    assert infos["touching"].all()
+    with pytest.raises(ValueError, match=r"\(2, 6\)"):
+        vec.step(np.zeros((2, 7)))
+    vec.close()
+
+
 def test_reset_options():
     e = make(init_on_handle=False)
     with pytest.raises(ValueError):

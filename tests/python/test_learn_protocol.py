@@ -239,6 +239,17 @@ def test_the_last_row_of_a_short_run_gives_way_when_it_is_continued(tmp_path):
     assert json.loads((run / "run.json").read_text())["config"]["steps"] == 20
 
 
+def test_runs_hold_the_handle_unless_told_and_older_runs_keep_their_free_fingers():
+    assert protocol.RunConfig().gripper == "closed"
+    old = protocol.RunConfig(gripper="free").to_json()
+    del old["gripper"]  # a run.json written before the option
+    assert protocol.RunConfig.from_json(old).gripper == "free"
+    env = protocol._make_env(protocol.RunConfig(), [protocol.task_objects(
+        protocol.RunConfig())[0][0]], 1)
+    assert env.single_action_space.shape == (6,)
+    env.close()
+
+
 def test_curves_of_several_runs_are_drawn_over_each_other(tmp_path):
     runs = [tmp_path / f"s{seed}" for seed in (0, 1)]
     for seed, run in enumerate(runs):
@@ -273,6 +284,7 @@ def test_curves_of_several_runs_are_drawn_over_each_other(tmp_path):
     (["table"], "at least one RUN"),
     (["frob"], "unknown command 'frob'"),
     (["train", "--device", "tpu", "--out", "X"], "--device wants auto, cpu or cuda"),
+    (["train", "--gripper", "loose", "--out", "X"], "gripper must be 'closed' or 'free'"),
     (["evaluate", "NOWHERE", "--shard", "2/2", "--results", "F"], "--shard wants i/N"),
     (["evaluate", "NOWHERE", "--merge"], "needs the shards' results files"),
     (["sweep", "--out", "X", "--tasks", "lid", "--steps", "10"], "unknown task 'lid'"),

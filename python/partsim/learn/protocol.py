@@ -84,7 +84,9 @@ class RunConfig:
     ``buffer_size`` (0: a million transitions for states, 20,000 for pictures, whose
     transitions are large), ``batch_size``, ``hidden_sizes``, ``lr``, ``init_alpha`` (the
     entropy coefficient's start, tuned from there); ``checkpoint_interval``,
-    ``log_interval``: in environment steps.
+    ``log_interval``: in environment steps. ``gripper``: "closed" (the action is the hand's
+    6-value twist; the fingers stay closed on the handle the episode starts on) or "free" (a
+    7th action commands the fingers; runs written before this option existed are "free").
     """
 
     task: str = "drawer"
@@ -107,6 +109,7 @@ class RunConfig:
     init_alpha: float = 0.1
     checkpoint_interval: int = 10_000
     log_interval: int = 2_000
+    gripper: str = "closed"
 
     def check(self):
         """Raises ValueError naming the first option out of range."""
@@ -114,6 +117,8 @@ class RunConfig:
             raise ValueError(f"task must be 'door' or 'drawer', got {self.task!r}")
         if self.obs not in ("raw", "mobility", "visual"):
             raise ValueError(f"obs must be 'raw', 'mobility' or 'visual', got {self.obs!r}")
+        if self.gripper not in ("closed", "free"):
+            raise ValueError(f"gripper must be 'closed' or 'free', got {self.gripper!r}")
         for name in ("train_objects", "num_envs", "max_episode_steps", "batch_size",
                      "log_interval"):
             if int(getattr(self, name)) < 1:
@@ -143,6 +148,7 @@ class RunConfig:
         if unknown:
             raise ValueError(f"unknown run options {unknown}")
         d = dict(d)
+        d.setdefault("gripper", "free")  # written before the option: the fingers were free
         if "hidden_sizes" in d:
             d["hidden_sizes"] = tuple(int(h) for h in d["hidden_sizes"])
         return cls(**d)
@@ -208,7 +214,8 @@ def _make_env(config: RunConfig, objects, num_envs: int):
 
     return envs.VectorOpenCabinetEnv(
         num_envs, task=config.task, obs_mode=config.obs, objects=list(objects),
-        dataset_seed=config.dataset_seed, max_episode_steps=config.max_episode_steps)
+        dataset_seed=config.dataset_seed, max_episode_steps=config.max_episode_steps,
+        gripper_action=config.gripper == "free")
 
 
 # --- training ------------------------------------------------------------------------------
@@ -751,6 +758,8 @@ train options (defaults in brackets):
   --max-episode-steps M [250] --warmup-steps W [2000] --updates-per-step U [0.25]
   --buffer-size B [1000000; visual 20000]  --batch-size 256 --lr 3e-4 --hidden 256,256
   --init-alpha A [0.1]        the entropy coefficient's start (it is then tuned)
+  --gripper closed|free [closed]  closed: the action is the hand's twist (6 values) and the
+                              fingers hold the handle; free: a 7th action opens and closes them
   --checkpoint-interval C [10000] --log-interval L [2000] --quiet
   --device auto|cpu|cuda [auto]  where the networks and updates run (auto: a GPU when PyTorch
                               sees one); not part of the run, which may continue elsewhere
@@ -804,6 +813,7 @@ TRAIN_SPEC = {
     "num-envs": int, "max-episode-steps": int, "warmup-steps": int, "updates-per-step": float,
     "buffer-size": int, "batch-size": int, "lr": float, "hidden": _hidden, "init-alpha": float,
     "checkpoint-interval": int, "log-interval": int, "quiet": bool, "device": str,
+    "gripper": str,
 }
 
 
