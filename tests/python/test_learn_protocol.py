@@ -250,6 +250,18 @@ def test_runs_hold_the_handle_unless_told_and_older_runs_keep_their_free_fingers
     env.close()
 
 
+def test_a_run_from_before_the_gripper_option_continues_with_free_fingers(tmp_path):
+    run = tmp_path / "run"
+    learn("train", "--steps", "10", "--gripper", "free", "--out", run, *SHORT)
+    doc = json.loads((run / "run.json").read_text())
+    del doc["config"]["gripper"]  # as such runs were written
+    (run / "run.json").write_text(json.dumps(doc))
+    bad = learn("train", "--steps", "20", "--out", run, *SHORT, check=False)
+    assert bad.returncode == 2 and "other options (gripper)" in bad.stderr
+    learn("train", "--steps", "20", "--gripper", "free", "--out", run, *SHORT)
+    assert json.loads((run / "checkpoint.json").read_text())["env_steps"] >= 20
+
+
 def test_curves_of_several_runs_are_drawn_over_each_other(tmp_path):
     runs = [tmp_path / f"s{seed}" for seed in (0, 1)]
     for seed, run in enumerate(runs):

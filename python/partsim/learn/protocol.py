@@ -297,9 +297,15 @@ def train(config: RunConfig, out: str, quiet: bool = False, device: str = "auto"
     resume = os.path.exists(run_file)
     if resume:
         old = _read_run(out)
-        # the same run, perhaps with more steps: it continues from its last checkpoint
-        differ = sorted(k for k in set(old["config"]) | set(doc["config"])
-                        if k != "steps" and old["config"].get(k) != doc["config"].get(k))
+        # the same run, perhaps with more steps: it continues from its last checkpoint (the
+        # old options read as RunConfig reads them, so that an option added since has the
+        # value the run trained with)
+        try:
+            old_config = RunConfig.from_json(old["config"]).to_json()
+        except (TypeError, ValueError):
+            old_config = old["config"]
+        differ = sorted(k for k in set(old_config) | set(doc["config"])
+                        if k != "steps" and old_config.get(k) != doc["config"].get(k))
         if differ:
             raise ValueError(f"{out!r} holds a run with other options ({', '.join(differ)}); "
                              "choose another folder")
