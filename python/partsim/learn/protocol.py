@@ -425,7 +425,9 @@ def _evaluate_objects(run: str, doc: dict, episodes: int, seed: int, which, poli
                 random_policy = None
                 if policy == "random":
                     rng = np.random.default_rng([seed, s, k])  # the object's own stream
-                    random_policy = lambda o: rng.uniform(-1, 1, (len(_first(o)), 7))  # noqa: E731
+                    size = env.single_action_space.shape[0]
+                    random_policy = lambda o: rng.uniform(  # noqa: E731
+                        -1, 1, (len(_first(o)), size))
                 ev = run_episodes(env, agent, episodes, seed=seed + 1000 * k,
                                   policy=random_policy)
             finally:
