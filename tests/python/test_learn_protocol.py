@@ -262,6 +262,28 @@ def test_a_run_from_before_the_gripper_option_continues_with_free_fingers(tmp_pa
     assert json.loads((run / "checkpoint.json").read_text())["env_steps"] >= 20
 
 
+@pytest.mark.parametrize("hostile, train_says, evaluate_says", [
+    (b"\xff\xfe garbage \xe9\x00", "run.json: cannot be read", "run.json: cannot be read"),
+    (b"[" * 100_000 + b"]" * 100_000, "run.json: cannot be read", "run.json: cannot be read"),
+    # hidden sizes of 1e999, which JSON reads as infinity
+    (None, "other options (hidden_sizes)", "hidden_sizes must be a list of integers"),
+])
+def test_a_hostile_run_json_is_refused_by_name(tmp_path, hostile, train_says, evaluate_says):
+    run = tmp_path / "run"
+    learn("train", "--steps", "10", "--out", run, *SHORT)
+    if hostile is None:
+        doc = json.loads((run / "run.json").read_text())
+        doc["config"]["hidden_sizes"] = [1e999]
+        hostile = json.dumps(doc).encode()
+    (run / "run.json").write_bytes(hostile)
+    for args, says in ((["train", "--steps", "20", "--out", run, *SHORT], train_says),
+                       (["evaluate", run], evaluate_says)):
+        bad = learn(*args, check=False)
+        assert bad.returncode == 2 and says in bad.stderr, (args[0], bad.stderr)
+        assert "Traceback" not in bad.stderr
+    assert (run / "run.json").read_bytes() == hostile  # nothing was written over it
+
+
 def test_curves_of_several_runs_are_drawn_over_each_other(tmp_path):
     runs = [tmp_path / f"s{seed}" for seed in (0, 1)]
     for seed, run in enumerate(runs):

@@ -150,7 +150,11 @@ class RunConfig:
         d = dict(d)
         d.setdefault("gripper", "free")  # written before the option: the fingers were free
         if "hidden_sizes" in d:
-            d["hidden_sizes"] = tuple(int(h) for h in d["hidden_sizes"])
+            try:
+                d["hidden_sizes"] = tuple(int(h) for h in d["hidden_sizes"])
+            except (TypeError, ValueError, OverflowError):  # 1e999 reads as inf
+                raise ValueError(f"hidden_sizes must be a list of integers, got "
+                                 f"{str(d['hidden_sizes'])[:80]}") from None
         return cls(**d)
 
 
@@ -228,7 +232,7 @@ def _read_run(run: str) -> dict:
             doc = json.load(f)
     except FileNotFoundError:
         raise ValueError(f"{run!r} is not a run folder (no {RUN_FILE})") from None
-    except (OSError, ValueError) as e:
+    except (OSError, ValueError, RecursionError) as e:  # RecursionError: nested too deep
         raise ValueError(f"{path}: cannot be read: {e}") from None
     if not isinstance(doc, dict) or not isinstance(doc.get("config"), dict):
         raise ValueError(f"{path}: has no 'config' object")
@@ -302,7 +306,7 @@ def train(config: RunConfig, out: str, quiet: bool = False, device: str = "auto"
         # value the run trained with)
         try:
             old_config = RunConfig.from_json(old["config"]).to_json()
-        except (TypeError, ValueError):
+        except (TypeError, ValueError):  # not options this code wrote
             old_config = old["config"]
         differ = sorted(k for k in set(old_config) | set(doc["config"])
                         if k != "steps" and old_config.get(k) != doc["config"].get(k))
