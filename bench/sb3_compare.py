@@ -48,9 +48,7 @@ def train_sb3(a, config, train_objects, out):
 
     def make(i):
         def thunk():
-            env = envs.OpenCabinetEnv(task=a.task, obs_mode=a.obs, objects=train_objects,
-                                      gripper_action=config.gripper == "free",
-                                      max_episode_steps=config.max_episode_steps)
+            env = envs.OpenCabinetEnv(**protocol.env_kwargs(config, train_objects))
             return Monitor(env, os.path.join(out, f"monitor_{i}"), info_keywords=("success",))
         return thunk
 

@@ -41,6 +41,7 @@ __all__ = [
     "TRAIN_SIZES",
     "RunConfig",
     "task_objects",
+    "env_kwargs",
     "train",
     "evaluate_run",
     "merge_evaluations",
@@ -213,13 +214,18 @@ def task_objects(config: RunConfig) -> tuple:
     return pool[: config.train_objects], test
 
 
+def env_kwargs(config: RunConfig, objects) -> dict:
+    """The keyword arguments of the run's environments (``OpenCabinetEnv``, and every copy of
+    ``VectorOpenCabinetEnv``) on ``objects``."""
+    return dict(task=config.task, obs_mode=config.obs, objects=list(objects),
+                dataset_seed=config.dataset_seed, max_episode_steps=config.max_episode_steps,
+                gripper_action=config.gripper == "free")
+
+
 def _make_env(config: RunConfig, objects, num_envs: int):
     from .. import envs
 
-    return envs.VectorOpenCabinetEnv(
-        num_envs, task=config.task, obs_mode=config.obs, objects=list(objects),
-        dataset_seed=config.dataset_seed, max_episode_steps=config.max_episode_steps,
-        gripper_action=config.gripper == "free")
+    return envs.VectorOpenCabinetEnv(num_envs, **env_kwargs(config, objects))
 
 
 # --- training ------------------------------------------------------------------------------
