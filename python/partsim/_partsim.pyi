@@ -3661,7 +3661,7 @@ def standing_root_pose(articulation: Articulation, altitude: float = ...) -> Pos
     ...
 
 def step_tasks(tasks: typing.List[ArticulationTask], actions: numpy.ndarray) -> None:
-    """apply_action(actions[i]) and step() of every task in `tasks` (distinct tasks), in parallel: one thread per task, the GIL released. `actions` has shape (len(tasks), 7); a wrong shape or a non-finite entry raises PartsimError before any task moves. Used by partsim.envs.VectorOpenCabinetEnv: one call per vector step instead of a hand-off to a worker thread per environment."""
+    """apply_action(actions[i]) and step() of every task in `tasks` (distinct tasks), in parallel: on the calling thread and threads kept between calls (up to one per core), each task taken by the next thread free, the GIL released. `actions` has shape (len(tasks), 7); a wrong shape or a non-finite entry raises PartsimError before any task moves. Used by partsim.envs.VectorOpenCabinetEnv: one call per vector step instead of a hand-off to a worker thread per environment."""
     ...
 
 def task_target_label(type: TaskType) -> str:

@@ -454,9 +454,9 @@ class VectorOpenCabinetEnv(gymnasium.vector.VectorEnv):
     every copy. Copy i always runs on thread ``i % workers``: the rasterizer's OpenGL context
     stays current on the thread that last rendered with it, so a scene cannot move between
     threads. Copies without cameras (state observations, no render mode) have no such context:
-    ``step`` advances their physics in one ``step_tasks`` call, a thread per copy without the
-    GIL, which saves a hand-off to a worker per copy and step; their resets still run on the
-    workers.
+    ``step`` advances their physics in one ``step_tasks`` call, on up to one thread per core
+    without the GIL, which saves a hand-off to a worker per copy and step; their resets still
+    run on the workers.
 
     ``reset`` returns batched observations and an info dict of arrays; ``step(actions)`` with
     actions of shape (num_envs, 7) (6 without ``gripper_action``) returns batched ``(obs, rewards, terminations, truncations,
@@ -615,7 +615,7 @@ class VectorOpenCabinetEnv(gymnasium.vector.VectorEnv):
             results = self._map(one)
         else:
             # no OpenGL context to keep on its thread: the resets on the workers, then every
-            # other copy's physics in one call that steps them on a thread each
+            # other copy's physics in one call that steps them on up to a thread per core
             results = [None] * self.num_envs
             resets = np.flatnonzero(restart)
             if len(resets):

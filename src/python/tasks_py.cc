@@ -230,7 +230,9 @@ void BindTasks(py::module_& m) {
   m.def("step_tasks", &StepTasks, py::call_guard<py::gil_scoped_release>(), py::arg("tasks"),
         py::arg("actions"),
         "apply_action(actions[i]) and step() of every task in `tasks` (distinct tasks), in "
-        "parallel: one thread per task, the GIL released. `actions` has shape (len(tasks), 7); a "
+        "parallel: on the calling thread and threads kept between calls (up to one per core), "
+        "each task taken by the next thread free, the GIL released. `actions` has shape "
+        "(len(tasks), 7); a "
         "wrong shape or a non-finite entry raises PartsimError before any task moves. Used by "
         "partsim.envs.VectorOpenCabinetEnv: one call per vector step instead of a hand-off to "
         "a worker thread per environment.");

@@ -2,6 +2,7 @@
 #include <pthread.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -244,17 +245,18 @@ double ArticulationTask::GetReward() const { return impl_->last_reward; }
 
 namespace {
 
-// The threads StepTasks runs tasks 1 ... n-1 on, kept between calls: a task's step takes about
-// 0.4 ms, and a thread started and joined per task and call would add its start-up and the
+// The threads StepTasks runs tasks on beside the caller, kept between calls: a task's step takes
+// about 0.4 ms, and a thread started and joined per task and call would add its start-up and the
 // caller's wait for it to every step. One pool for the process, used by one call at a time (a
-// second caller waits on `call`), grown to the largest number of tasks seen less one, its threads
-// joined when the process exits (after a call in progress, which holds `call`).
+// second caller waits on `call`), grown to the largest number of tasks seen, up to the cores, less
+// one; its threads poll for the next call for kPoll before they park, and are joined when the
+// process exits (after a call in progress, which holds `call`).
 //
 // fork() copies only the thread that forks, so a child of a process that has the pool would wait
 // for workers it does not have (Gymnasium's AsyncVectorEnv and multiprocessing fork). The fork
-// handlers hold `call` across the fork, so that no call is running and every worker is parked
-// with the work handed out done; the child then drops the pool without touching it (its threads
-// and their locks are not there) and makes a new one on its first call.
+// handlers hold `call` across the fork, so that no call is running and the work handed out is
+// done (a worker may still be polling); the child then drops the pool without touching it (its
+// threads and their locks are not there) and makes a new one on its first call.
 class StepPool {
  public:
   static StepPool& Get() {
@@ -262,21 +264,22 @@ class StepPool {
     return pool;
   }
 
-  // Runs part(0) on the calling thread and part(1) ... part(n - 1) on the workers; returns when
+  // Runs part(0) ... part(n - 1) on the calling thread and the workers, each part taken by the
+  // next thread free (tasks whose step takes longer do not hold the others back); returns when
   // all are done. `part` must not throw.
   void Run(int n, const std::function<void(int)>& part) {
-    if (n < 2) {
-      if (n == 1) part(0);
+    const int threads = std::min(n, Cores()) - 1;  // besides the caller
+    if (threads < 1) {
+      for (int i = 0; i < n; ++i) part(i);
       return;
     }
     std::lock_guard<std::mutex> lock(call_);
-    if (!workers_ || workers_->size() < n - 1) {
+    if (!workers_ || workers_->size() < threads) {
       workers_.reset();  // joins the smaller pool's threads first
-      workers_ = std::make_unique<internal::WorkerPool>(n - 1);
+      workers_ = std::make_unique<internal::WorkerPool>(threads, kPoll);
     }
-    workers_->Start(n - 1, [&part](int k) { part(k + 1); });
-    part(0);
-    workers_->Wait();  // also runs any part that no worker has begun
+    workers_->Start(n, part);
+    workers_->Wait();  // runs parts on this thread too
   }
 
  private:
@@ -286,11 +289,24 @@ class StepPool {
                   std::to_string(err) + ")");
   }
 
+  // more threads than cores would take turns on them: a task's step is pure computation
+  static int Cores() {
+    const unsigned cores = std::thread::hardware_concurrency();
+    return cores == 0 ? 1 << 20 : static_cast<int>(cores);
+  }
+
   // at exit: after a call still running on another thread, joins the workers
   ~StepPool() {
     std::lock_guard<std::mutex> lock(call_);
     workers_.reset();
   }
+
+  // How long a worker that has stepped a task polls for the next call before it parks, and how
+  // long the caller polls for the workers' tasks: a vector environment calls again within
+  // 0.1-0.5 ms (its Python, the policy), and waking a parked thread on a 2-vCPU virtual machine
+  // cost about 0.4 ms, as much as a step (bench/README.md). Bounded so that a pause of the caller
+  // (a learner's update) costs at most this much CPU per call.
+  static constexpr std::chrono::microseconds kPoll{500};
 
   static void Prepare() { Get().call_.lock(); }
   static void Parent() { Get().call_.unlock(); }

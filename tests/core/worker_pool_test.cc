@@ -67,5 +67,22 @@ TEST(WorkerPoolTest, StartWaitsForTheJobBeforeAndTheDestructorForTheThreads) {
   WorkerPool never_started(2);  // no threads until the first job
 }
 
+TEST(WorkerPoolTest, APollingPoolRunsEveryPartOnceJobAfterJob) {
+  // polling workers and a polling Wait: jobs back to back (taken while polling) and after a pause
+  // longer than the poll (taken from the condition variable) each run every part exactly once
+  for (int spinners : {0, 1, 3}) {
+    WorkerPool pool(3, std::chrono::microseconds(300), spinners);
+    for (int job = 0; job < 200; ++job) {
+      const int parts = 1 + job % 5;
+      std::vector<std::atomic<int>> runs(parts);
+      pool.Start(parts, [&](int k) { runs[k]++; });
+      pool.Wait();
+      for (int k = 0; k < parts; ++k)
+        ASSERT_EQ(runs[k].load(), 1) << "job " << job << ", part " << k << ", " << spinners;
+      if (job % 50 == 49) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }  // destroyed with workers possibly still polling: they stop within the poll
+}
+
 }  // namespace
 }  // namespace partsim::internal
