@@ -91,6 +91,22 @@ constexpr char kShowUsage[] =
       defaults to the kind whose split files DIR holds.
 )";
 
+constexpr char kBaselinesUsage[] =
+    R"(  partsim vision train maskrcnn|insseg|motion-resnet|motion-pointnet --data DIR --out RUN
+                 [--input I] [--epochs N] [--size S] [--batch-size B] [--lr LR] [--seed S]
+                 [--backbone resnet50|resnet18] [--points N] [--instances K] [--init FILE]
+                 [--device auto|cpu|cuda] [--no-eval] [--quiet]
+  partsim vision predict RUN [--split test|train] [--data DIR] [--shard i/N]
+  partsim vision table RUN... [--split test|train] [--out FILE]
+      The paper's baselines (Python, PyTorch; partsim.perception): train one on a dataset's
+      train split into RUN (checkpoints, continued when RUN exists; progress.csv, curves.png,
+      model.pt), predict a split and score it (RUN/eval-SPLIT/), print Tables 1 and 2 beside
+      the paper's numbers. `partsim vision train --help` lists every option.
+)";
+
+// the subcommands that are Python (partsim.perception), run by RunPythonModule
+const char* const kPythonSubcommands[] = {"train", "predict", "table"};
+
 // one subcommand: its name, its part of the help, and what runs it (the arguments after its
 // name; returns the exit code, throws UsageError for a bad command line)
 struct Subcommand {
@@ -116,12 +132,14 @@ const Subcommand kSubcommands[] = {
 std::string Usage() {
   std::string s = "usage:\n";
   for (const Subcommand& c : kSubcommands) s += c.usage;
+  s += kBaselinesUsage;
   return s + "Exit codes: 0 success, 1 a file missing or malformed, 2 a bad command line.\n";
 }
 
 std::vector<std::string> Names() {
   std::vector<std::string> names;
   for (const Subcommand& c : kSubcommands) names.push_back(c.name);
+  for (const char* name : kPythonSubcommands) names.push_back(name);
   return names;
 }
 
@@ -285,6 +303,10 @@ int RunShow(const std::vector<std::string>& args) {
 
 int RunVisionCommand(int argc, char** argv) {
   const std::vector<std::string> args(argv, argv + argc);
+  for (const char* name : kPythonSubcommands)
+    if (argc > 0 && args[0] == name)
+      return RunPythonModule("partsim.perception", "partsim vision train|predict|table (PyTorch)",
+                             argc, argv);
   if (ArgParser::AsksForHelp(args)) {
     std::printf("%s", Usage().c_str());
     return 0;

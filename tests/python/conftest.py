@@ -100,3 +100,29 @@ def assert_vec(a, shape, dtype=np.float64):
     assert isinstance(a, np.ndarray), type(a)
     assert a.shape == shape, (a.shape, shape)
     assert a.dtype == dtype, a.dtype
+
+
+class PerceptionData:
+    """A tiny perception benchmark made by the command line: `tree` (two generated
+    StorageFurniture objects, seed 1), `det` (its detection dataset) and `mot` (its motion
+    dataset), 4 views each at 64 x 64, seed 5. The split puts one object in train and one in
+    test; the baselines' tests overfit the training split and score it."""
+
+
+@pytest.fixture(scope="session")
+def perception_data(tmp_path_factory):
+    import subprocess
+    cli = os.environ.get("PARTSIM_CLI", os.path.join(os.path.dirname(os.path.abspath(PYTHON_DIR)),
+                                                     "partsim"))
+    base = tmp_path_factory.mktemp("perception_data")
+    d = PerceptionData()
+    d.cli = cli
+    d.tree, d.det, d.mot = str(base / "tree"), str(base / "det"), str(base / "mot")
+    common = ["--views", "4", "--size", "64", "--seed", "5", "--quiet"]
+    for args in (["assets", "generate", "--out", d.tree, "--categories", "StorageFurniture",
+                  "--per-category", "2", "--seed", "1"],
+                 ["vision", "detection-dataset", "--dataset", d.tree, "--out", d.det] + common,
+                 ["vision", "motion-dataset", "--dataset", d.tree, "--out", d.mot] + common):
+        r = subprocess.run([cli] + args, capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, "partsim %s: %s%s" % (" ".join(args), r.stdout, r.stderr)
+    return d

@@ -34,6 +34,7 @@ import time
 
 import numpy as np
 
+from .._device import resolve_device  # noqa: F401 (part of this module's API)
 from .._files import atomic_write
 
 __all__ = [
@@ -255,19 +256,6 @@ def _make_agent(config: RunConfig, env, device: str = "cpu"):
                device=device)
 
 
-def resolve_device(device: str) -> str:
-    """"auto": "cuda" when PyTorch sees a GPU, else "cpu"; "cpu" and "cuda" as they are (a
-    ValueError for "cuda" without one, or anything else)."""
-    import torch
-
-    if device == "auto":
-        return "cuda" if torch.cuda.is_available() else "cpu"
-    if device == "cuda" and not torch.cuda.is_available():
-        raise ValueError("--device cuda: PyTorch sees no GPU (this torch is "
-                         f"{torch.__version__}; Debian's is built for the CPU only)")
-    if device not in ("cpu", "cuda"):
-        raise ValueError(f"--device wants auto, cpu or cuda, got {device!r}")
-    return device
 
 
 def _make_buffer(config: RunConfig, env, action_dim: int):
