@@ -11,8 +11,9 @@ PACKAGES=(
   # the SAPIEN-style examples save pictures and build rotations as SAPIEN's tutorials do
   python3-pil python3-transforms3d
   # PyTorch (CPU) for partsim.vision's torch datasets, learning on the tasks and the perception
-  # baselines (torchvision: Mask R-CNN, ResNet-50); matplotlib for the learning curves
-  python3-torch python3-torchvision python3-matplotlib
+  # baselines (torchvision: Mask R-CNN, ResNet-50; scipy: Hungarian matching); matplotlib for
+  # the learning curves
+  python3-torch python3-torchvision python3-scipy python3-matplotlib
   # an optimised BLAS for it (Debian's torch calls the system BLAS: the reference one is ~15x
   # slower at the networks' matrix products)
   libopenblas0-openmp

@@ -73,7 +73,8 @@ def parser():
     t.add_argument("--batch-size", type=_positive_int)
     t.add_argument("--lr", type=_positive_float)
     t.add_argument("--seed", type=int)
-    t.add_argument("--backbone", help="resnet50 (default) or resnet18 (maskrcnn, motion-resnet)")
+    t.add_argument("--backbone", help="resnet50 (default) or resnet18 (maskrcnn, motion-resnet); "
+                   "ssg (default) or small (insseg, motion-pointnet)")
     t.add_argument("--points", type=_positive_int, help="points per view (insseg, "
                    "motion-pointnet)")
     t.add_argument("--instances", type=_positive_int, help="instance masks per view (insseg)")
