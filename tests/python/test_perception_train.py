@@ -1,0 +1,191 @@
+"""The shared machinery of the perception baselines (partsim.perception.train and the
+`partsim vision train|predict|table` commands): runs that continue exactly after a kill or a
+longer --epochs, sharded prediction equal to one pass, the tables, weights loaded from a file,
+and bad command lines and run folders refused with a message and exit code 2.
+
+The network is the motion-attribute ResNet with the small resnet18 backbone on 32-pixel
+pictures of the session's tiny dataset: the machinery does not depend on the model."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from conftest import PYTHON_DIR, require
+
+torch = require("torch", "Debian's python3-torch")
+require("torchvision", "Debian's python3-torchvision")
+
+SMALL = ["--backbone", "resnet18", "--size", "32", "--batch-size", "4", "--seed", "3",
+         "--quiet"]
+
+
+def vision(cli, *args, ok=True, timeout=600):
+    r = subprocess.run([cli, "vision"] + [str(a) for a in args], capture_output=True,
+                       text=True, timeout=timeout)
+    if ok:
+        assert r.returncode == 0, "partsim vision %s: %s%s" % (" ".join(map(str, args)),
+                                                               r.stdout, r.stderr)
+    return r
+
+
+def weights(run):
+    return torch.load(os.path.join(run, "model.pt"), map_location="cpu")
+
+
+def assert_same_weights(a, b):
+    assert a.keys() == b.keys()
+    for k in a:
+        assert torch.equal(a[k], b[k]), k
+
+
+@pytest.fixture(scope="module")
+def straight(perception_data, tmp_path_factory):
+    """A run of 2 epochs in one go (4 batches per epoch), predicted on the test split."""
+    run = str(tmp_path_factory.mktemp("perception_train") / "straight")
+    vision(perception_data.cli, "train", "motion-resnet", "--data", perception_data.mot,
+           "--out", run, "--epochs", 2, "--log-every", 1, *SMALL)
+    return run
+
+
+def test_a_run_continued_to_more_epochs_equals_one_run(perception_data, straight, tmp_path):
+    run = str(tmp_path / "continued")
+    vision(perception_data.cli, "train", "motion-resnet", "--data", perception_data.mot,
+           "--out", run, "--epochs", 1, "--log-every", 1, "--no-eval", *SMALL)
+    one = weights(run)
+    vision(perception_data.cli, "train", "motion-resnet", "--data", perception_data.mot,
+           "--out", run, "--epochs", 2, "--log-every", 1, "--no-eval", *SMALL)
+    assert_same_weights(weights(run), weights(straight))
+    assert any(not torch.equal(one[k], weights(run)[k]) for k in one)  # it did train on
+    # the log is the straight run's, but for the timing columns
+    def rows(r):
+        with open(os.path.join(r, "progress.csv")) as f:
+            lines = f.read().splitlines()
+        head = lines[0].split(",")
+        keep = [i for i, h in enumerate(head) if h not in ("items_per_s", "wall_s")]
+        return [[line.split(",")[i] for i in keep] for line in lines]
+    assert rows(run) == rows(straight)
+    assert len(rows(run)) == 1 + 2 * 4
+    assert os.path.getsize(os.path.join(run, "curves.png")) > 1000
+
+
+def test_a_killed_run_continues_where_its_checkpoint_was(perception_data, straight, tmp_path):
+    """Checkpoints after every logged batch (--checkpoint-minutes tiny); the process is killed
+    with SIGKILL once one exists, then started again with the same command."""
+    run = str(tmp_path / "killed")
+    args = [perception_data.cli, "vision", "train", "motion-resnet", "--data",
+            perception_data.mot, "--out", run, "--epochs", "2", "--log-every", "1",
+            "--checkpoint-minutes", "1e-9", "--no-eval"] + SMALL
+    p = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    checkpoint = os.path.join(run, "checkpoint.pt")
+    deadline = time.monotonic() + 300
+    while not os.path.exists(checkpoint) and p.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    assert os.path.exists(checkpoint)
+    assert not os.path.exists(os.path.join(run, "model.pt"))
+    vision(perception_data.cli, *args[2:])
+    assert_same_weights(weights(run), weights(straight))
+
+
+def test_sharded_prediction_equals_one_pass(perception_data, straight, tmp_path):
+    with open(os.path.join(straight, "eval-test", "predictions.json")) as f:
+        whole = json.load(f)
+    first = vision(perception_data.cli, "predict", straight, "--shard", "0/2", "--quiet")
+    assert "not all done" in first.stdout
+    os.remove(os.path.join(straight, "eval-test", "predictions.json"))
+    vision(perception_data.cli, "predict", straight, "--shard", "1/2", "--quiet")
+    with open(os.path.join(straight, "eval-test", "predictions.json")) as f:
+        merged = json.load(f)
+    assert len(merged["samples"]) == len(whole["samples"]) > 0
+    for a, b in zip(merged["samples"], whole["samples"]):
+        assert a["sample_id"] == b["sample_id"]
+        np.testing.assert_allclose(a["m"], b["m"], rtol=1e-5, atol=1e-6)
+
+
+def test_the_table_puts_the_run_beside_the_paper(perception_data, straight, tmp_path):
+    out = str(tmp_path / "table.md")
+    r = vision(perception_data.cli, "table", straight, "--out", out)
+    assert "Table 2" in r.stdout and "Table 1" not in r.stdout
+    lines = r.stdout.splitlines()
+    paper = [line for line in lines if "| paper |" in line]
+    assert len(paper) == 2 and "| 95.5% | 95.5% | 0.168 |" in paper[0]
+    ours = [line for line in lines if "partsim `straight`" in line]
+    assert len(ours) == 1
+    with open(os.path.join(straight, "eval-test", "metrics.json")) as f:
+        metrics = json.load(f)
+    assert ("%.1f%%" % (100 * metrics["hinge_accuracy"])) in ours[0]
+    with open(out) as f:
+        assert f.read().strip() == r.stdout.strip()
+    # a run never predicted is named
+    bare = str(tmp_path / "bare")
+    vision(perception_data.cli, "train", "motion-resnet", "--data", perception_data.mot,
+           "--out", bare, "--epochs", 1, "--no-eval", *SMALL)
+    r = vision(perception_data.cli, "table", bare, ok=False)
+    assert r.returncode == 1 and "eval-test/metrics.json" in r.stderr and "predict" in r.stderr
+
+
+def test_init_loads_the_tensors_that_fit(perception_data, straight, tmp_path):
+    sys.path.insert(0, PYTHON_DIR)
+    from partsim.perception.train import Run, load_matching, RunError
+
+    run = Run(str(tmp_path / "init"), baseline="motion-resnet", data=perception_data.mot,
+              device="cpu", quiet=True, backbone="resnet18", size=32, epochs=1)
+    model = run.baseline.build_model()
+    saved = weights(straight)
+    loaded, skipped = load_matching(model, os.path.join(straight, "model.pt"))
+    assert set(loaded) == set(saved) and skipped == []
+    for k, v in model.state_dict().items():
+        assert torch.equal(v, saved[k]), k
+    # a file of another network's tensors: nothing fits
+    other = str(tmp_path / "other.pt")
+    torch.save({"fc.weight": torch.zeros(3, 3)}, other)
+    with pytest.raises(RunError, match="none of its 1 tensors fits"):
+        load_matching(model, other)
+    with open(str(tmp_path / "garbage.pt"), "wb") as f:
+        f.write(b"\x00not a torch file")
+    with pytest.raises(RunError, match="garbage.pt' cannot be read"):
+        load_matching(model, str(tmp_path / "garbage.pt"))
+
+
+def test_bad_command_lines_and_run_folders(perception_data, straight, tmp_path):
+    cli, mot = perception_data.cli, perception_data.mot
+    cases = [
+        (["train", "yolo", "--data", mot, "--out", str(tmp_path / "a")], "invalid choice"),
+        (["train", "maskrcnn", "--data", mot, "--out", str(tmp_path / "a"), "--input",
+          "xyz"], "takes --input rgb or rgbd"),
+        (["train", "motion-resnet", "--data", mot, "--out", str(tmp_path / "a"), "--epochs",
+          "0"], "positive integer"),
+        (["train", "motion-resnet", "--data", mot, "--out", str(tmp_path / "a"), "--lr",
+          "nan"], "positive number"),
+        (["train", "motion-resnet", "--data", mot, "--out", str(tmp_path / "a"), "--device",
+          "tpu"], "auto, cpu or cuda"),
+        (["train", "motion-resnet", "--data", mot, "--out", straight, "--lr", "0.5"],
+         "was started with lr="),
+        (["train", "insseg", "--data", mot, "--out", straight], "trains motion-resnet"),
+        (["predict", str(tmp_path / "nothing")], "holds no run"),
+        (["predict", straight, "--shard", "2/2"], "i must be in [0, N)"),
+    ]
+    if not torch.cuda.is_available():
+        cases.append((["train", "motion-resnet", "--data", mot, "--out", str(tmp_path / "a"),
+                       "--device", "cuda"], "PyTorch sees no GPU"))
+    for args, message in cases:
+        r = vision(cli, *args, ok=False)
+        assert r.returncode == 2, (args, r.stdout, r.stderr)
+        assert message in r.stderr, (args, r.stderr)
+    # a damaged run.json is named, and the run's files stay as they were
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    (broken / "run.json").write_text("[" * 100000)
+    r = vision(cli, "predict", str(broken), ok=False)
+    assert r.returncode == 2 and "run.json' cannot be read" in r.stderr
+    assert (broken / "run.json").read_text() == "[" * 100000
+    r = vision(cli, "train", "motion-resnet", "--data", str(tmp_path / "no-data"), "--out",
+               str(tmp_path / "b"), ok=False)
+    assert r.returncode == 1 and "no-data" in r.stderr
