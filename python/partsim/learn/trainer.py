@@ -44,6 +44,7 @@ import time
 import numpy as np
 import torch
 
+from .._text import duration as _duration
 from .._files import atomic_write as _atomic_write
 from ..envs import _stack, _stack_infos, _vector_seeds
 
@@ -391,21 +392,7 @@ class Trainer:
         print(" | ".join(parts), file=sys.stderr, flush=True)
 
 
-def _duration(s):
-    """'1h02m', '3m05s' or '12s'."""
-    if not math.isfinite(s):
-        return "?"
-    s = int(round(s))
-    if s >= 3600:
-        return f"{s // 3600}h{s % 3600 // 60:02d}m"
-    if s >= 60:
-        return f"{s // 60}m{s % 60:02d}s"
-    return f"{s}s"
-
-
 # --- a generic vector environment --------------------------------------------------------------
-
-
 
 
 class SyncVectorEnv:

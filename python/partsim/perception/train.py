@@ -28,7 +28,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import math
 import os
 import sys
 import time
@@ -37,6 +36,7 @@ import numpy as np
 
 from .._device import resolve_device
 from .._files import atomic_write
+from .._text import duration as _duration
 from . import baseline_class
 
 RUN_FILE = "run.json"
@@ -59,18 +59,6 @@ def _datasets():
 def open_split(kind, data, split):
     """The dataset of ``kind`` ('detection' or 'motion') in folder ``data``, split ``split``."""
     return _datasets()[kind](data, split)
-
-
-def _duration(s):
-    """'1h02m', '3m05s' or '12s'."""
-    if not math.isfinite(s):
-        return "?"
-    s = int(round(s))
-    if s >= 3600:
-        return f"{s // 3600}h{s % 3600 // 60:02d}m"
-    if s >= 60:
-        return f"{s // 60}m{s % 60:02d}s"
-    return f"{s}s"
 
 
 def _read_json(path, what):
