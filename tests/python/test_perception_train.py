@@ -169,6 +169,8 @@ def test_bad_command_lines_and_run_folders(perception_data, straight, tmp_path):
         (["train", "motion-resnet", "--data", mot, "--out", straight, "--lr", "0.5"],
          "was started with lr="),
         (["train", "insseg", "--data", mot, "--out", straight], "trains motion-resnet"),
+        (["train", "motion-resnet", "--data", mot, "--out", str(tmp_path / "a"), "--backbone",
+          "vgg"], "vgg"),
         (["predict", str(tmp_path / "nothing")], "holds no run"),
         (["predict", straight, "--shard", "2/2"], "i must be in [0, N)"),
     ]

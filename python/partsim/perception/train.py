@@ -158,7 +158,10 @@ class Run:
         self.train_set = open_split(self.kind, self.data, "train")
         if len(self.train_set) == 0:
             raise RunError(f"dataset '{self.data}': the train split is empty")
-        self.baseline = cls(self.train_set, self.options)
+        try:
+            self.baseline = cls(self.train_set, self.options)
+        except ValueError as e:  # an option the baseline refuses (a backbone it does not know)
+            raise RunError(str(e)) from None
 
     # --- files ---------------------------------------------------------------------------------
 
