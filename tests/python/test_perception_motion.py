@@ -16,7 +16,7 @@ torch = require("torch", "Debian's python3-torch")
 
 import partsim.vision as vision  # noqa: E402
 from partsim.perception.motion import (  # noqa: E402
-    MotionPointNet, MotionResNet, lift_depth, motion_loss, motion_outputs)
+    MotionPointNet, MotionResNet, axis_output, lift_depth, motion_loss, motion_outputs)
 
 
 def softplus(x):
@@ -32,29 +32,30 @@ def loss_batch():
     test_loss_terms_match_a_hand_computation."""
     raw = torch.zeros(3, 13, dtype=torch.float64)
     m = torch.zeros(3, 13, dtype=torch.float64)
-    # A, a hinge: tanh(raw axis) = (0.6, 0.8, 0) against (1, 0, 0): 1 - |cos| = 0.4; pivot
+    # A, a hinge: raw axis (3, 4, 0), output tanh((0.6, 0.8, 0)) against (1, 0, 0); pivot
     # (0.3, 0.4, 2.5) against the line through (0, 0, 2) along x: squared distance
     # 0.4^2 + 0.5^2 = 0.41; door sigmoid(0) = 0.5 against 0.25: 0.0625
     raw[0, :2] = f64([2.0, -1.0])
     raw[0, 2:5] = f64([0.3, 0.4, 2.5])
-    raw[0, 5:8] = f64([math.atanh(0.6), math.atanh(0.8), 0.0])
+    raw[0, 5:8] = f64([3.0, 4.0, 0.0])
     m[0, :2] = f64([1.0, 0.0])
     m[0, 2:5] = f64([0.0, 0.0, 2.0])
     m[0, 5:8] = f64([1.0, 0.0, 0.0])
     m[0, 11] = 0.25
-    # B, a slider: tanh(raw axis) = (-0.6, 0, 0.8) against (0, 0, 2) (not unit): 1 - 0.8 =
-    # 0.2; drawer sigmoid(log 3) = 0.75 against 0.5: 0.0625
+    # B, a slider: raw axis (-30, 0, 40), output tanh((-0.6, 0, 0.8)) against (0, 0, 2) (not
+    # unit); drawer sigmoid(log 3) = 0.75 against 0.5: 0.0625
     raw[1, :2] = f64([-0.5, 1.5])
-    raw[1, 8:11] = f64([math.atanh(-0.6), 0.0, math.atanh(0.8)])
+    raw[1, 8:11] = f64([-30.0, 0.0, 40.0])  # the length does not matter
     raw[1, 12] = math.log(3.0)
     m[1, :2] = f64([0.0, 1.0])
     m[1, 8:11] = f64([0.0, 0.0, 2.0])
     m[1, 12] = 0.5
-    # C, a hinge: (0, 0.6, 0.8) against (0, 0, -1): 1 - |-0.8| = 0.2; pivot (1, 1, 1) on the
-    # line through (1, 1, 0) along z: 0; door sigmoid(log 1/3) = 0.25 against 0.75: 0.25
+    # C, a hinge: raw axis (0, 0.3, 0.4), output tanh((0, 0.6, 0.8)) against (0, 0, -1); pivot
+    # (1, 1, 1) on the line through (1, 1, 0) along z: 0; door sigmoid(log 1/3) = 0.25
+    # against 0.75: 0.25
     raw[2, :2] = f64([1.0, -2.0])
     raw[2, 2:5] = f64([1.0, 1.0, 1.0])
-    raw[2, 5:8] = f64([0.0, math.atanh(0.6), math.atanh(0.8)])
+    raw[2, 5:8] = f64([0.0, 0.3, 0.4])
     raw[2, 11] = math.log(1.0 / 3.0)
     m[2, :2] = f64([1.0, 0.0])
     m[2, 2:5] = f64([1.0, 1.0, 0.0])
@@ -66,12 +67,16 @@ def loss_batch():
 def test_loss_terms_match_a_hand_computation():
     raw, m = loss_batch()
     total, terms = motion_loss(raw, m)
+    # the axis outputs: tanh of the unit raw vector; 1 - |cos| against the true axes
+    t6, t8 = math.tanh(0.6), math.tanh(0.8)
+    norm = math.hypot(t6, t8)
+    d_a, d_b, d_c = 1 - t6 / norm, 1 - t8 / norm, 1 - t8 / norm
     # means over the samples of each type (A and C hinges, B the slider), BCE over all three
     expected = {
-        "dr": (0.4 + 0.2) / 2,
+        "dr": (d_a + d_c) / 2,
         "p": (0.41 + 0.0) / 2,
         "door": (0.0625 + 0.25) / 2,
-        "dt": 0.2,
+        "dt": d_b,
         "drawer": 0.0625,
         "Tr": (softplus(-2.0) + softplus(-0.5) + softplus(-1.0)) / 3,
         "Tt": (softplus(-1.0) + softplus(-1.5) + softplus(-2.0)) / 3,
@@ -123,6 +128,27 @@ def test_outputs_ranges():
     assert torch.equal(out[:, 2:5], raw[:, 2:5])  # pivot in metres, as is
     zero = motion_outputs(torch.zeros(1, 13))
     assert torch.allclose(zero[0, [0, 1, 11, 12]], torch.full((4,), 0.5))
+
+
+def test_axis_outputs_depend_on_the_raw_direction_only():
+    # tanh on raw values saturates once they grow (the cosine loss does not hold their length);
+    # the axis output takes tanh of the unit raw vector, the same at any length
+    raw = torch.randn(8, 3, generator=torch.Generator().manual_seed(2), dtype=torch.float64)
+    assert torch.allclose(axis_output(raw), axis_output(1000.0 * raw))
+    assert torch.allclose(axis_output(raw), torch.tanh(raw / raw.norm(dim=1, keepdim=True)))
+    # where tanh of the raw values is flat (every component 50 or more away from 0), the
+    # direction still gets a gradient
+    raw = torch.tensor([[1.0, 2.0, 3.0], [-1.0, 1.0, 2.0], [2.0, -1.0, 1.0], [1.0, 1.0, -1.0]],
+                       dtype=torch.float64)
+    big = (50.0 * raw).requires_grad_(True)
+    true = torch.tensor([[0.0, 0.0, 1.0]], dtype=torch.float64).expand(4, 3)
+    cos = (axis_output(big) * true).sum(1) / axis_output(big).norm(dim=1)
+    (1 - cos.abs()).sum().backward()
+    assert float(big.grad.abs().max()) > 1e-4
+    flat = (50.0 * raw).requires_grad_(True)
+    cos = (torch.tanh(flat) * true).sum(1) / torch.tanh(flat).norm(dim=1)
+    (1 - cos.abs()).sum().backward()
+    assert float(flat.grad.abs().max()) < 1e-10
 
 
 def test_lifted_points_project_back_onto_their_pixels():

@@ -34,15 +34,26 @@ X_DOOR, X_DRAWER = 11, 12
 _EPS = 1e-8
 
 
+def axis_output(raw_axis):
+    """An axis prediction from its three raw outputs (B, 3): tanh of the raw vector scaled to
+    unit length, so each component is in [-1, 1] as the paper's tanh gives, and tanh never
+    saturates. The loss on an axis is a cosine, blind to the raw vector's length; with tanh on
+    the raw values that length drifts, and once every component is far from 0 tanh is flat and
+    the axis stops learning (seen in training: the slider axis' raw outputs grew to 10-50, all
+    of one sign, and its loss term stayed at 0.6 for 15 epochs)."""
+    return torch.tanh(raw_axis / raw_axis.norm(dim=1, keepdim=True).clamp_min(_EPS))
+
+
 def motion_outputs(raw):
     """The prediction vector m from the networks' raw outputs ``raw`` (B, 13) (a torch tensor):
-    T_r and T_t as probabilities (sigmoid of the logits), the pivot as is (metres), tanh on the
-    hinge and slider axes (each component in [-1, 1]) and sigmoid on x_door and x_drawer (in
-    [0, 1]). The evaluator takes the larger of T_r and T_t as the predicted type."""
+    T_r and T_t as probabilities (sigmoid of the logits), the pivot as is (metres), the hinge
+    and slider axes through :func:`axis_output` (each component in [-1, 1]) and sigmoid on
+    x_door and x_drawer (in [0, 1]). The evaluator takes the larger of T_r and T_t as the
+    predicted type."""
     return torch.cat([torch.sigmoid(raw[:, T_R:T_T + 1]),
                       raw[:, PIVOT],
-                      torch.tanh(raw[:, AXIS_R]),
-                      torch.tanh(raw[:, AXIS_T]),
+                      axis_output(raw[:, AXIS_R]),
+                      axis_output(raw[:, AXIS_T]),
                       torch.sigmoid(raw[:, X_DOOR:X_DRAWER + 1])], dim=1)
 
 
@@ -50,7 +61,8 @@ def motion_loss(raw, m):
     """The paper's loss L = L_dr + L_dt + L_p + L_Tr + L_Tt + L_door + L_drawer of the raw
     outputs ``raw`` (B, 13) against the labels ``m`` (B, 13).
 
-    - L_dr, L_dt: 1 - |cos| between tanh(raw) and the true axis (sign-free cosine distance);
+    - L_dr, L_dt: 1 - |cos| between the axis output (:func:`axis_output`) and the true axis
+      (sign-free cosine distance);
     - L_p: the squared distance (m^2) from the predicted pivot to the true hinge axis line;
     - L_Tr, L_Tt: binary cross-entropies of T_r and T_t, computed from the logits;
     - L_door, L_drawer: squared errors of sigmoid(raw) against x_door and x_drawer.
@@ -83,8 +95,8 @@ def motion_loss(raw, m):
     off_axis = v - (v * axis_r).sum(dim=1, keepdim=True) * axis_r
 
     terms = {
-        "dr": mean_over(axis_distance(torch.tanh(raw[:, AXIS_R]), m[:, AXIS_R]), hinge),
-        "dt": mean_over(axis_distance(torch.tanh(raw[:, AXIS_T]), m[:, AXIS_T]), slider),
+        "dr": mean_over(axis_distance(axis_output(raw[:, AXIS_R]), m[:, AXIS_R]), hinge),
+        "dt": mean_over(axis_distance(axis_output(raw[:, AXIS_T]), m[:, AXIS_T]), slider),
         "p": mean_over((off_axis ** 2).sum(dim=1), hinge),
         "Tr": F.binary_cross_entropy_with_logits(raw[:, T_R], m[:, T_R]),
         "Tt": F.binary_cross_entropy_with_logits(raw[:, T_T], m[:, T_T]),
