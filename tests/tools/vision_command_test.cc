@@ -111,7 +111,7 @@ TEST_F(VisionCommandTest, BadCommandLinesExitWith2) {
   EXPECT_EQ(code, 2);
   EXPECT_TRUE(Contains(out,
                        "expected a subcommand (detection-dataset, motion-dataset, "
-                       "evaluate-detection, evaluate-motion, show)"))
+                       "evaluate-detection, evaluate-motion, show, train, predict, table)"))
       << out;
   out = Run("evaluate-detections --gt gt.json", &code);
   EXPECT_EQ(code, 2);
