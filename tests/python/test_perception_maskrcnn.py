@@ -367,3 +367,35 @@ def test_resized_pictures_give_masks_at_the_pictures_size(perception_data):
         out = model(images)[0]
     assert images_seen.tensors.shape[-2:] == (96, 96)
     assert out["masks"].shape[1:] == (1, 64, 64)
+
+
+def test_pycocotools_scores_the_predictions_as_partsim_does(perception_data, rgb_run, tmp_path):
+    # the trained network's own results, with no conversion, scored by COCOeval (segm, IoU 0.5,
+    # 100 detections) and by partsim's evaluator: the same AP per category
+    require("pycocotools", "pycocotools (requirements.lock)")
+    import contextlib
+    import io
+    import json
+    from pycocotools.coco import COCO
+    from pycocotools.cocoeval import COCOeval
+
+    _, results, evaluation = rgb_run
+    path = str(tmp_path / "results.json")
+    with open(path, "w") as f:
+        json.dump(results, f)
+    gt = vision.DetectionDataset(perception_data.det, "train").annotation_file
+    with contextlib.redirect_stdout(io.StringIO()):
+        coco_gt = COCO(gt)
+        e = COCOeval(coco_gt, coco_gt.loadRes(path), "segm")
+        e.evaluate()
+        e.accumulate()
+    t = [round(float(x), 2) for x in e.params.iouThrs].index(0.5)
+    compared = 0
+    for c in evaluation.categories:
+        p = e.eval["precision"][t, :, list(e.params.catIds).index(c.category_id), 0, 2]
+        if np.all(p == -1):
+            assert not c.present, c.name
+            continue
+        assert c.ap == pytest.approx(float(np.mean(p)), abs=1e-9), c.name
+        compared += 1
+    assert compared >= 2
