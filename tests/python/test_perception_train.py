@@ -188,6 +188,23 @@ def test_bad_command_lines_and_run_folders(perception_data, straight, tmp_path):
     r = vision(cli, "predict", str(broken), ok=False)
     assert r.returncode == 2 and "run.json' cannot be read" in r.stderr
     assert (broken / "run.json").read_text() == "[" * 100000
+    # a run.json with a huge number or garbage where a name goes: refused, named, left alone
+    with open(os.path.join(straight, "run.json")) as f:
+        good = json.load(f)
+    for key, value, message in (("epochs", "1e999", "'epochs' must be a positive integer"),
+                                ("lr", "-1", "'lr' must be a positive number"),
+                                ("baseline", r'"\u00e9\u2603\ud83d\ude00"',
+                                 "'baseline' must be one of")):
+        # the value written into the JSON text as it is (1e999 reads back as infinity)
+        if key == "baseline":
+            text = json.dumps(dict(good, baseline="@")).replace('"@"', value)
+        else:
+            text = json.dumps(dict(good, options=dict(good["options"], **{key: "@"})))
+            text = text.replace('"@"', value)
+        (broken / "run.json").write_text(text)
+        r = vision(cli, "predict", str(broken), ok=False)
+        assert r.returncode == 2 and message in r.stderr, (key, r.stderr)
+        assert (broken / "run.json").read_text() == text
     r = vision(cli, "train", "motion-resnet", "--data", str(tmp_path / "no-data"), "--out",
                str(tmp_path / "b"), ok=False)
     assert r.returncode == 1 and "no-data" in r.stderr

@@ -28,6 +28,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import os
 import sys
 import time
@@ -37,7 +38,7 @@ import numpy as np
 from .._device import resolve_device
 from .._files import atomic_write
 from .._text import duration as _duration
-from . import baseline_class
+from . import BASELINES, baseline_class
 
 RUN_FILE = "run.json"
 CHECKPOINT = "checkpoint.pt"
@@ -70,6 +71,27 @@ def _read_json(path, what):
     if not isinstance(doc, dict):
         raise RunError(f"{what} '{path}' is not a JSON object")
     return doc
+
+
+# the options every run has that must be positive numbers (the rest are checked by the baseline)
+_POSITIVE_INTS = ("epochs", "batch_size", "log_every")
+_POSITIVE_FLOATS = ("lr", "checkpoint_minutes")
+
+
+def _check_options(options, where):
+    """Raises RunError naming ``where`` unless the shared numeric options are usable: positive
+    integers, positive finite numbers and an integer seed (a run.json written by hand or
+    damaged, or options given from Python, never reach the trainer as 1e999 or "ten")."""
+    for k in _POSITIVE_INTS:
+        v = options.get(k)
+        if not (isinstance(v, int) and not isinstance(v, bool) and v >= 1):
+            raise RunError(f"{where}: '{k}' must be a positive integer, got {v!r}")
+    for k in _POSITIVE_FLOATS:
+        v = options.get(k)
+        if not (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v < math.inf):
+            raise RunError(f"{where}: '{k}' must be a positive number, got {v!r}")
+    if not (isinstance(options.get("seed"), int) and not isinstance(options["seed"], bool)):
+        raise RunError(f"{where}: 'seed' must be an integer, got {options.get('seed')!r}")
 
 
 def _write_json(path, doc):
@@ -117,8 +139,12 @@ class Run:
             if data is not None and os.path.abspath(data) != doc["data"]:
                 raise RunError(f"run '{self.out}' trains on '{doc['data']}', not "
                                f"'{os.path.abspath(data)}'")
-            self.name, self.data = doc["baseline"], doc["data"]
+            if doc["baseline"] not in BASELINES or not isinstance(doc["options"], dict):
+                raise RunError(f"run file '{path}': 'baseline' must be one of "
+                               f"{', '.join(BASELINES)} and 'options' an object")
+            self.name, self.data = doc["baseline"], str(doc["data"])
             self.options = dict(doc["options"])
+            _check_options(self.options, f"run file '{path}'")
             for k, v in options.items():
                 if v is None or k == "epochs":
                     continue
@@ -150,6 +176,7 @@ class Run:
                 raise RunError(f"{baseline} takes --input {' or '.join(cls.inputs)}, not "
                                f"'{self.options['input']}'")
             self.options.update({k: v for k, v in options.items() if v is not None})
+            _check_options(self.options, "options")
             self._make_baseline()
 
     def _make_baseline(self):
