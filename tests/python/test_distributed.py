@@ -174,6 +174,49 @@ def test_sweep_and_learn_evaluate_on_ray_equal_one_process(cluster, tmp_path):
     assert "(2 done before, skipped)" in again.stderr and again.stdout == many.stdout
 
 
+def assert_close(a, b, where="metrics"):
+    """Equal JSON documents, numbers to 1e-5 (the units' batches differ from one pass's)."""
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and sorted(a) == sorted(b), where
+        for k in a:
+            assert_close(a[k], b[k], f"{where}.{k}")
+    elif isinstance(a, list):
+        assert isinstance(b, list) and len(a) == len(b), where
+        for i, (x, y) in enumerate(zip(a, b)):
+            assert_close(x, y, f"{where}[{i}]")
+    elif isinstance(a, float) or isinstance(b, float):
+        assert a == pytest.approx(b, rel=1e-5, abs=1e-6), where
+    else:
+        assert a == b, where
+
+
+def test_vision_predict_on_ray_equals_one_pass(cluster, perception_data, tmp_path):
+    """A perception run's prediction in 3 units (each `vision predict --shard i/3 --results`),
+    merged and scored by the driver: the run's own predictions and scores."""
+    import json
+
+    import numpy as np
+
+    run = tmp_path / "run"
+    partsim("vision", "train", "motion-resnet", "--data", perception_data.mot, "--out", run,
+            "--backbone", "resnet18", "--size", "32", "--epochs", "1", "--seed", "3", "--quiet")
+    folder = run / "eval-test"
+    whole = json.loads((folder / "predictions.json").read_text())
+    metrics = json.loads((folder / "metrics.json").read_text())
+    for name in ("predictions.json", "metrics.json", "table.md"):
+        os.remove(folder / name)
+    r = partsim("vision", "predict", run, "--ray", cluster, "--units", "3", "--state",
+                tmp_path / "state")
+    assert "3/3 units done" in r.stderr and "hinge_accuracy" in r.stdout
+    merged = json.loads((folder / "predictions.json").read_text())
+    assert [s["sample_id"] for s in merged["samples"]] == \
+        [s["sample_id"] for s in whole["samples"]]
+    for a, b in zip(merged["samples"], whole["samples"]):
+        np.testing.assert_allclose(a["m"], b["m"], rtol=1e-5, atol=1e-6)
+    assert_close(json.loads((folder / "metrics.json").read_text()), metrics)
+    assert (folder / "table.md").exists() and not (tmp_path / "state").exists()
+
+
 def test_a_worker_killed_mid_run_loses_nothing(cluster, single, tmp_path):
     args = ["tasks", "evaluate", "--dataset", single / "objects", "--count", "6",
             "--no-cameras"]

@@ -10,6 +10,10 @@ regions per picture) at the pictures' own size: 100 steps and the predictions ta
 per input on a loaded 2-core machine.
 """
 
+import json
+import os
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -353,6 +357,47 @@ def test_backbone_weights_load_and_rgbd_gets_the_rgb_filters(perception_data, tm
     assert not skipped and loaded
     for key, value in model.backbone.body.state_dict().items():
         assert torch.equal(value, source.backbone.body.state_dict()[key])
+
+
+def test_the_command_takes_the_network_options_and_a_resnet_as_init(perception_data, tmp_path):
+    """`partsim vision train maskrcnn --channels --rois --init RESNET.pt`: the options reach
+    run.json, and a torchvision ResNet's state dict (as pretrained weights are saved) starts
+    the backbone; the RGB-D network's first layer gets its RGB filters."""
+    torch.manual_seed(11)
+    resnet = torchvision.models.resnet18().state_dict()
+    path = str(tmp_path / "resnet18.pt")
+    torch.save(resnet, path)
+    run = str(tmp_path / "run")
+    r = subprocess.run([perception_data.cli, "vision", "train", "maskrcnn", "--data",
+                        perception_data.det, "--out", run, "--input", "rgbd", "--backbone",
+                        "resnet18", "--channels", "32", "--rois", "16", "--size", "32",
+                        "--epochs", "1", "--lr", "1e-12", "--no-eval", "--init", path],
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert "initialised" in r.stderr and path in r.stderr
+    with open(os.path.join(run, "run.json")) as f:
+        model = json.load(f)["model"]
+    assert (model["channels"], model["rois"], model["input"]) == (32, 16, "rgbd")
+    trained = torch.load(os.path.join(run, "model.pt"), map_location="cpu")
+    # one epoch at a rate of 1e-12 leaves the loaded weights where they were (Adam's step is
+    # about the rate)
+    conv = trained["backbone.body.conv1.weight"]
+    assert conv.shape[1] == 4
+    torch.testing.assert_close(conv[:, :3], resnet["conv1.weight"], atol=1e-9, rtol=0)
+    torch.testing.assert_close(conv[:, 3], resnet["conv1.weight"].mean(dim=1), atol=1e-9,
+                               rtol=0)
+    torch.testing.assert_close(trained["backbone.body.layer4.1.conv2.weight"],
+                               resnet["layer4.1.conv2.weight"], atol=1e-9, rtol=0)
+    # a ResNet's file whose tensors fit none of the backbone's: refused by name
+    other = str(tmp_path / "resnet50.pt")
+    torch.save({"conv1.weight": torch.zeros(64, 3, 3, 3), "fc.weight": torch.zeros(10, 2048)},
+               other)
+    r = subprocess.run([perception_data.cli, "vision", "train", "maskrcnn", "--data",
+                        perception_data.det, "--out", str(tmp_path / "other"), "--backbone",
+                        "resnet18", "--channels", "32", "--rois", "16", "--size", "32",
+                        "--epochs", "1", "--no-eval", "--init", other],
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode == 2 and "resnet50.pt': none of its" in r.stderr, r.stderr
 
 
 def test_resized_pictures_give_masks_at_the_pictures_size(perception_data):

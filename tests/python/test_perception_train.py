@@ -109,6 +109,65 @@ def test_sharded_prediction_equals_one_pass(perception_data, straight, tmp_path)
         np.testing.assert_allclose(a["m"], b["m"], rtol=1e-5, atol=1e-6)
 
 
+def test_shards_written_to_files_merge_to_one_pass(perception_data, straight, tmp_path):
+    """--shard i/N --results FILE (a Ray unit's way) writes nothing into the run; --merge
+    scores the files as one pass would."""
+    cli, folder = perception_data.cli, os.path.join(straight, "eval-test")
+    with open(os.path.join(folder, "predictions.json")) as f:
+        whole = json.load(f)
+    with open(os.path.join(folder, "metrics.json")) as f:
+        whole_metrics = json.load(f)
+    before = sorted(os.listdir(folder))
+    files = [str(tmp_path / f"shard{i}.json") for i in range(3)]
+    for i, path in enumerate(files):
+        r = vision(cli, "predict", straight, "--shard", f"{i}/3", "--results", path)
+        assert f"shard {i}/3 written to {path}" in r.stdout
+    assert sorted(os.listdir(folder)) == before
+    # bad merges: named, exit 2, the run's evaluation left as it was
+    other = str(tmp_path / "other.json")
+    with open(other, "w") as f:
+        json.dump({"episodes": []}, f)
+    for args, message in (
+            (files[:2], "shards 2/3 are missing"),
+            (files + [files[1]], "shard 1/3 is also in"),
+            (files[:2] + [other], "not a file of 'partsim vision predict"),
+            ([str(tmp_path / "none.json")], "none.json' cannot be read")):
+        r = vision(cli, "predict", straight, "--merge", *args, ok=False)
+        assert r.returncode == 2 and message in r.stderr, (args, r.stderr)
+    r = vision(cli, "predict", straight, "--results", files[0], ok=False)
+    assert r.returncode == 2 and "give --shard i/N with it" in r.stderr
+    os.remove(os.path.join(folder, "predictions.json"))
+    os.remove(os.path.join(folder, "metrics.json"))
+    r = vision(cli, "predict", straight, "--merge", files[2], files[0], files[1])
+    assert "hinge_accuracy" in r.stdout
+    with open(os.path.join(folder, "predictions.json")) as f:
+        merged = json.load(f)
+    with open(os.path.join(folder, "metrics.json")) as f:
+        assert json.load(f) == whole_metrics
+    assert [a["sample_id"] for a in merged["samples"]] == \
+        [b["sample_id"] for b in whole["samples"]]
+    for a, b in zip(merged["samples"], whole["samples"]):
+        np.testing.assert_allclose(a["m"], b["m"], rtol=1e-5, atol=1e-6)
+
+
+def test_network_options_from_the_command_line(perception_data, tmp_path):
+    """--width of the PointNet++ baselines reaches the network and run.json; a run continued
+    with another width is refused."""
+    run = str(tmp_path / "narrow")
+    args = ["train", "motion-pointnet", "--data", perception_data.mot, "--out", run,
+            "--backbone", "small", "--points", "256", "--epochs", "1", "--no-eval", "--quiet"]
+    vision(perception_data.cli, *args, "--width", "0.5")
+    with open(os.path.join(run, "run.json")) as f:
+        doc = json.load(f)
+    assert doc["model"]["width"] == 0.5 and doc["options"]["width"] == 0.5
+    narrow = sum(v.numel() for v in weights(run).values())
+    wide = str(tmp_path / "wide")
+    vision(perception_data.cli, *[wide if a == run else a for a in args], "--width", "1")
+    assert sum(v.numel() for v in weights(wide).values()) > 2 * narrow
+    r = vision(perception_data.cli, *args, "--width", "2", ok=False)
+    assert r.returncode == 2 and "was started with width=0.5" in r.stderr
+
+
 def test_the_table_puts_the_run_beside_the_paper(perception_data, straight, tmp_path):
     out = str(tmp_path / "table.md")
     r = vision(perception_data.cli, "table", straight, "--out", out)
@@ -173,6 +232,10 @@ def test_bad_command_lines_and_run_folders(perception_data, straight, tmp_path):
           "vgg"], "vgg"),
         (["predict", str(tmp_path / "nothing")], "holds no run"),
         (["predict", straight, "--shard", "2/2"], "i must be in [0, N)"),
+        (["predict", straight, "--merge", "a.json", "--shard", "0/2"],
+         "--merge takes the run and the shards' files only"),
+        (["train", "insseg", "--data", mot, "--out", str(tmp_path / "a"), "--width", "0"],
+         "positive number"),
     ]
     if not torch.cuda.is_available():
         cases.append((["train", "motion-resnet", "--data", mot, "--out", str(tmp_path / "a"),

@@ -28,7 +28,8 @@ partsim COMMAND ... --ray auto|ADDRESS [--units N] [--shared] [--retries R] [--s
 runs a list-shaped command's parts (--shard i/N, i = 0..N-1) as tasks on a Ray cluster and
 makes their outputs one run's, byte for byte: COMMAND is one of
   assets generate, assets check, vision detection-dataset, vision motion-dataset,
-  tasks evaluate, learn evaluate (and learn sweep, whose units are training runs).
+  tasks evaluate, learn evaluate, vision predict (and learn sweep, whose units are
+  training runs).
 
   --ray auto|ADDRESS  auto: the cluster this machine is in (RAY_ADDRESS, or the one `ray
                       start` started here), else a local cluster started for the run;
@@ -45,8 +46,9 @@ makes their outputs one run's, byte for byte: COMMAND is one of
                       <hash of the command>), removed when the run completes: the same
                       command started again after a crash skips them
 Units run in this program's working folder, so relative paths work as they do here: inputs
-(--dataset ROOT, assets check's DIR, learn evaluate's RUN) and that folder must be at the same
-path on every node (a shared file system), or give absolute paths. docs/distributed.md has the
+(--dataset ROOT, assets check's DIR, learn evaluate's and vision predict's RUN, --data) and
+that folder must be at the same path on every node (a shared file system), or give absolute
+paths. docs/distributed.md has the
 local, Ray-cluster and Slurm recipes.
 """
 
@@ -89,6 +91,11 @@ def _learn_merge(cmd, args, files, cli):
             "--merge"] + files
 
 
+def _predict_merge(cmd, args, files, cli):
+    return [cli, "vision", "predict", _positional(args, COMMANDS[("vision", "predict")]),
+            "--merge"] + files
+
+
 COMMANDS = {
     ("assets", "generate"): Spec(switches={"--by-category", "--overwrite"}, out="--out"),
     ("assets", "check"): Spec(switches={"--no-visibility"}, positional_path=True,
@@ -102,6 +109,8 @@ COMMANDS = {
                                 merge=_tasks_merge),
     ("learn", "evaluate"): Spec(switches={"--random"}, positional_path=True,
                                 result="--results", merge=_learn_merge, quiet=True),
+    ("vision", "predict"): Spec(positional_path=True, result="--results",
+                                merge=_predict_merge, quiet=True),
 }
 
 

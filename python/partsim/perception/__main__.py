@@ -3,10 +3,13 @@
 
     partsim vision train maskrcnn|insseg|motion-resnet|motion-pointnet --data DIR --out RUN
         [--input I] [--epochs N] [--size S] [--batch-size B] [--lr LR] [--seed S]
-        [--backbone NAME] [--points N] [--instances K] [--init WEIGHTS] [--device auto|cpu|cuda]
-        [--log-every N] [--checkpoint-minutes M] [--no-eval] [--quiet]
-    partsim vision predict RUN [--split test|train] [--data DIR] [--shard i/N] [--batch-size B]
-        [--device auto|cpu|cuda] [--quiet]
+        [--backbone NAME] [--points N] [--instances K] [--channels C] [--rois R] [--width W]
+        [--init WEIGHTS] [--device auto|cpu|cuda] [--log-every N] [--checkpoint-minutes M]
+        [--no-eval] [--quiet]
+    partsim vision predict RUN [--split test|train] [--data DIR] [--shard i/N [--results FILE]]
+        [--batch-size B] [--device auto|cpu|cuda] [--quiet]
+    partsim vision predict RUN --merge FILE...
+    partsim vision predict RUN ... --ray auto|ADDRESS [--units N]   (shards as Ray tasks)
     partsim vision table RUN... [--split test|train] [--out FILE]
 
 Exit codes: 0 done, 1 a failure while running (a file that cannot be read, PyTorch missing),
@@ -78,7 +81,15 @@ def parser():
     t.add_argument("--points", type=_positive_int, help="points per view (insseg, "
                    "motion-pointnet)")
     t.add_argument("--instances", type=_positive_int, help="instance masks per view (insseg)")
-    t.add_argument("--init", help="weights to start from (a state dict: another run's model.pt)")
+    t.add_argument("--channels", type=_positive_int,
+                   help="width of the FPN and the mask head (maskrcnn; 256)")
+    t.add_argument("--rois", type=_positive_int,
+                   help="regions sampled per picture for the box and mask heads (maskrcnn; 512)")
+    t.add_argument("--width", type=_positive_float,
+                   help="channel multiplier of the PointNet++ (insseg, motion-pointnet; 1)")
+    t.add_argument("--init", help="weights to start from: a state dict (another run's "
+                   "model.pt or checkpoint.pt; for maskrcnn also a torchvision ResNet's, "
+                   "loaded into the backbone)")
     t.add_argument("--device", default="auto")
     t.add_argument("--log-every", type=_positive_int, help="batches per progress row (10)")
     t.add_argument("--checkpoint-minutes", type=_positive_float,
@@ -91,6 +102,10 @@ def parser():
     r.add_argument("--split", default="test", choices=["test", "train"])
     r.add_argument("--data", help="another dataset folder (default: the run's)")
     r.add_argument("--shard", type=_shard, help="predict items i, i+N, ... (then merge)")
+    r.add_argument("--results", help="with --shard: write the shard's predictions to this file "
+                   "instead of the run (then --merge)")
+    r.add_argument("--merge", nargs="+", metavar="FILE",
+                   help="score the shards' --results files as one prediction of the split")
     r.add_argument("--batch-size", type=_positive_int)
     r.add_argument("--device", default="auto")
     r.add_argument("--quiet", action="store_true")
@@ -129,7 +144,7 @@ def main(argv=None):
         if args.command == "train":
             options = {k: getattr(args, k) for k in (
                 "input", "epochs", "size", "batch_size", "lr", "seed", "backbone", "points",
-                "instances", "log_every", "checkpoint_minutes")}
+                "instances", "channels", "rois", "width", "log_every", "checkpoint_minutes")}
             run = Run(args.out, baseline=args.baseline, data=args.data, device=args.device,
                       quiet=args.quiet, **options)
             run.train(init=args.init)
@@ -137,8 +152,19 @@ def main(argv=None):
                 _print_scores(run.predict("test"))
         elif args.command == "predict":
             run = Run(args.run, device=args.device, quiet=args.quiet)
-            _print_scores(run.predict(args.split, data=args.data, shard=args.shard,
-                                      batch_size=args.batch_size))
+            if args.merge:
+                if args.shard or args.results or args.data:
+                    raise RunError("--merge takes the run and the shards' files only (their "
+                                   "split and data are in the files)")
+                _print_scores(run.merge(args.merge))
+            elif args.results:
+                run.predict(args.split, data=args.data, shard=args.shard,
+                            batch_size=args.batch_size, results=args.results)
+                if not args.quiet:
+                    print(f"shard {args.shard[0]}/{args.shard[1]} written to {args.results}")
+            else:
+                _print_scores(run.predict(args.split, data=args.data, shard=args.shard,
+                                          batch_size=args.batch_size))
         else:
             text = table_module.render(args.runs, args.split)
             print(text)

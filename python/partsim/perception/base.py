@@ -49,6 +49,13 @@ class Baseline:
         """A new torch.nn.Module, on the CPU, initialised from the seed torch was given."""
         raise NotImplementedError
 
+    def load_weights(self, model, path):
+        """Loads the weights file ``path`` (``--init``) into a new ``model``: by default the
+        tensors of its state dict whose names and shapes match (another run's ``model.pt`` or
+        checkpoint). Returns ``(loaded, skipped)``, lists of the file's keys."""
+        from .train import load_matching
+        return load_matching(model, path)
+
     def make_optimizer(self, model, lr):
         """The optimiser over ``model``'s parameters (Adam unless the baseline says otherwise)."""
         import torch

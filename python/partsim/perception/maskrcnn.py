@@ -88,6 +88,27 @@ class MaskRCNN(Baseline):
         return {"input": self.input, "backbone": self.backbone, "channels": self.channels,
                 "rois": self.rois, "size": self.size, "categories": list(self.categories)}
 
+    def load_weights(self, model, path):
+        """``--init``: a Mask R-CNN's state dict (another run's) loads tensor by tensor as for
+        every baseline; a bare ResNet's (keys ``conv1.weight``, ``layer1...``, as torchvision's
+        classification networks save them: pretrained weights) loads into the backbone by
+        :func:`load_backbone_weights`."""
+        import torch
+        from .train import RunError, load_matching
+
+        try:
+            saved = torch.load(path, map_location="cpu")
+        except Exception as e:  # torch raises many kinds for a bad file
+            raise RunError(f"weights '{path}' cannot be read: {type(e).__name__}: {e}") from None
+        if isinstance(saved, dict) and "conv1.weight" in saved and not any(
+                str(k).startswith("backbone.") for k in saved):
+            loaded, skipped = load_backbone_weights(model, path)
+            if not loaded:
+                raise RunError(f"weights '{path}': none of its {len(saved)} tensors fits "
+                               f"the {self.backbone} backbone")
+            return loaded, skipped
+        return load_matching(model, path)
+
     def build_model(self):
         import torch
         import torchvision

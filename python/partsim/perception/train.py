@@ -44,6 +44,8 @@ RUN_FILE = "run.json"
 CHECKPOINT = "checkpoint.pt"
 MODEL = "model.pt"
 PROGRESS = "progress.csv"
+# the "format" of a shard's results file (predict --shard i/N --results FILE)
+SHARD_FORMAT = "partsim-vision-predict-shard-1"
 FIXED_COLUMNS = ("epoch", "batch", "items", "loss")
 TIMING_COLUMNS = ("items_per_s", "wall_s")
 
@@ -228,7 +230,7 @@ class Run:
             torch.set_rng_state(state["torch_rng"])
             self._log(f"continuing from epoch {epoch + 1}, batch {batch} ({checkpoint})")
         elif init is not None:
-            loaded, skipped = load_matching(model, init)
+            loaded, skipped = self.baseline.load_weights(model, init)
             self._log(f"initialised {len(loaded)} tensors from '{init}' ({len(skipped)} skipped)")
         self._save_run_file()
         self._truncate_progress(rows)
@@ -351,18 +353,21 @@ class Run:
         model.load_state_dict(state)
         return model.to(self.device).eval()
 
-    def predict(self, split="test", data=None, shard=None, batch_size=None):
+    def predict(self, split="test", data=None, shard=None, batch_size=None, results=None):
         """Predicts split ``split`` of ``data`` (default: the run's dataset) and scores it.
-        ``shard`` (i, n) predicts only the items whose index modulo n is i and writes
-        ``eval-<split>/results.shard-i-of-n.json``; once every shard's file is there, any call
-        (or ``shard=None``) merges them. Returns the evaluation's metrics dict (None for a shard
-        whose siblings are not all done)."""
+        ``shard`` (i, n) predicts only the items whose index modulo n is i. With ``results``
+        (a file name) the shard's predictions go to that file and nothing is written into the
+        run (a Ray unit's way: :meth:`merge` scores the files); without it they go to
+        ``eval-<split>/results.shard-i-of-n.json``, and once every shard's file is there, any
+        call (or ``shard=None``) merges them. Returns the evaluation's metrics dict (None for a
+        shard whose siblings are not all done, or one written to ``results``)."""
         import torch
 
+        if results is not None and shard is None:
+            raise RunError("--results is a shard's file: give --shard i/N with it")
         data = os.path.abspath(data or self.data)
         dataset = open_split(self.kind, data, split)
         folder = self.path(f"eval-{split}")
-        os.makedirs(folder, exist_ok=True)
         stem = "results" if self.kind == "detection" else "predictions"
         indices = list(range(len(dataset)))
         n_shards = 1
@@ -379,6 +384,12 @@ class Run:
                 rng = np.random.default_rng([int(self.options["seed"]), 1 << 31, chunk[0]])
                 entries.extend(self.baseline.predict(model, dataset, chunk, self.device, rng))
         self._log(f"predicted {len(indices)} items of {split} in {time.monotonic() - t0:.1f} s")
+        if results is not None:
+            _write_json(results, {"format": SHARD_FORMAT, "baseline": self.name, "data": data,
+                                  "split": split, "shard": [shard[0], n_shards],
+                                  "entries": entries})
+            return None
+        os.makedirs(folder, exist_ok=True)
         if shard is not None:
             part = os.path.join(folder, f"{stem}.shard-{shard[0]}-of-{n_shards}.json")
             _write_json_list(part, entries)
@@ -390,6 +401,49 @@ class Run:
             for p in parts:
                 with open(p, encoding="utf-8") as f:
                     entries.extend(json.load(f))
+        return self._score(dataset, folder, stem, entries)
+
+    def merge(self, files):
+        """Scores the shards' files written by ``predict(shard=(i, n), results=FILE)``, one
+        file per shard 0..n-1 of one split and dataset, as one unsharded ``predict`` of that
+        split would (the same ``eval-<split>/`` files). Returns the metrics dict."""
+        if not files:
+            raise RunError("--merge needs the shards' results files")
+        seen, entries, first = {}, [], None
+        for path in files:
+            doc = _read_json(path, "shard results")
+            shard = doc.get("shard")
+            if (doc.get("format") != SHARD_FORMAT or not isinstance(doc.get("entries"), list)
+                    or not (isinstance(shard, list) and len(shard) == 2
+                            and all(isinstance(x, int) and not isinstance(x, bool)
+                                    for x in shard) and 0 <= shard[0] < shard[1])):
+                raise RunError(f"shard results '{path}': not a file of 'partsim vision predict "
+                               "--shard i/N --results FILE'")
+            key = (doc.get("baseline"), doc.get("data"), doc.get("split"), shard[1])
+            if doc.get("baseline") != self.name:
+                raise RunError(f"shard results '{path}': predicted by {doc.get('baseline')}, "
+                               f"this run trains {self.name}")
+            if first is None:
+                first = (path, key)
+            elif key != first[1]:
+                raise RunError(f"shard results '{path}': its data, split or shard count "
+                               f"{key[1:]} differ from '{first[0]}' {first[1][1:]}")
+            if shard[0] in seen:
+                raise RunError(f"shard results '{path}': shard {shard[0]}/{shard[1]} is also "
+                               f"in '{seen[shard[0]]}'")
+            seen[shard[0]] = path
+            entries.extend(doc["entries"])
+        _, data, split, n = first[1]
+        missing = sorted(set(range(n)) - set(seen))
+        if missing:
+            raise RunError(f"--merge: shards {', '.join(f'{k}/{n}' for k in missing)} are "
+                           "missing")
+        if split not in ("test", "train") or not isinstance(data, str):
+            raise RunError(f"shard results '{first[0]}': bad 'split' or 'data'")
+        dataset = open_split(self.kind, data, split)
+        folder = self.path(f"eval-{split}")
+        os.makedirs(folder, exist_ok=True)
+        stem = "results" if self.kind == "detection" else "predictions"
         return self._score(dataset, folder, stem, entries)
 
     def _score(self, dataset, folder, stem, entries):
