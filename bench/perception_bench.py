@@ -16,7 +16,7 @@ Usage:
   PARTSIM_PYTHON_DIR=build/python .venv/bin/python bench/perception_bench.py \\
       --detection DET --motion MOT [--baselines maskrcnn,insseg,motion-resnet,motion-pointnet]
       [--size 256] [--batch-size 4] [--batches 5] [--repeats 3] [--device auto]
-      [--backbone resnet50] [--points 10000] [--out FILE.md]
+      [--backbone resnet50] [--point-backbone ssg] [--points 10000] [--out FILE.md]
 
 DET and MOT are folders of `partsim vision detection-dataset` / `motion-dataset`.
 """
@@ -101,7 +101,9 @@ def main():
     p.add_argument("--batches", type=int, default=5)
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--device", default="auto")
-    p.add_argument("--backbone", default="resnet50")
+    p.add_argument("--backbone", default="resnet50", help="of maskrcnn and motion-resnet")
+    p.add_argument("--point-backbone", default="ssg",
+                   help="the PointNet++ preset of insseg and motion-pointnet (ssg or small)")
     p.add_argument("--points", type=int, default=10000)
     p.add_argument("--out")
     a = p.parse_args()
@@ -121,8 +123,9 @@ def main():
             print(f"skipping {name}: no --{cls.kind} dataset", file=sys.stderr)
             continue
         for inp in cls.inputs:
-            options = {"input": inp, "size": a.size, "seed": 0, "backbone": a.backbone,
-                       "points": a.points}
+            point_net = name in ("insseg", "motion-pointnet")
+            options = {"input": inp, "size": a.size, "seed": 0, "points": a.points,
+                       "backbone": a.point_backbone if point_net else a.backbone}
             kind, rates, params = measure(name, data, options, a.batch_size, a.batches,
                                           a.repeats, device)
             points = (f"{rates['train'] * a.points:,.0f}"

@@ -12,6 +12,11 @@ curves), ``partsim vision predict RUN`` writes and scores its predictions, ``par
 table RUN...`` prints the paper's tables beside the runs' (docs/vision.md). In Python:
 :func:`baseline_class` and :mod:`partsim.perception.train`. Needs PyTorch (and torchvision
 for ``maskrcnn`` and ``motion-resnet``).
+
+The networks, their batches and losses need only PyTorch and NumPy: partsim's compiled module
+(``partsim.vision``) is imported where the datasets are opened and predictions encoded and
+scored, so a machine with another Python (a GPU node) can run them on dataset items packed
+elsewhere (bench/perception_gpu_check.py).
 """
 
 import importlib

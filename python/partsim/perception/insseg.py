@@ -42,7 +42,6 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-from .. import vision
 from .base import Baseline
 from .pointnet2 import SEGMENTER_PRESETS, PointNet2Segmenter
 
@@ -305,6 +304,8 @@ class InsSeg(Baseline):
     def predict(self, model, dataset, indices, device, rng):
         """COCO results for views ``indices``: one per predicted mask whose most probable class
         is a part and that covers at least one pixel (see the module's docstring)."""
+        from .. import vision  # the compiled module: imported when used
+
         results = []
         with torch.no_grad():
             for index in indices:

@@ -10,7 +10,6 @@ the picture's size) for ``partsim vision evaluate-detection``.
 
 import numpy as np
 
-from .. import vision
 from .base import Baseline
 
 # The normalisation of the model's transform, per input channel: ImageNet's RGB statistics
@@ -217,6 +216,8 @@ class MaskRCNN(Baseline):
 
     def predict(self, model, dataset, indices, device, rng):
         import torch
+
+        from .. import vision  # the compiled module: imported when used (see __init__)
         indices = list(indices)
         results = []
         # a few pictures at a time, so that a whole test split never sits in memory
