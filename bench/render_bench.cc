@@ -20,8 +20,16 @@
 // counts the cost of its shading model. Runs interleave within each repetition; the summary
 // gives medians over repetitions.
 //
-// Usage: partsim_render_bench [--reps N] [--seconds S] [--shadows] [--cpu-time]
+// Usage: partsim_render_bench [--reps N] [--seconds S] [--shadows] [--cpu-time] [--shadow-modes]
 // (--cpu-time: frames per second of process CPU time, all of llvmpipe's threads together)
+//
+// --shadow-modes: instead, partsim alone (c+d, the forward path) under the shadowing sun, against
+// the same scene without shadows, with the maps
+//   redrawn      drawn for every picture (RasterOptions::reuse_shadow_maps = false), 2048 texels
+//   kept         kept while nothing they hold moves (the default), 2048 texels
+//   kept, auto   kept, sized from the picture (shadow_map_size = 0: 512 at 128², 1024 at 512²)
+//   moving       a gripper-sized box moving every picture (the maps drawn again), auto size
+// each as fps and as a ratio to shadows off; the same rotation and medians as above.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
@@ -30,6 +38,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <vector>
@@ -218,12 +227,89 @@ double Fps(F&& render, double seconds) {
   return frames / elapsed;
 }
 
+// --shadow-modes (see the file's comment)
+int ShadowModes(int reps, double seconds) {
+  struct Mode {
+    const char* name;
+    bool shadows, reuse, moving;
+    int map_size;
+  };
+  const Mode modes[] = {{"off", false, true, false, 2048},
+                        {"redrawn", true, false, false, 2048},
+                        {"kept", true, true, false, 2048},
+                        {"kept, auto", true, true, false, 0},
+                        {"moving", true, true, true, 0}};
+  const int n = static_cast<int>(std::size(modes));
+  std::vector<std::unique_ptr<partsim::RenderBackend>> backends;
+  for (const Mode& m : modes) {
+    partsim::RasterOptions options;
+    options.shadow_map_size = m.map_size;
+    options.reuse_shadow_maps = m.reuse;
+    backends.push_back(partsim::MakeRasterBackend(options));
+  }
+  std::printf("device: %s; shadow maps, partsim c+d; %d repetitions of >= %.2f s (%s) per run\n",
+              backends[0]->Device().c_str(), reps, seconds,
+              g_cpu_time ? "process CPU time" : "wall clock");
+  std::printf("%-16s %5s |", "scene", "size");
+  for (const Mode& m : modes) std::printf(" %11s", m.name);
+  std::printf(" | ratios to off\n");
+  const unsigned kColorDepth = partsim::kColor | partsim::kPosition;
+  for (int scene = 0; scene < 2; ++scene) {
+    RenderWorld plain = scene == 0 ? CabinetScene(false) : SpheresScene(false);
+    RenderWorld shadowed = scene == 0 ? CabinetScene(true) : SpheresScene(true);
+    RenderWorld moving = shadowed;
+    moving.instances.push_back(
+        Instance(Box({0.05f, 0.05f, 0.05f}), {0.6, 0, 0.4}, {0.9f, 0.9f, 0.9f, 1}, 99, 99));
+    Eigen::Vector3d eye =
+        scene == 0 ? Eigen::Vector3d(1.8, 0.9, 1.2) : Eigen::Vector3d(1.6, 0, 1.3);
+    Eigen::Vector3d target = scene == 0 ? Eigen::Vector3d(0.2, 0, 0.25) : Eigen::Vector3d::Zero();
+    for (int size : {128, 512}) {
+      CameraParams cam = CameraFor(size, eye, target);
+      partsim::Picture pic;
+      int step = 0;
+      std::vector<std::vector<double>> fps(n), ratio(n);
+      for (int r = 0; r < reps; ++r) {
+        std::vector<double> f(n);
+        for (int k = 0; k < n; ++k) {
+          const int i = (r + k) % n;
+          const Mode& m = modes[i];
+          RenderWorld& world = m.moving ? moving : m.shadows ? shadowed : plain;
+          f[i] = Fps(
+              [&] {
+                if (m.moving) world.instances.back().X_WV(1, 3) = 0.002 * (++step % 100);
+                backends[i]->Render(world, cam, &pic, kColorDepth);
+              },
+              seconds);
+        }
+        for (int i = 0; i < n; ++i) {
+          fps[i].push_back(f[i]);
+          ratio[i].push_back(f[i] / f[0]);
+        }
+      }
+      std::printf("%-16s %5d |", scene == 0 ? "cabinet+gripper" : "50 spheres", size);
+      for (int i = 0; i < n; ++i) std::printf(" %11.1f", Median(fps[i]));
+      std::printf(" |");
+      for (int i = 1; i < n; ++i) std::printf(" %6.3f", Median(ratio[i]));
+      std::printf("\n");
+      std::fflush(stdout);
+    }
+  }
+  for (int i = 1; i < n; ++i) {
+    partsim::RenderCounters c = backends[i]->Counters();
+    std::printf("%s: %llu pictures, %llu shadow maps drawn, %llu kept\n", modes[i].name,
+                static_cast<unsigned long long>(c.pictures),
+                static_cast<unsigned long long>(c.shadow_layers_drawn),
+                static_cast<unsigned long long>(c.shadow_layers_reused));
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int reps = 7;
   double seconds = 0.5;
-  bool shadows = false;
+  bool shadows = false, shadow_modes = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) {
       reps = std::atoi(argv[++i]);
@@ -233,12 +319,17 @@ int main(int argc, char** argv) {
       shadows = true;
     } else if (!std::strcmp(argv[i], "--cpu-time")) {
       g_cpu_time = true;
+    } else if (!std::strcmp(argv[i], "--shadow-modes")) {
+      shadow_modes = true;
     } else {
-      std::fprintf(stderr, "usage: %s [--reps N] [--seconds S] [--shadows] [--cpu-time]\n",
+      std::fprintf(stderr,
+                   "usage: %s [--reps N] [--seconds S] [--shadows] [--cpu-time] "
+                   "[--shadow-modes]\n",
                    argv[0]);
       return 2;
     }
   }
+  if (shadow_modes) return ShadowModes(reps, seconds);
 
   struct Case {
     const char* name;

@@ -54,6 +54,7 @@ void RenderBackend::Render(const RenderWorld& world, const CameraParams& camera,
   // the picture holds nothing until DoRender has filled it
   out->outputs = 0;
   DoRender(world, camera, out, outputs);
+  ++pictures_;
   // outputs not asked for are dropped whatever the backend filled
   internal::KeepOutputs(outputs, out);
 }

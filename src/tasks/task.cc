@@ -475,7 +475,7 @@ TaskImpl::TaskImpl(const TaskOptions& o) : options(o) {
   if (o.cameras || video) {
     if (video && o.render_backend == "rasterizer") {
       // the video's shadows: a 1024 map covers a cabinet's shadow sharply enough at 640 x 480,
-      // at less than half the cost of the default 2048 on a CPU rasterizer
+      // at less than half the cost of the 2048 the automatic size gives it on a CPU rasterizer
       RasterOptions ro;
       ro.shadow_map_size = 1024;
       SetRenderBackend(*scene, MakeRasterBackend(ro));

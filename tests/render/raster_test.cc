@@ -18,6 +18,7 @@
 #include "partsim/render/backend.h"
 #include "partsim/render/camera_math.h"
 #include "render/jpeg_test_util.h"
+#include "render/raster/shadows.h"
 
 namespace partsim {
 namespace {
@@ -386,6 +387,103 @@ TEST(RasterTest, ShadowMapsAreMadeAtTheFirstShadowedPicture) {
   EXPECT_EQ(before.color, after.color);
   const size_t behind = Pixel(before, Project(cam, {1.7, 0, 0}));
   EXPECT_LT(shadowed.color[4 * behind], 0.3f * before.color[4 * behind]);
+}
+
+// a spot light above ShadowWorld's box, with a shadow
+LightDesc SpotAbove() {
+  LightDesc spot;
+  spot.type = LightType::kSpot;
+  spot.position = {1.5, 0.3, 1.5};
+  spot.direction = Eigen::Vector3d(0, -0.2, -1).normalized();
+  spot.inner_angle = 0.5;
+  spot.outer_angle = 0.6;
+  spot.color = Eigen::Vector3f::Constant(2.0f);
+  spot.shadow = true;
+  return spot;
+}
+
+// the picture a backend that never drew anything else draws
+Picture FreshPicture(const RenderWorld& world, const CameraParams& cam, unsigned outputs,
+                     const RasterOptions& options = RasterOptions()) {
+  Picture pic;
+  MakeRasterBackend(options)->Render(world, cam, &pic, outputs);
+  return pic;
+}
+
+// Shadow maps are drawn again only when what they hold would change: a still scene reuses them,
+// a moved caster or light or (for the sun) a moved camera draws them again, and every picture is
+// the one a fresh backend draws, to the bit, on the deferred and the forward path.
+TEST(RasterTest, ShadowMapsAreKeptWhileNothingTheyHoldMoves) {
+  for (unsigned outputs : {unsigned{kAllOutputs}, unsigned{kColor | kPosition}}) {
+    SCOPED_TRACE(outputs);
+    std::unique_ptr<RenderBackend> backend = MakeRasterBackend();
+    RenderWorld world = ShadowWorld(true);
+    world.lights.push_back(SpotAbove());
+    CameraParams cam = CameraAbove(64, 64, {1.5, 0, 2});
+    auto render = [&](const CameraParams& c) {
+      Picture pic;
+      backend->Render(world, c, &pic, outputs);
+      EXPECT_EQ(pic.color, FreshPicture(world, c, outputs).color);
+      return pic;
+    };
+    auto counters = [&] {
+      RenderCounters n = backend->Counters();
+      return std::make_pair(n.shadow_layers_drawn, n.shadow_layers_reused);
+    };
+    Picture first = render(cam);
+    EXPECT_EQ(counters(), std::make_pair(uint64_t{2}, uint64_t{0}));
+    render(cam);  // nothing moved: both maps kept
+    EXPECT_EQ(counters(), std::make_pair(uint64_t{2}, uint64_t{2}));
+    // the box moves: both maps again, and the shadow with it
+    world.instances[1].X_WV(1, 3) = 0.3;
+    Picture moved = render(cam);
+    EXPECT_NE(moved.color, first.color);
+    EXPECT_EQ(counters(), std::make_pair(uint64_t{4}, uint64_t{2}));
+    world.instances[1].X_WV(1, 3) = 0.0;
+    EXPECT_EQ(render(cam).color, first.color);
+    EXPECT_EQ(counters(), std::make_pair(uint64_t{6}, uint64_t{2}));
+    // the camera moves and still sees the whole scene: the sun's map covers the scene's box
+    // cut by the view's, the same box, and the spot light's does not depend on the view
+    render(CameraAbove(64, 64, {1.6, 0.1, 2.2}));
+    EXPECT_EQ(counters(), std::make_pair(uint64_t{6}, uint64_t{4}));
+    // the spot light turns: its map alone
+    world.lights[1].direction = Eigen::Vector3d(0.2, -0.2, -1).normalized();
+    render(cam);
+    EXPECT_EQ(counters(), std::make_pair(uint64_t{7}, uint64_t{5}));
+    // a camera that sees part of the scene: the sun's map fits that part, the spot's is kept
+    CameraParams close = CameraAbove(64, 64, {1.5, 0, 0.6});
+    close = MakeCameraParams(64, 64, close.K, close.near, 1.0, close.X_WC);
+    render(close);
+    EXPECT_EQ(counters(), std::make_pair(uint64_t{8}, uint64_t{6}));
+    // a picture without colour draws no map and keeps them
+    Picture depth_only;
+    backend->Render(world, cam, &depth_only, kPosition);
+    EXPECT_EQ(counters(), std::make_pair(uint64_t{8}, uint64_t{6}));
+    EXPECT_EQ(backend->Counters().pictures, 8u);
+  }
+}
+
+// shadow_map_size = 0 sizes the maps from the picture: the same shadow, drawn with maps of
+// 512 texels for a 64 x 64 picture; 2048 for 1024 x 1024 and larger
+TEST(RasterTest, AutomaticShadowMapSizeFollowsThePicture) {
+  RasterOptions automatic;
+  automatic.shadow_map_size = 0;
+  RasterOptions fixed;
+  fixed.shadow_map_size = 512;
+  CameraParams cam = CameraAbove(64, 64, {1.5, 0, 2});
+  EXPECT_EQ(FreshPicture(ShadowWorld(true), cam, kColor, automatic).color,
+            FreshPicture(ShadowWorld(true), cam, kColor, fixed).color);
+  Picture lit = FreshPicture(ShadowWorld(false), cam, kColor, automatic);
+  Picture shadowed = FreshPicture(ShadowWorld(true), cam, kColor, automatic);
+  const size_t behind = Pixel(lit, Project(cam, {1.7, 0, 0}));
+  EXPECT_LT(shadowed.color[4 * behind], 0.3f * lit.color[4 * behind]);
+  for (int side : {1, 64, 256}) EXPECT_EQ(internal::raster::ShadowMaps::AutoSize(side, 1), 512);
+  EXPECT_EQ(internal::raster::ShadowMaps::AutoSize(300, 400), 1024);
+  EXPECT_EQ(internal::raster::ShadowMaps::AutoSize(640, 480), 2048);
+  EXPECT_EQ(internal::raster::ShadowMaps::AutoSize(4096, 4096), 2048);
+  RasterOptions bad;
+  bad.shadow_map_size = -1;
+  EXPECT_THROW(MakeRasterBackend(bad), Error);
 }
 
 TEST(RasterTest, SpotLightLightsInsideItsConeOnly) {

@@ -91,6 +91,13 @@ struct Picture {
   std::vector<uint32_t> segmentation;  ///< h x w x 2: visual id, entity id; 0 = background
 };
 
+/// What a backend did since it was made (for benchmarks and tests: work it could skip).
+struct RenderCounters {
+  uint64_t pictures = 0;              ///< Render calls that drew a picture
+  uint64_t shadow_layers_drawn = 0;   ///< shadow maps drawn (one per shadowed light and picture)
+  uint64_t shadow_layers_reused = 0;  ///< shadow maps kept from an earlier picture, unchanged
+};
+
 /// A rendering backend. Render is not virtual: it checks its arguments once for every backend,
 /// then calls the backend's DoRender, which can rely on them.
 class RenderBackend {
@@ -98,6 +105,8 @@ class RenderBackend {
   virtual ~RenderBackend() = default;
   /// "rasterizer", "pathtracer" or "null".
   virtual std::string Name() const = 0;
+  /// The backend's counters (only `pictures` for backends without shadow maps).
+  virtual RenderCounters Counters() const { return {pictures_, 0, 0}; }
   /// A line for logs: which device renders (e.g. the GL_RENDERER string).
   virtual std::string Device() const = 0;
   /// Fills the outputs of `out` named by `outputs` (PictureOutput bits, sized width x height),
@@ -119,6 +128,11 @@ class RenderBackend {
   /// `outputs` (it may fill others too; Render empties them afterwards).
   virtual void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
                         unsigned outputs) = 0;
+  /// Pictures drawn so far (Render counts them).
+  uint64_t pictures_drawn() const { return pictures_; }
+
+ private:
+  uint64_t pictures_ = 0;
 };
 
 /// Fills nothing but the background (for tests that need no pixels).
@@ -131,7 +145,14 @@ struct RasterOptions {
   std::string gbuffer_vertex_shader;
   std::string gbuffer_fragment_shader;
   std::string lighting_fragment_shader;
-  int shadow_map_size = 2048;
+  /// Side of a light's shadow map (texels), in [16, 16384]; 0 (the default) sizes the maps from
+  /// each picture: the power of two at or above twice its larger side, in [512, 2048] (512 for
+  /// pictures up to 256 pixels a side, 1024 up to 512, 2048 above).
+  int shadow_map_size = 0;
+  /// Keep a shadow map from one picture to the next while what it holds (the casters' meshes
+  /// and poses seen from the light) is the same; false draws every map for every picture (the
+  /// pictures are the same either way).
+  bool reuse_shadow_maps = true;
 };
 
 /// OpenGL 4.5 core through headless EGL. Pictures that ask for no more than Color and Position

@@ -36,10 +36,11 @@ class RasterBackend final : public RenderBackend {
   explicit RasterBackend(const RasterOptions& options)
       : options_(options),
         programs_(options),
-        shadows_(options.shadow_map_size),
+        shadows_(options.shadow_map_size, options.reuse_shadow_maps),
         passes_(programs_, resources_, shadows_) {
-    if (options_.shadow_map_size < 16 || options_.shadow_map_size > 16384) {
-      throw Error("RasterOptions::shadow_map_size must be in [16, 16384], got " +
+    if (options_.shadow_map_size != 0 &&
+        (options_.shadow_map_size < 16 || options_.shadow_map_size > 16384)) {
+      throw Error("RasterOptions::shadow_map_size must be 0 (automatic) or in [16, 16384], got " +
                   std::to_string(options_.shadow_map_size));
     }
     context_ = std::make_unique<internal::EglContext>();
@@ -70,6 +71,9 @@ class RasterBackend final : public RenderBackend {
 
   std::string Name() const override { return "rasterizer"; }
   std::string Device() const override { return context_->Renderer(); }
+  RenderCounters Counters() const override {
+    return {pictures_drawn(), shadows_.layers_drawn(), shadows_.layers_reused()};
+  }
 
  protected:
   void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,

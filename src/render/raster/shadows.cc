@@ -70,19 +70,33 @@ GLuint MakeDepthArray(int size, int layers) {
 void ShadowMaps::Create() { glCreateFramebuffers(1, &fbo_); }
 
 void ShadowMaps::Delete() {
-  glDeleteTextures(1, &maps_);
+  for (auto& [side, set] : sets_) glDeleteTextures(1, &set.texture);
+  sets_.clear();
+  current_ = nullptr;
   glDeleteTextures(1, &stand_in_);
   glDeleteFramebuffers(1, &fbo_);
-  maps_ = stand_in_ = fbo_ = 0;
+  stand_in_ = fbo_ = 0;
 }
 
-GLuint ShadowMaps::Maps() {
-  if (maps_ == 0) maps_ = MakeDepthArray(size_, kMaxShadows);
-  return maps_;
+int ShadowMaps::AutoSize(int width, int height) {
+  int want = 2 * std::max(width, height), side = 512;
+  while (side < want && side < 2048) side *= 2;
+  return side;
+}
+
+ShadowMaps::MapSet& ShadowMaps::Maps(int side, uint64_t geometry_version) {
+  MapSet& set = sets_[side];
+  if (set.texture == 0) set.texture = MakeDepthArray(side, kMaxShadows);
+  // new meshes may sit where freed ones were (the same vertex array name): draw every layer again
+  if (set.geometry_version != geometry_version) {
+    set.valid.fill(false);
+    set.geometry_version = geometry_version;
+  }
+  return set;
 }
 
 GLuint ShadowMaps::Texture() {
-  if (maps_ != 0) return maps_;
+  if (current_ != nullptr) return current_->texture;
   if (stand_in_ == 0) stand_in_ = MakeDepthArray(1, 1);
   return stand_in_;
 }
@@ -93,6 +107,7 @@ int ShadowMaps::Render(const RenderWorld& world, const CameraParams& camera,
   int count = 0;
   layer_.assign(world.lights.size(), -1);
   if (scene_box.isEmpty()) return 0;
+  const int side = size_ > 0 ? size_ : AutoSize(camera.width, camera.height);
   Eigen::Matrix4d X_WG = camera.view.inverse();
 
   // receivers: the scene's box cut by the box of the view frustum
@@ -130,7 +145,7 @@ int ShadowMaps::Render(const RenderWorld& world, const CameraParams& camera,
       }
       double margin = 0.01 * (zmax - zmin) + 1e-3;
       proj = Ortho(-r, r, -r, r, -zmax - margin, -zmin + margin);
-      texel = Eigen::Vector2d(2 * r / size_, 0);
+      texel = Eigen::Vector2d(2 * r / side, 0);
     } else {
       view = LookAlong(light.position, dir);
       double dmax = 0;
@@ -142,30 +157,44 @@ int ShadowMaps::Render(const RenderWorld& world, const CameraParams& camera,
       double f = dmax * 1.01 + 1e-3;
       double n = std::max(f * 1e-4, 1e-3);
       proj = Perspective(fovy, n, f);
-      texel = Eigen::Vector2d(0, 2 * std::tan(fovy / 2) / size_);
+      texel = Eigen::Vector2d(0, 2 * std::tan(fovy / 2) / side);
     }
     Eigen::Matrix4d view_proj = proj * view;
-    glNamedFramebufferTextureLayer(fbo_, GL_DEPTH_ATTACHMENT, Maps(), 0, count);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    glViewport(0, 0, size_, size_);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);
-    glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(1.5f, 2.0f);
-    const float one = 1.0f;
-    glClearNamedFramebufferfv(fbo_, GL_DEPTH, 0, &one);
-    glUseProgram(program);
+    // what this layer would draw; when its last drawing was the same, the layer stays
+    draws_.clear();
     for (size_t i = 0; i < world.instances.size(); ++i) {
       const GpuMesh* mesh = resources.mesh(i);
       if (mesh == nullptr) continue;
-      Eigen::Matrix4f mvp = ToFloat(view_proj * world.instances[i].X_WV);
-      glUniformMatrix4fv(mvp_location, 1, GL_FALSE, mvp.data());
-      glBindVertexArray(mesh->vao);
-      glDrawElements(GL_TRIANGLES, mesh->index_count, GL_UNSIGNED_INT, nullptr);
+      draws_.push_back(
+          {mesh->vao, mesh->index_count, ToFloat(view_proj * world.instances[i].X_WV)});
     }
-    glDisable(GL_POLYGON_OFFSET_FILL);
+    MapSet& set = Maps(side, world.geometry_version);
+    current_ = &set;
+    if (reuse_ && set.valid[count] && set.drawn[count] == draws_) {
+      ++layers_reused_;
+    } else {
+      glNamedFramebufferTextureLayer(fbo_, GL_DEPTH_ATTACHMENT, set.texture, 0, count);
+      glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+      glViewport(0, 0, side, side);
+      glEnable(GL_DEPTH_TEST);
+      glDepthFunc(GL_LESS);
+      glDepthMask(GL_TRUE);
+      glDisable(GL_CULL_FACE);
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(1.5f, 2.0f);
+      const float one = 1.0f;
+      glClearNamedFramebufferfv(fbo_, GL_DEPTH, 0, &one);
+      glUseProgram(program);
+      for (const Draw& d : draws_) {
+        glUniformMatrix4fv(mvp_location, 1, GL_FALSE, d.mvp.data());
+        glBindVertexArray(d.vao);
+        glDrawElements(GL_TRIANGLES, d.count, GL_UNSIGNED_INT, nullptr);
+      }
+      glDisable(GL_POLYGON_OFFSET_FILL);
+      set.drawn[count].swap(draws_);
+      set.valid[count] = true;
+      ++layers_drawn_;
+    }
     // camera G -> light clip -> [0, 1]^3
     Eigen::Matrix4d bias = Eigen::Matrix4d::Identity() * 0.5;
     bias(3, 3) = 1;
