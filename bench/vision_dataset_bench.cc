@@ -23,6 +23,10 @@
 // without rendering), i.e. it counts the workers' time only. The projection for the paper's
 // 2,346 objects x 20 views is 46,920 / render rate + the merge-only time scaled by objects.
 //
+// After the table: the phases of the dataset runs (GenerateDataset's DatasetSummary::phases),
+// wall and thread CPU ms per view summed over the workers, to tell a shared bottleneck (wall grows
+// with --jobs, CPU does not) from work that is simply slow.
+//
 // Usage: partsim_vision_dataset_bench [--objects N] [--views V] [--size S] [--reps R]
 //                                     [--seconds T] [--jobs J1,J2,...] [--tree DIR] [--keep]
 //                                     [--processes P]
@@ -186,6 +190,7 @@ struct DatasetRun {
   double merge = 0;   // merge-only seconds
   double cpu_ms = 0;  // process CPU milliseconds per view, the merge-only run's left out
   long views = 0;
+  std::vector<partsim::vision::DatasetPhase> phases;  // one process's (not for --processes)
 };
 
 partsim::vision::DatasetOptions Options(const std::string& tree, const std::string& out, int views,
@@ -281,6 +286,7 @@ DatasetRun RunDataset(const std::string& tree, const std::string& out, int views
   r.cpu_ms = 1000 * ((cpu1 - cpu0) - (cpu2 - cpu1)) / static_cast<double>(s.views);
   r.all = static_cast<double>(s.views) / s.seconds;
   r.render = static_cast<double>(s.views) / std::max(s.seconds - m.seconds, 1e-9);
+  r.phases = s.phases;
   return r;
 }
 
@@ -411,6 +417,10 @@ int main(int argc, char** argv) {
   std::vector<double> raster, raster_cpu, bare_rate, bare_cpu;
   std::vector<std::vector<double>> j_all(jobs.size()), j_render(jobs.size()), j_cpu(jobs.size()),
       j_merge(jobs.size());
+  // per --jobs value: each phase's wall and CPU ms per view (load: per object), summed over the
+  // workers, one entry per repetition
+  std::vector<std::map<std::string, std::pair<std::vector<double>, std::vector<double>>>> j_phases(
+      jobs.size());
   long views_per_run = 0;
   for (int r = 0; r < reps; ++r) {
     for (size_t k = 0; k < runs; ++k) {
@@ -439,6 +449,12 @@ int main(int argc, char** argv) {
         j_cpu[j].push_back(d.cpu_ms);
         j_merge[j].push_back(d.merge);
         views_per_run = d.views;
+        for (const partsim::vision::DatasetPhase& p : d.phases) {
+          if (p.count == 0) continue;
+          auto& [wall, cpu] = j_phases[j][p.name];
+          wall.push_back(1000 * p.wall_seconds / static_cast<double>(p.count));
+          cpu.push_back(1000 * p.cpu_seconds / static_cast<double>(p.count));
+        }
       }
     }
     std::printf("rep %d: raster C+P+S %.1f/s (%.1f cpu ms), bare GL %.1f/s (%.1f cpu ms)", r + 1,
@@ -474,6 +490,30 @@ int main(int argc, char** argv) {
   std::printf(
       "(render: views/s without the merge-only run's time; /raster, /bare GL: render "
       "rate over theirs; cpu/rast: raster CPU per picture over dataset CPU per view)\n");
+  // where the workers' time goes: a phase whose wall time per view grows with the workers while
+  // its CPU time does not waits for something they share (a lock, the GPU's driver, the disk)
+  if (processes <= 1) {
+    std::printf("\nphases, ms per view (load: per object), wall / thread CPU, medians:\n%-9s",
+                "dataset");
+    const char* names[] = {"load", "render", "convert", "write"};
+    for (const char* n : names) std::printf(" %17s", n);
+    std::printf("\n");
+    for (size_t j = 0; j < jobs.size(); ++j) {
+      std::printf("%-9s", ("--jobs " + std::to_string(jobs[j])).c_str());
+      for (const char* n : names) {
+        auto it = j_phases[j].find(n);
+        if (it == j_phases[j].end()) {
+          std::printf(" %17s", "-");
+        } else {
+          char cell[64];
+          std::snprintf(cell, sizeof(cell), "%.2f / %.2f", Median(it->second.first),
+                        Median(it->second.second));
+          std::printf(" %17s", cell);
+        }
+      }
+      std::printf("\n");
+    }
+  }
   if (!keep)
     fs::remove_all(root);
   else

@@ -231,6 +231,17 @@ int RunDataset(const std::string& name, vision::DatasetKind kind,
   if (s.views > 0 && s.seconds > 0)
     std::printf(" (%s per second)",
                 FormatNumber(std::round(s.views / s.seconds * 10) / 10).c_str());
+  // where the workers' time went, per picture (load: per object)
+  std::string phases;
+  for (const vision::DatasetPhase& p : s.phases) {
+    if (p.count == 0) continue;
+    const auto ms = [&](double seconds) {
+      return FormatNumber(std::round(seconds / static_cast<double>(p.count) * 1e4) / 10);
+    };
+    phases += (phases.empty() ? "" : ", ") + p.name + " " + ms(p.wall_seconds) + " ms (CPU " +
+              ms(p.cpu_seconds) + ")";
+  }
+  if (!phases.empty()) std::printf("\nper picture (load: per object): %s", phases.c_str());
   std::printf("\ntrain: %d objects, %ld %s; test: %d objects, %ld %s", s.train_objects,
               s.train_images, detection ? "images" : "samples", s.test_objects, s.test_images,
               detection ? "images" : "samples");

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -236,6 +237,57 @@ class BackgroundStage {
   std::future<void> pending_;
 };
 
+// The time of each phase of rendering an object (DatasetPhase): wall and thread CPU time. One
+// object's phases are timed on its worker's thread ("load", "render", "convert") and on its
+// writing thread ("write"), each phase from one thread only, and summed into the run's under a
+// lock when the object is done.
+enum Phase { kLoadPhase, kRenderPhase, kConvertPhase, kWritePhase, kNumPhases };
+constexpr const char* kPhaseNames[kNumPhases] = {"load", "render", "convert", "write"};
+
+struct PhaseTimes {
+  std::array<long, kNumPhases> count{};
+  std::array<double, kNumPhases> wall{}, cpu{};
+  void Add(const PhaseTimes& o) {
+    for (int p = 0; p < kNumPhases; ++p) {
+      count[p] += o.count[p];
+      wall[p] += o.wall[p];
+      cpu[p] += o.cpu[p];
+    }
+  }
+};
+
+double ThreadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+// times the scope into phase `phase` of `times` (nothing when `times` is null)
+class PhaseTimer {
+ public:
+  PhaseTimer(PhaseTimes* times, Phase phase) : times_(times), phase_(phase) {
+    if (times_ != nullptr) {
+      wall_ = std::chrono::steady_clock::now();
+      cpu_ = ThreadCpuSeconds();
+    }
+  }
+  ~PhaseTimer() {
+    if (times_ == nullptr) return;
+    times_->count[phase_] += 1;
+    times_->wall[phase_] +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_).count();
+    times_->cpu[phase_] += ThreadCpuSeconds() - cpu_;
+  }
+  PhaseTimer(const PhaseTimer&) = delete;
+  PhaseTimer& operator=(const PhaseTimer&) = delete;
+
+ private:
+  PhaseTimes* times_;
+  Phase phase_;
+  std::chrono::steady_clock::time_point wall_;
+  double cpu_ = 0;
+};
+
 // ---------------------------------------------------------------------------------------------
 // rendering one object
 
@@ -352,8 +404,11 @@ class ObjectRenderer {
  public:
   // `backend`: a kept backend to render with (it must outlive this), or null for a new one of
   // options.backend
-  ObjectRenderer(const DatasetOptions& options, const std::string& folder, RenderBackend* backend)
-      : options_(options), scene_(std::make_unique<Scene>()) {
+  // `times`: where the pictures' and conversions' time goes (may be null)
+  ObjectRenderer(const DatasetOptions& options, const std::string& folder, RenderBackend* backend,
+                 PhaseTimes* times)
+      : options_(options), times_(times), scene_(std::make_unique<Scene>()) {
+    PhaseTimer timer(times, kLoadPhase);
     if (backend != nullptr)
       SetRenderBackend(*scene_, std::make_unique<LentBackend>(backend));
     else
@@ -420,7 +475,11 @@ class ObjectRenderer {
                               std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
     const Eigen::Vector3d eye = centre + distance * dir;
     camera_.LookAt(eye, centre);  // a free camera: the picture reads its pose, not the snapshot
-    camera_.TakePicture(kColor | kPosition | kSegmentation);
+    {
+      PhaseTimer timer(times_, kRenderPhase);
+      camera_.TakePicture(kColor | kPosition | kSegmentation);
+    }
+    PhaseTimer timer(times_, kConvertPhase);
     const Picture& pic = camera_.GetPictureData();
 
     View& v = *view;
@@ -453,6 +512,7 @@ class ObjectRenderer {
 
  private:
   const DatasetOptions& options_;
+  PhaseTimes* times_;
   std::unique_ptr<Scene> scene_;
   PartNetMobilityObject object_;
   Articulation articulation_;
@@ -536,8 +596,9 @@ std::vector<Rle> EncodeInstances(const std::vector<std::uint16_t>& map, int widt
 // The detection views of one object into `dir`; returns views.json.
 json RenderDetectionObject(const DatasetOptions& options, const std::string& folder,
                            const std::string& name, const std::map<std::string, int>& category_ids,
-                           const std::string& dir, RenderBackend* backend, long* views_rendered) {
-  ObjectRenderer r(options, folder, backend);
+                           const std::string& dir, RenderBackend* backend, long* views_rendered,
+                           PhaseTimes* times) {
+  ObjectRenderer r(options, folder, backend, times);
   const PartNetMobilityObject& o = r.Object();
   const std::string category = CategoryOf(o);
   // per link index: its PartNet entry when labelled (else null) and its category id
@@ -569,6 +630,7 @@ json RenderDetectionObject(const DatasetOptions& options, const std::string& fol
     r.Render(r.DrawJointPositions(&rng), &rng, &v);
     ++*views_rendered;
     writing.Submit([&, k, &v = v] {
+      PhaseTimer timer(times, kWritePhase);
       const std::string stem = Two(k);
       WriteViewPictures(dir, stem, v);
       // pixel counts of the labelled links seen; instances numbered in link order
@@ -651,8 +713,8 @@ json RenderDetectionObject(const DatasetOptions& options, const std::string& fol
 // drawn again, at most 10 times, then left out.
 json RenderMotionObject(const DatasetOptions& options, const std::string& folder,
                         const std::string& name, const std::string& dir, RenderBackend* backend,
-                        long* views_rendered) {
-  ObjectRenderer r(options, folder, backend);
+                        long* views_rendered, PhaseTimes* times) {
+  ObjectRenderer r(options, folder, backend, times);
   const PartNetMobilityObject& o = r.Object();
   Articulation& art = r.GetArticulation();
   for (const char* sub : {"rgb", "depth", "mask"}) fs::create_directories(dir + "/" + sub);
@@ -688,6 +750,7 @@ json RenderMotionObject(const DatasetOptions& options, const std::string& folder
       art.SetQpos(v.qpos);
       const Pose X_WJ = joint.GetGlobalPose();
       writing.Submit([&, k, link = link, pl = pl, motion, dof, lower, link_name, X_WJ, &v = v] {
+        PhaseTimer timer(times, kWritePhase);
         const std::string stem = link_name + "_" + Two(k);
         WriteViewPictures(dir, stem, v);
         std::vector<std::uint8_t> mask(v.link.size());
@@ -1008,6 +1071,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
   if (!options.merge_only && !pending.empty()) {
     std::mutex mutex;
     long done = 0;
+    PhaseTimes run_times;
     partsim::internal::ProgressLine progress(stderr);
     BackendShelf backends(options.backend);
     // the scan above logged each object's load warnings once; reading the objects again to
@@ -1023,6 +1087,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
       const std::string final_dir = options.out + "/objects/" + info.name;
       long views = 0;
       std::string error;
+      PhaseTimes times;
       try {
         // made under <name>.partial (removed on an error), renamed into place when whole
         partsim::internal::StagedPath staged(final_dir, final_dir + ".partial");
@@ -1031,11 +1096,11 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
         fs::remove_all(final_dir);
         fs::create_directories(dir);
         std::unique_ptr<RenderBackend> backend = backends.Take();  // null: a new one per object
-        const json doc =
-            options.kind == DatasetKind::kDetection
-                ? RenderDetectionObject(options, info.folder, info.name, category_ids, dir,
-                                        backend.get(), &views)
-                : RenderMotionObject(options, info.folder, info.name, dir, backend.get(), &views);
+        const json doc = options.kind == DatasetKind::kDetection
+                             ? RenderDetectionObject(options, info.folder, info.name, category_ids,
+                                                     dir, backend.get(), &views, &times)
+                             : RenderMotionObject(options, info.folder, info.name, dir,
+                                                  backend.get(), &views, &times);
         backends.Put(std::move(backend));
         WriteText(dir + "/views.json", doc.dump(1));
         WriteText(dir + "/" + kDone, "");
@@ -1045,6 +1110,7 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
       }
       std::lock_guard<std::mutex> lock(mutex);
       summary.views += views;
+      run_times.Add(times);
       if (error.empty()) {
         ++summary.rendered;
       } else {
@@ -1066,6 +1132,9 @@ DatasetSummary GenerateDataset(const DatasetOptions& options) {
       }
     });
     progress.Break();
+    for (int p = 0; p < kNumPhases; ++p)
+      summary.phases.push_back(
+          {kPhaseNames[p], run_times.count[p], run_times.wall[p], run_times.cpu[p]});
   }
   std::sort(summary.errors.begin(), summary.errors.end());
   Merge(options, objects, categories, slider_range, &summary);

@@ -93,6 +93,19 @@ TEST(DatasetTest, DetectionDatasetIsTheSameWhateverTheJobsAndShards) {
   EXPECT_EQ(s1.views, 8);
   EXPECT_EQ(s1.train_images + s1.test_images, 8);
   EXPECT_GT(s1.annotations, 0);
+  // where the time went: each object loaded once, each view rendered, converted and written
+  ASSERT_EQ(s1.phases.size(), 4u);
+  const char* names[] = {"load", "render", "convert", "write"};
+  const long counts[] = {4, 8, 8, 8};
+  for (int p = 0; p < 4; ++p) {
+    EXPECT_EQ(s1.phases[p].name, names[p]);
+    EXPECT_EQ(s1.phases[p].count, counts[p]) << names[p];
+    EXPECT_GT(s1.phases[p].wall_seconds, 0) << names[p];
+    EXPECT_GT(s1.phases[p].cpu_seconds, 0) << names[p];
+    // one thread's CPU time within a phase is at most its wall time (clock ticks aside)
+    EXPECT_LE(s1.phases[p].cpu_seconds, s1.phases[p].wall_seconds + 0.01) << names[p];
+  }
+  EXPECT_LE(s1.phases[1].wall_seconds + s1.phases[2].wall_seconds, s1.seconds);
   o.out = two;
   o.jobs = 2;
   GenerateDataset(o);
@@ -214,6 +227,12 @@ TEST(DatasetTest, MotionDatasetHasDoorsAndDrawersWithUnitAxes) {
   const DatasetSummary s = GenerateDataset(o);
   EXPECT_EQ(s.objects, 3);  // the faucet has neither
   EXPECT_GT(s.slider_range, 0);
+  // a sample drawn again when its part is not seen renders more views than it writes
+  ASSERT_EQ(s.phases.size(), 4u);
+  EXPECT_EQ(s.phases[0].count, 3);
+  EXPECT_EQ(s.phases[1].count, s.views);
+  EXPECT_LE(s.phases[3].count, s.views);
+  EXPECT_GT(s.phases[3].count, 0);
   const MotionGroundTruth train = LoadMotionGroundTruth(out + "/motion_train.json");
   EXPECT_EQ(train.slider_range, s.slider_range);
   int hinges = 0, sliders = 0;

@@ -58,6 +58,17 @@ struct DatasetOptions {
 };
 
 /// What a run did.
+/// Where the time of a dataset run went, one phase of rendering an object, summed over the
+/// workers: "load" (reading the object and building its scene), "render" (the pictures, read-back
+/// included), "convert" (a picture into the view's pixels, depth and points), "write" (encoding
+/// and writing a view's files, on each worker's writing thread beside its rendering).
+struct DatasetPhase {
+  std::string name;
+  long count = 0;           ///< times the phase ran (objects for "load", views for the others)
+  double wall_seconds = 0;  ///< wall time inside the phase
+  double cpu_seconds = 0;   ///< CPU time of the thread inside it
+};
+
 struct DatasetSummary {
   int objects = 0;                  ///< objects in the dataset (all shards)
   int rendered = 0;                 ///< objects rendered by this run
@@ -69,9 +80,10 @@ struct DatasetSummary {
   int test_objects = 0;
   long train_images = 0;  ///< detection images or motion samples, merged
   long test_images = 0;
-  long annotations = 0;     ///< detection: part instances, merged
-  double slider_range = 0;  ///< motion: the slider normalisation, m
-  double seconds = 0;       ///< wall time of the run
+  long annotations = 0;              ///< detection: part instances, merged
+  double slider_range = 0;           ///< motion: the slider normalisation, m
+  double seconds = 0;                ///< wall time of the run
+  std::vector<DatasetPhase> phases;  ///< load, render, convert, write: this run's objects
 };
 
 /// Renders the dataset's objects of this shard that are not DONE yet, then writes the split
