@@ -142,12 +142,14 @@ def test_train_evaluate_table_through_the_command_line(tmp_path):
     assert json.loads((run / "eval.json").read_text()) == ev
 
     table = learn("table", run).stdout
-    cell = f"{ev['train']['metric']:.2f} (0.83)"
+    # a run of 400 steps: its cells are marked reduced
+    cell = f"{ev['train']['metric']:.2f}† (0.83)"
     assert "| mobility-exp | train |" in table and cell in table
     assert "- (85.4)" in table  # raw door: no run, the paper's number
+    assert "training steps per run: 400 (the paper: 1,000,000); †: reduced" in table
     rows = learn("table", run, "--csv").stdout.splitlines()
-    assert rows[0] == "obs,task,set,train_objects,ours,runs,paper"
-    assert "mobility,drawer,test,2," in "\n".join(rows)
+    assert rows[0] == "obs,task,set,train_objects,ours,runs,paper,steps"
+    assert any(r.startswith("mobility,drawer,test,2,") and r.endswith(",400") for r in rows)
 
     # hostile shard files for --merge: refused, naming the file; the run's eval files stay
     saved = (run / "eval.json").read_bytes()

@@ -38,6 +38,7 @@ from .._device import resolve_device  # noqa: F401 (part of this module's API)
 from .._files import atomic_write
 
 __all__ = [
+    "PAPER_STEPS",
     "PAPER_TABLE3",
     "TRAIN_SIZES",
     "RunConfig",
@@ -52,6 +53,8 @@ __all__ = [
 ]
 
 TRAIN_SIZES = (2, 4, 8, 16)
+# the environment steps of each of the paper's runs
+PAPER_STEPS = 1_000_000
 # Table 3 of the SAPIEN paper: door (final angle, degrees) and drawer (success rate at 80% of
 # the range) after 1M steps, for 2 / 4 / 8 / 16 training objects
 PAPER_TABLE3 = {
@@ -595,9 +598,10 @@ def _first(obs):
 def table(runs, fmt: str = "markdown") -> str:
     """Table 3's layout from evaluated runs: rows (state, train|test), columns door and drawer
     at 2 / 4 / 8 / 16 training objects; each cell "ours (paper)", ours the mean over the runs
-    (seeds) of that cell and "-" where no run is. ``fmt``: "markdown" or "csv" (one row per
-    cell with both values and the number of runs)."""
-    cells, steps = {}, set()
+    (seeds) of that cell and "-" where no run is. A cell with a run of fewer steps than the
+    paper's 1,000,000 is marked "†" (reduced). ``fmt``: "markdown" or "csv" (one row per cell
+    with both values, the number of runs and the fewest steps of its runs)."""
+    cells, steps, cell_steps = {}, set(), {}
     for run in runs:
         path = os.path.join(run, EVAL_FILE)
         try:
@@ -613,12 +617,14 @@ def table(runs, fmt: str = "markdown") -> str:
             if part in ev:
                 key = (ev["obs"], ev["task"], part, int(ev["train_objects"]))
                 cells.setdefault(key, []).append(float(ev[part]["metric"]))
+                cell_steps[key] = min(cell_steps.get(key, PAPER_STEPS), int(ev.get("steps", 0)))
     if fmt == "csv":
-        lines = ["obs,task,set,train_objects,ours,runs,paper"]
+        lines = ["obs,task,set,train_objects,ours,runs,paper,steps"]
         for (obs, task, part, n), vals in sorted(cells.items()):
             paper = PAPER_TABLE3.get((obs, task, part))
             ref = paper[TRAIN_SIZES.index(n)] if paper and n in TRAIN_SIZES else ""
-            lines.append(f"{obs},{task},{part},{n},{np.mean(vals):.4g},{len(vals)},{ref}")
+            lines.append(f"{obs},{task},{part},{n},{np.mean(vals):.4g},{len(vals)},{ref},"
+                         f"{cell_steps[(obs, task, part, n)]}")
         return "\n".join(lines) + "\n"
     if fmt != "markdown":
         raise ValueError(f"fmt must be 'markdown' or 'csv', got {fmt!r}")
@@ -635,6 +641,8 @@ def table(runs, fmt: str = "markdown") -> str:
                     ref = f"{paper[i]:.1f}" if task == "door" else f"{paper[i]:.2f}"
                     ours = "-" if not vals else (f"{np.mean(vals):.1f}" if task == "door"
                                                  else f"{np.mean(vals):.2f}")
+                    if vals and cell_steps[(obs, task, part, n)] < PAPER_STEPS:
+                        ours += "†"
                     row.append(f"{ours} ({ref})")
             lines.append("| " + " | ".join(row) + " |")
     other = sorted(k for k in cells if k[3] not in TRAIN_SIZES)
@@ -644,7 +652,8 @@ def table(runs, fmt: str = "markdown") -> str:
     lines.append("\ncells: ours, mean over runs (the paper's Table 3 in brackets); door: final "
                  "angle in degrees, drawer: success rate at 80% of the range; training steps "
                  "per run: " + ", ".join(f"{n:,}" for n in sorted(steps)) + " (the paper: "
-                 "1,000,000)")
+                 f"{PAPER_STEPS:,}); †: reduced, a run of the cell has fewer steps than the "
+                 "paper's")
     return "\n".join(lines) + "\n"
 
 
