@@ -21,6 +21,7 @@
 // gives medians over repetitions.
 //
 // Usage: partsim_render_bench [--reps N] [--seconds S] [--shadows] [--cpu-time] [--shadow-modes]
+//                             [--batch]
 // (--cpu-time: frames per second of process CPU time, all of llvmpipe's threads together)
 //
 // --shadow-modes: instead, partsim alone (c+d, the forward path) under the shadowing sun, against
@@ -30,6 +31,10 @@
 //   kept, auto   kept, sized from the picture (shadow_map_size = 0: 512 at 128², 1024 at 512²)
 //   moving       a gripper-sized box moving every picture (the maps drawn again), auto size
 // each as fps and as a ratio to shadows off; the same rotation and medians as above.
+//
+// --batch: instead, partsim c+d with every picture taking and releasing the GL context (as
+// pictures outside a batch do) against the same pictures inside one RenderBatch (the context
+// kept current), with the bare program beside them; the same rotation and medians.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
@@ -304,12 +309,63 @@ int ShadowModes(int reps, double seconds) {
   return 0;
 }
 
+// --batch (see the file's comment)
+int BatchModes(int reps, double seconds) {
+  auto backend = partsim::MakeRasterBackend();
+  std::printf(
+      "device: %s; partsim c+d, pictures alone or in a batch; %d repetitions of >= %.2f s "
+      "(%s) per run\n",
+      backend->Device().c_str(), reps, seconds, g_cpu_time ? "process CPU time" : "wall clock");
+  std::printf("%-16s %5s | %9s %9s %9s | %8s %8s\n", "scene", "size", "bare", "alone", "batch",
+              "batch/al", "batch/bare");
+  const unsigned kColorDepth = partsim::kColor | partsim::kPosition;
+  for (int scene = 0; scene < 2; ++scene) {
+    RenderWorld world = scene == 0 ? CabinetScene(false) : SpheresScene(false);
+    Eigen::Vector3d eye =
+        scene == 0 ? Eigen::Vector3d(1.8, 0.9, 1.2) : Eigen::Vector3d(1.6, 0, 1.3);
+    Eigen::Vector3d target = scene == 0 ? Eigen::Vector3d(0.2, 0, 0.25) : Eigen::Vector3d::Zero();
+    BareRenderer bare(world, false);
+    for (int size : {32, 128, 512}) {
+      CameraParams cam = CameraFor(size, eye, target);
+      partsim::Picture pic;
+      std::vector<float> color, depth;
+      std::vector<double> fps[3], ratio[2];
+      for (int r = 0; r < reps; ++r) {
+        double f[3] = {0, 0, 0};
+        for (int k = 0; k < 3; ++k) {
+          switch ((r + k) % 3) {
+            case 0:
+              f[0] = Fps([&] { bare.Render(world, cam, &color, &depth); }, seconds);
+              break;
+            case 1:
+              f[1] = Fps([&] { backend->Render(world, cam, &pic, kColorDepth); }, seconds);
+              break;
+            case 2: {
+              partsim::RenderBatch batch(*backend);
+              f[2] = Fps([&] { backend->Render(world, cam, &pic, kColorDepth); }, seconds);
+              break;
+            }
+          }
+        }
+        for (int k = 0; k < 3; ++k) fps[k].push_back(f[k]);
+        ratio[0].push_back(f[2] / f[1]);
+        ratio[1].push_back(f[2] / f[0]);
+      }
+      std::printf("%-16s %5d | %9.1f %9.1f %9.1f | %8.3f %8.3f\n",
+                  scene == 0 ? "cabinet+gripper" : "50 spheres", size, Median(fps[0]),
+                  Median(fps[1]), Median(fps[2]), Median(ratio[0]), Median(ratio[1]));
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int reps = 7;
   double seconds = 0.5;
-  bool shadows = false, shadow_modes = false;
+  bool shadows = false, shadow_modes = false, batch_modes = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) {
       reps = std::atoi(argv[++i]);
@@ -321,15 +377,18 @@ int main(int argc, char** argv) {
       g_cpu_time = true;
     } else if (!std::strcmp(argv[i], "--shadow-modes")) {
       shadow_modes = true;
+    } else if (!std::strcmp(argv[i], "--batch")) {
+      batch_modes = true;
     } else {
       std::fprintf(stderr,
                    "usage: %s [--reps N] [--seconds S] [--shadows] [--cpu-time] "
-                   "[--shadow-modes]\n",
+                   "[--shadow-modes] [--batch]\n",
                    argv[0]);
       return 2;
     }
   }
   if (shadow_modes) return ShadowModes(reps, seconds);
+  if (batch_modes) return BatchModes(reps, seconds);
 
   struct Case {
     const char* name;

@@ -16,6 +16,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
@@ -338,6 +339,8 @@ class LentBackend final : public RenderBackend {
   }
   std::string Name() const override { return backend_->Name(); }
   std::string Device() const override { return backend_->Device(); }
+  void BeginBatch() override { backend_->BeginBatch(); }
+  void EndBatch() override { backend_->EndBatch(); }
 
  protected:
   void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
@@ -599,6 +602,9 @@ json RenderDetectionObject(const DatasetOptions& options, const std::string& fol
                            const std::string& dir, RenderBackend* backend, long* views_rendered,
                            PhaseTimes* times) {
   ObjectRenderer r(options, folder, backend, times);
+  // the object's pictures as one batch of the kept rasterizer: its context stays current
+  std::optional<RenderBatch> batch;
+  if (backend != nullptr) batch.emplace(*backend);
   const PartNetMobilityObject& o = r.Object();
   const std::string category = CategoryOf(o);
   // per link index: its PartNet entry when labelled (else null) and its category id
@@ -715,6 +721,8 @@ json RenderMotionObject(const DatasetOptions& options, const std::string& folder
                         const std::string& name, const std::string& dir, RenderBackend* backend,
                         long* views_rendered, PhaseTimes* times) {
   ObjectRenderer r(options, folder, backend, times);
+  std::optional<RenderBatch> batch;  // as RenderDetectionObject's
+  if (backend != nullptr) batch.emplace(*backend);
   const PartNetMobilityObject& o = r.Object();
   Articulation& art = r.GetArticulation();
   for (const char* sub : {"rgb", "depth", "mask"}) fs::create_directories(dir + "/" + sub);

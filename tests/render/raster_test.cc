@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <future>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -484,6 +485,60 @@ TEST(RasterTest, AutomaticShadowMapSizeFollowsThePicture) {
   RasterOptions bad;
   bad.shadow_map_size = -1;
   EXPECT_THROW(MakeRasterBackend(bad), Error);
+}
+
+// A batch keeps the context current on its thread: the same pictures as outside one; another
+// thread is refused while it lasts and renders once it has ended; batches nest; a backend made
+// within the batch on the same thread (FreshPicture) takes the thread's context, and the batch's
+// next picture takes its own back.
+TEST(RasterTest, BatchKeepsTheContextOnItsThread) {
+  std::unique_ptr<RenderBackend> backend = MakeRasterBackend();
+  const RenderWorld world = ShadowWorld(true);
+  const CameraParams cam = CameraAbove(48, 48, {1.5, 0, 2});
+  Picture alone;
+  backend->Render(world, cam, &alone);
+  auto render_elsewhere = [&] {
+    return std::async(std::launch::async,
+                      [&] {
+                        Picture pic;
+                        backend->Render(world, cam, &pic);
+                        return pic;
+                      })
+        .get();
+  };
+  {
+    RenderBatch batch(*backend);
+    for (int i = 0; i < 3; ++i) {
+      Picture pic;
+      backend->Render(world, cam, &pic);
+      EXPECT_EQ(pic.color, alone.color);
+      EXPECT_EQ(pic.segmentation, alone.segmentation);
+    }
+    {
+      RenderBatch inner(*backend);
+      Picture pic;
+      backend->Render(world, cam, &pic, kColor | kPosition);
+      EXPECT_EQ(pic.color, FreshPicture(world, cam, kColor | kPosition).color);
+    }
+    try {
+      render_elsewhere();
+      ADD_FAILURE() << "a picture from another thread during a batch did not throw";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("batch begun on another thread"), std::string::npos)
+          << e.what();
+    }
+    // the batch goes on after the refusal
+    Picture pic;
+    backend->Render(world, cam, &pic);
+    EXPECT_EQ(pic.color, alone.color);
+  }
+  EXPECT_EQ(render_elsewhere().color, alone.color);  // released: any thread renders
+  EXPECT_THROW(backend->EndBatch(), Error);
+  // a batch begun on another thread that ended there leaves the context free here
+  std::async(std::launch::async, [&] { RenderBatch b(*backend); }).get();
+  Picture here;
+  backend->Render(world, cam, &here);
+  EXPECT_EQ(here.color, alone.color);
 }
 
 TEST(RasterTest, SpotLightLightsInsideItsConeOnly) {

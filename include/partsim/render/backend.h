@@ -107,6 +107,14 @@ class RenderBackend {
   virtual std::string Name() const = 0;
   /// The backend's counters (only `pictures` for backends without shadow maps).
   virtual RenderCounters Counters() const { return {pictures_, 0, 0}; }
+
+  /// A batch of pictures from the calling thread, until the matching EndBatch (batches nest):
+  /// the backend keeps what it binds to a thread bound between them (the rasterizer's GL
+  /// context stays current, where a picture outside a batch takes it and releases it, so that
+  /// any thread can render next). During a batch, pictures from another thread throw
+  /// partsim::Error. RenderBatch does both in a scope.
+  virtual void BeginBatch() {}
+  virtual void EndBatch() {}
   /// A line for logs: which device renders (e.g. the GL_RENDERER string).
   virtual std::string Device() const = 0;
   /// Fills the outputs of `out` named by `outputs` (PictureOutput bits, sized width x height),
@@ -133,6 +141,18 @@ class RenderBackend {
 
  private:
   uint64_t pictures_ = 0;
+};
+
+/// BeginBatch and EndBatch of a backend for a scope (see RenderBackend::BeginBatch).
+class RenderBatch {
+ public:
+  explicit RenderBatch(RenderBackend& backend) : backend_(backend) { backend_.BeginBatch(); }
+  ~RenderBatch() { backend_.EndBatch(); }
+  RenderBatch(const RenderBatch&) = delete;
+  RenderBatch& operator=(const RenderBatch&) = delete;
+
+ private:
+  RenderBackend& backend_;
 };
 
 /// Fills nothing but the background (for tests that need no pixels).

@@ -16,6 +16,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 
 #include "partsim/core/error.h"
 #include "partsim/render/backend.h"
@@ -71,6 +72,20 @@ class RasterBackend final : public RenderBackend {
 
   std::string Name() const override { return "rasterizer"; }
   std::string Device() const override { return context_->Renderer(); }
+  void BeginBatch() override {
+    if (batch_depth_ > 0) {
+      CheckBatchThread();
+    } else {
+      context_->MakeCurrent();
+      batch_thread_ = std::this_thread::get_id();
+    }
+    ++batch_depth_;
+  }
+  void EndBatch() override {
+    if (batch_depth_ == 0) throw Error("rasterizer: EndBatch without a BeginBatch");
+    CheckBatchThread();
+    if (--batch_depth_ == 0) context_->Release();
+  }
   RenderCounters Counters() const override {
     return {pictures_drawn(), shadows_.layers_drawn(), shadows_.layers_reused()};
   }
@@ -78,7 +93,27 @@ class RasterBackend final : public RenderBackend {
  protected:
   void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
                 unsigned outputs) override {
-    internal::CurrentContextScope current(*context_);
+    if (batch_depth_ > 0) {
+      CheckBatchThread();
+      // current since BeginBatch, unless another backend took this thread's context meanwhile
+      // (a check of the current context, without a release)
+      context_->MakeCurrent();
+      Draw(world, camera, out, outputs);
+    } else {
+      internal::CurrentContextScope current(*context_);
+      Draw(world, camera, out, outputs);
+    }
+  }
+
+ private:
+  void CheckBatchThread() const {
+    if (std::this_thread::get_id() != batch_thread_)
+      throw Error(
+          "rasterizer: a batch begun on another thread holds the GL context (RenderBatch: "
+          "pictures of a batch come from the thread that began it)");
+  }
+
+  void Draw(const RenderWorld& world, const CameraParams& camera, Picture* out, unsigned outputs) {
     passes_.targets().Ensure(camera.width, camera.height);
     resources_.Sync(world);
     Eigen::AlignedBox3d scene_box = resources_.UpdateBounds(world);
@@ -102,7 +137,6 @@ class RasterBackend final : public RenderBackend {
     }
   }
 
- private:
   // the forward path: only Color and Position asked for, and the built-in shaders
   bool UsesForwardPath(unsigned outputs) const {
     return (outputs & ~unsigned{kColor | kPosition}) == 0 &&
@@ -119,6 +153,8 @@ class RasterBackend final : public RenderBackend {
 
   RasterOptions options_;
   std::unique_ptr<internal::EglContext> context_;
+  int batch_depth_ = 0;           ///< BeginBatch calls not yet ended
+  std::thread::id batch_thread_;  ///< the thread that began the batch
   internal::raster::Programs programs_;
   internal::raster::Resources resources_;
   internal::raster::ShadowMaps shadows_;
