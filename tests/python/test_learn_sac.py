@@ -700,8 +700,13 @@ def test_sac_learns_to_reach(tmp_path):
     assert random.mean_return < -20
     assert learned.mean_return > 0.5 * random.mean_return + 3, (learned.mean_return,
                                                                  random.mean_return)
-    assert learned.success_rate >= random.success_rate + 0.2, (learned.success_rate,
-                                                                random.success_rate)
+    # more episodes end within the success radius: counted, not compared as rates (9 of 30
+    # against 3 + 6 as rates is 0.3 >= 0.1 + 0.2, false in floating point)
+    successes = [sum(bool(i["success"]) for i in e.infos) for e in (learned, random)]
+    assert successes[0] >= successes[1] + 6, successes
+    # and the tip ends nearer the target: the median final distance under half the random's
+    distance = [np.median([i["distance"] for i in e.infos]) for e in (learned, random)]
+    assert distance[0] < 0.5 * distance[1], distance
     rows = list(csv.DictReader(open(tmp_path / "progress.csv")))
     assert float(rows[-1]["mean_return"]) > float(rows[0]["mean_return"])
 
