@@ -2619,6 +2619,21 @@ class RayHit:
 
 class RenderBackend:
     """The scene's rendering backend."""
+    def __enter__(self) -> RenderBackend:
+        """`with scene.get_render_backend():` takes the pictures of the block as one batch: the rasterizer keeps its GL context current on this thread between them, where each picture outside a batch takes and releases it. Pictures from another thread during the block raise PartsimError; blocks nest."""
+        ...
+    def __exit__(self, *args) -> None:
+        """Ends the batch of the with block."""
+        ...
+    def begin_batch(self) -> None:
+        """Starts a batch of pictures from this thread (see __enter__)."""
+        ...
+    def end_batch(self) -> None:
+        """Ends the batch begun by begin_batch."""
+        ...
+    def get_counters(self) -> dict:
+        """What the backend did since it was made: {'pictures', 'shadow_layers_drawn', 'shadow_layers_reused'} (shadow maps drawn, and kept unchanged from an earlier picture)."""
+        ...
     def get_device(self) -> str:
         """Which device renders (e.g. GL_RENDERER)."""
         ...

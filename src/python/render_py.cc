@@ -145,7 +145,37 @@ void BindTypes(py::module_& m) {
 
   py::class_<RenderBackend>(m, "RenderBackend", "The scene's rendering backend.")
       .def("get_name", &RenderBackend::Name, "'rasterizer', 'pathtracer' or 'null'.")
-      .def("get_device", &RenderBackend::Device, "Which device renders (e.g. GL_RENDERER).");
+      .def("get_device", &RenderBackend::Device, "Which device renders (e.g. GL_RENDERER).")
+      .def(
+          "get_counters",
+          [](const RenderBackend& self) {
+            const RenderCounters c = self.Counters();
+            py::dict d;
+            d["pictures"] = c.pictures;
+            d["shadow_layers_drawn"] = c.shadow_layers_drawn;
+            d["shadow_layers_reused"] = c.shadow_layers_reused;
+            return d;
+          },
+          "What the backend did since it was made: {'pictures', 'shadow_layers_drawn', "
+          "'shadow_layers_reused'} (shadow maps drawn, and kept unchanged from an earlier "
+          "picture).")
+      .def("begin_batch", &RenderBackend::BeginBatch,
+           "Starts a batch of pictures from this thread (see __enter__).")
+      .def("end_batch", &RenderBackend::EndBatch, "Ends the batch begun by begin_batch.")
+      .def(
+          "__enter__",
+          [](RenderBackend& self) -> RenderBackend& {
+            self.BeginBatch();
+            return self;
+          },
+          py::return_value_policy::reference,
+          "`with scene.get_render_backend():` takes the pictures of the block as one batch: "
+          "the rasterizer keeps its GL context current on this thread between them, where "
+          "each picture outside a batch takes and releases it. Pictures from another thread "
+          "during the block raise PartsimError; blocks nest.")
+      .def(
+          "__exit__", [](RenderBackend& self, const py::args&) { self.EndBatch(); },
+          "Ends the batch of the with block.");
 }
 
 void BindCamera(py::module_& m) {

@@ -1,6 +1,6 @@
 """Cameras, lights, pictures and image writers (render bindings), on the null backend: shapes,
 dtypes, views without copies, errors, and the files the writers make. The renderers themselves
-are tested in C++."""
+are tested in C++; one test takes real pictures with the rasterizer (its counters and batches)."""
 
 import gc
 import math
@@ -170,6 +170,55 @@ def test_take_picture_without_update_render_and_with_lights(render_scene):
     cam = render_scene.add_camera("c", 4, 4, 1.0, 0.1, 10.0)
     cam.take_picture()
     assert render_scene.get_render_backend().get_name() == "null"
+
+
+def test_rasterizer_counters_and_a_batch_of_pictures(scene):
+    """The rasterizer (llvmpipe here): its counters say the shadow map was kept for a still
+    scene; a `with backend:` block is one batch, whose pictures are the ones taken alone and
+    which refuses pictures from another thread while it lasts."""
+    import threading
+
+    scene.set_render_backend("rasterizer")
+    scene.add_ground()
+    build_box(scene, z=0.1)
+    scene.add_directional_light([0.3, 0.2, -1], [2, 2, 2], shadow=True)
+    cam = scene.add_camera("c", 32, 32, 1.0, 0.05, 10.0)
+    cam.set_pose(look_at([1.0, 0.5, 1.0], [0, 0, 0.1]))
+    backend = scene.get_render_backend()
+    cam.take_picture()
+    first = cam.get_picture("Color").copy()
+    assert backend.get_counters() == {"pictures": 1, "shadow_layers_drawn": 1,
+                                      "shadow_layers_reused": 0}
+
+    errors, pictures = [], []
+
+    def elsewhere():
+        try:
+            cam.take_picture()
+            pictures.append(cam.get_picture("Color").copy())
+        except partsim.PartsimError as e:
+            errors.append(str(e))
+
+    with backend as same:
+        assert same is backend
+        cam.take_picture()
+        np.testing.assert_array_equal(cam.get_picture("Color"), first)
+        t = threading.Thread(target=elsewhere)
+        t.start()
+        t.join()
+        assert len(errors) == 1 and "batch begun on another thread" in errors[0]
+        cam.take_picture()
+        np.testing.assert_array_equal(cam.get_picture("Color"), first)
+    t = threading.Thread(target=elsewhere)
+    t.start()
+    t.join()
+    assert len(pictures) == 1
+    np.testing.assert_array_equal(pictures[0], first)
+    counters = backend.get_counters()
+    assert counters["pictures"] == 4 and counters["shadow_layers_drawn"] == 1
+    assert counters["shadow_layers_reused"] == 3
+    with pytest.raises(partsim.PartsimError, match="EndBatch without a BeginBatch"):
+        backend.end_batch()
 
 
 def test_render_ids_name_actors_and_links(render_scene, cabinet):
