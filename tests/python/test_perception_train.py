@@ -74,6 +74,31 @@ def test_a_run_continued_to_more_epochs_equals_one_run(perception_data, straight
     assert os.path.getsize(os.path.join(run, "curves.png")) > 1000
 
 
+def test_a_run_trained_further_drops_its_earlier_model(perception_data, tmp_path):
+    """model.pt is the network of the run's last epoch: a run continued to more epochs removes
+    the earlier one, so that predict, meanwhile, takes the newer checkpoint."""
+    run = str(tmp_path / "further")
+    args = ["train", "motion-resnet", "--data", perception_data.mot, "--out", run,
+            "--log-every", "1", "--checkpoint-minutes", "1e-9", "--no-eval", *SMALL]
+    vision(perception_data.cli, *args, "--epochs", 1)
+    first = weights(run)
+    p = subprocess.Popen([perception_data.cli, "vision"] + args + ["--epochs", "3"],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    checkpoint = os.path.join(run, "checkpoint.pt")
+    start = os.path.getmtime(checkpoint)
+    deadline = time.monotonic() + 300
+    while (os.path.getmtime(checkpoint) == start and p.poll() is None
+           and time.monotonic() < deadline):
+        time.sleep(0.05)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    assert not os.path.exists(os.path.join(run, "model.pt"))
+    r = vision(perception_data.cli, "predict", run)
+    assert "predicting with the last checkpoint" in r.stderr
+    newer = torch.load(checkpoint, map_location="cpu")["model"]
+    assert any(not torch.equal(first[k], newer[k]) for k in first)
+
+
 def test_a_killed_run_continues_where_its_checkpoint_was(perception_data, straight, tmp_path):
     """Checkpoints after every logged batch (--checkpoint-minutes tiny); the process is killed
     with SIGKILL once one exists, then started again with the same command."""

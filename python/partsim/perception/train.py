@@ -229,6 +229,10 @@ class Run:
             epoch, batch, rows = state["epoch"], state["batch"], state["rows"]
             torch.set_rng_state(state["torch_rng"])
             self._log(f"continuing from epoch {epoch + 1}, batch {batch} ({checkpoint})")
+            if epoch < epochs and os.path.exists(self.path(MODEL)):
+                # the network of an earlier end: no longer the run's, and predict would take it
+                # over the checkpoints this training writes
+                os.remove(self.path(MODEL))
         elif init is not None:
             loaded, skipped = self.baseline.load_weights(model, init)
             self._log(f"initialised {len(loaded)} tensors from '{init}' ({len(skipped)} skipped)")
