@@ -123,6 +123,8 @@ def test_train_evaluate_table_through_the_command_line(tmp_path):
     assert "train: success rate at 80% of the range" in out and "test:" in out
     ev = json.loads((run / "eval.json").read_text())
     assert ev["policy"] == "agent" and ev["episodes"] == 2
+    # the steps of the checkpoint played (the table marks cells by them), and the run's target
+    assert ev["steps"] == ev["run_steps"] == 400
     for part in ("train", "test"):
         assert [o["object"] for o in ev[part]["objects"]] == doc[part]
         assert 0.0 <= ev[part]["metric"] <= 1.0
@@ -384,3 +386,19 @@ def test_without_torch_the_commands_say_what_to_install(tmp_path):
     assert "import: partsim.learn needs PyTorch" in result.stdout
     assert "needs torch: install Debian's python3-torch" in result.stderr
     assert not (tmp_path / "run").exists()
+
+
+def test_an_evaluation_records_the_steps_its_checkpoint_trained(tmp_path):
+    """A run evaluated before its end is recorded (and marked in the table) by the steps of
+    the checkpoint played, not by its --steps; without a readable checkpoint.json, --steps."""
+    from partsim.learn.protocol import RunConfig, _trained_steps
+
+    config = RunConfig(task="drawer", obs="mobility", train_objects=2, steps=1_000_000)
+    assert _trained_steps(str(tmp_path), config) == 1_000_000
+    pointer = tmp_path / "checkpoint.json"
+    pointer.write_text(json.dumps({"dir": "ckpt_000000280000", "env_steps": 280000}))
+    assert _trained_steps(str(tmp_path), config) == 280000
+    for bad in ('{"env_steps": 1e999}', '{"env_steps": true}', '{"env_steps": -5}', "[",
+                '{"dir": "x"}'):
+        pointer.write_text(bad)
+        assert _trained_steps(str(tmp_path), config) == 1_000_000, bad

@@ -380,6 +380,21 @@ def _load_agent(run: str, config: RunConfig, env):
     return agent
 
 
+def _trained_steps(run: str, config: RunConfig) -> int:
+    """The environment steps of the checkpoint an evaluation plays (checkpoint.json), or the
+    run's --steps when there is none (a random baseline of a run never trained)."""
+    from .trainer import POINTER
+
+    try:
+        with open(os.path.join(run, POINTER), encoding="utf-8") as f:
+            steps = json.load(f)["env_steps"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return int(config.steps)
+    if not (isinstance(steps, int) and not isinstance(steps, bool) and 0 <= steps < 10**15):
+        return int(config.steps)
+    return steps
+
+
 # --- evaluation ----------------------------------------------------------------------------
 
 
@@ -452,7 +467,8 @@ def _write_evaluation(run: str, doc: dict, episodes: int, seed: int, which, poli
     config = RunConfig.from_json(doc["config"])
     result = {"episodes": int(episodes), "seed": int(seed), "policy": policy,
               "task": config.task, "obs": config.obs, "train_objects": config.train_objects,
-              "steps": config.steps, "metric": "final angle (degrees)" if config.task == "door"
+              "steps": _trained_steps(run, config), "run_steps": config.steps,
+              "metric": "final angle (degrees)" if config.task == "door"
               else f"success rate at {int(DRAWER_SUCCESS * 100)}% of the range"}
     by_place = {(r["set"], r["index"]): r for r in records}
     rows = []
