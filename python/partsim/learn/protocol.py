@@ -350,16 +350,21 @@ def train(config: RunConfig, out: str, quiet: bool = False, device: str = "auto"
 
 
 def _checkpoint_steps(run: str) -> int:
-    """Environment steps of a run's last checkpoint (0 without one)."""
+    """Environment steps of a run's last checkpoint (0 without one). Raises ValueError naming
+    checkpoint.json when it cannot be read or its env_steps is not a count."""
     from .trainer import POINTER
 
+    path = os.path.join(run, POINTER)
     try:
-        with open(os.path.join(run, POINTER), encoding="utf-8") as f:
-            return int(json.load(f)["env_steps"])
+        with open(path, encoding="utf-8") as f:
+            steps = json.load(f)["env_steps"]
     except FileNotFoundError:
         return 0
-    except (OSError, ValueError, KeyError, TypeError) as e:
-        raise ValueError(f"{os.path.join(run, POINTER)}: cannot be read: {e}") from None
+    except (OSError, ValueError, KeyError, TypeError, RecursionError) as e:
+        raise ValueError(f"{path}: cannot be read: {e}") from None
+    if not (isinstance(steps, int) and not isinstance(steps, bool) and 0 <= steps < 10**15):
+        raise ValueError(f"{path}: env_steps must be a count of steps, got {steps!r}")
+    return steps
 
 
 def _load_agent(run: str, config: RunConfig, env):
@@ -382,17 +387,12 @@ def _load_agent(run: str, config: RunConfig, env):
 
 def _trained_steps(run: str, config: RunConfig) -> int:
     """The environment steps of the checkpoint an evaluation plays (checkpoint.json), or the
-    run's --steps when there is none (a random baseline of a run never trained)."""
-    from .trainer import POINTER
-
+    run's --steps when there is none or it cannot be read (a random baseline of a run never
+    trained)."""
     try:
-        with open(os.path.join(run, POINTER), encoding="utf-8") as f:
-            steps = json.load(f)["env_steps"]
-    except (OSError, ValueError, KeyError, TypeError):
+        return _checkpoint_steps(run) or int(config.steps)
+    except ValueError:
         return int(config.steps)
-    if not (isinstance(steps, int) and not isinstance(steps, bool) and 0 <= steps < 10**15):
-        return int(config.steps)
-    return steps
 
 
 # --- evaluation ----------------------------------------------------------------------------
