@@ -434,6 +434,8 @@ class ObjectRenderer {
       entity_link_[id] = e.link_index;
     }
     limits_ = articulation_.GetQlimits();
+    // the object's pictures as one batch of the kept rasterizer: its context stays current
+    if (backend != nullptr) batch_.emplace(*backend);
   }
 
   const PartNetMobilityObject& Object() const { return object_; }
@@ -523,6 +525,7 @@ class ObjectRenderer {
   std::vector<int> entity_link_;  // render entity id -> link index of the object, -1 none
   MeshBounds mesh_bounds_;
   Eigen::MatrixX2d limits_;
+  std::optional<RenderBatch> batch_;  // with a kept backend, for the object's lifetime
 };
 
 // Link index -> its PartNet entry (only labelled links of the file).
@@ -602,9 +605,6 @@ json RenderDetectionObject(const DatasetOptions& options, const std::string& fol
                            const std::string& dir, RenderBackend* backend, long* views_rendered,
                            PhaseTimes* times) {
   ObjectRenderer r(options, folder, backend, times);
-  // the object's pictures as one batch of the kept rasterizer: its context stays current
-  std::optional<RenderBatch> batch;
-  if (backend != nullptr) batch.emplace(*backend);
   const PartNetMobilityObject& o = r.Object();
   const std::string category = CategoryOf(o);
   // per link index: its PartNet entry when labelled (else null) and its category id
@@ -721,8 +721,6 @@ json RenderMotionObject(const DatasetOptions& options, const std::string& folder
                         const std::string& name, const std::string& dir, RenderBackend* backend,
                         long* views_rendered, PhaseTimes* times) {
   ObjectRenderer r(options, folder, backend, times);
-  std::optional<RenderBatch> batch;  // as RenderDetectionObject's
-  if (backend != nullptr) batch.emplace(*backend);
   const PartNetMobilityObject& o = r.Object();
   Articulation& art = r.GetArticulation();
   for (const char* sub : {"rgb", "depth", "mask"}) fs::create_directories(dir + "/" + sub);
