@@ -101,12 +101,12 @@ class MaskRCNN(Baseline):
             raise RunError(f"weights '{path}' cannot be read: {type(e).__name__}: {e}") from None
         if isinstance(saved, dict) and "conv1.weight" in saved and not any(
                 str(k).startswith("backbone.") for k in saved):
-            loaded, skipped = load_backbone_weights(model, path)
+            loaded, skipped = load_backbone_weights(model, path, saved)
             if not loaded:
                 raise RunError(f"weights '{path}': none of its {len(saved)} tensors fits "
                                f"the {self.backbone} backbone")
             return loaded, skipped
-        return load_matching(model, path)
+        return load_matching(model, path, saved)
 
     def build_model(self):
         import torch
@@ -245,16 +245,18 @@ class MaskRCNN(Baseline):
         return results
 
 
-def load_backbone_weights(model, path):
+def load_backbone_weights(model, path, saved=None):
     """Loads the ResNet weights saved at ``path`` (a state dict written by ``torch.save``: a
     torchvision ResNet's ``state_dict()``, or keys under ``backbone.body.``, a Mask R-CNN's)
     into ``model``'s backbone (``model.backbone.body``). Keys the backbone does not have (the
     ResNet's ``fc``, BatchNorm's running statistics when the backbone uses GroupNorm) and
     tensors of another shape are skipped, except the first convolution of an RGB-D model,
     which gets the saved RGB weights in its first three input channels and their mean in the
-    fourth. Returns ``(loaded, skipped)``, the lists of the file's keys (without prefix)."""
+    fourth. Returns ``(loaded, skipped)``, the lists of the file's keys (without prefix).
+    ``saved``: the file's contents when the caller has read them already."""
     import torch
-    saved = torch.load(path, map_location="cpu")
+    if saved is None:
+        saved = torch.load(path, map_location="cpu")
     if not isinstance(saved, dict):
         raise ValueError("load_backbone_weights: %s does not hold a state dict (got %s)"
                          % (path, type(saved).__name__))

@@ -477,17 +477,18 @@ def _write_json_list(path, entries):
     atomic_write(path, lambda f: f.write(text.encode("utf-8")))
 
 
-def load_matching(model, path):
+def load_matching(model, path, state=None):
     """Loads the tensors of the state dict in file ``path`` whose names and shapes match
     ``model``'s (pretrained weights saved by torch.save, e.g. another run's model.pt); returns
     (loaded names, skipped names). Raises RunError when the file cannot be read or nothing
-    matches."""
+    matches. ``state``: the file's contents when the caller has read them already."""
     import torch
 
-    try:
-        state = torch.load(path, map_location="cpu")
-    except Exception as e:  # torch raises many kinds for a bad file
-        raise RunError(f"weights '{path}' cannot be read: {type(e).__name__}: {e}") from None
+    if state is None:
+        try:
+            state = torch.load(path, map_location="cpu")
+        except Exception as e:  # torch raises many kinds for a bad file
+            raise RunError(f"weights '{path}' cannot be read: {type(e).__name__}: {e}") from None
     if isinstance(state, dict) and "model" in state and isinstance(state["model"], dict):
         state = state["model"]  # a checkpoint
     if not isinstance(state, dict):
