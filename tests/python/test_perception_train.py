@@ -152,7 +152,16 @@ def test_shards_written_to_files_merge_to_one_pass(perception_data, straight, tm
     other = str(tmp_path / "other.json")
     with open(other, "w") as f:
         json.dump({"episodes": []}, f)
+    # a shard count of 10^18 in a file: named at once, not counted out
+    huge = str(tmp_path / "huge.json")
+    with open(files[0]) as f:
+        doc = json.load(f)
+    with open(huge, "w") as f:
+        json.dump(dict(doc, shard=[0, 10**18]), f)
     for args, message in (
+            ([huge], "shards 1/1000000000000000000, 2/1000000000000000000, "
+                     "3/1000000000000000000, 4/1000000000000000000, "
+                     "5/1000000000000000000 and more are missing"),
             (files[:2], "shards 2/3 are missing"),
             (files + [files[1]], "shard 1/3 is also in"),
             (files[:2] + [other], "not a file of 'partsim vision predict"),
