@@ -21,6 +21,7 @@ namespace {
 constexpr char kAssetsUsage[] = R"(usage:
   partsim assets generate --out DIR [--categories all|Cat1,Cat2] [--per-category N|paper]
                           [--seed S] [--jobs J] [--by-category] [--overwrite] [--shard i/N]
+                          [--unannotated]
   partsim assets categories
   partsim assets check DIR [--jobs J] [--no-visibility] [--backend B] [--report FILE]
                        [--limit N] [--shard i/N] [--results FILE]
@@ -47,6 +48,11 @@ generate     writes DIR/<anno_id>/ folders in the PartNet-Mobility format, laid 
                           which then replaces only this shard's objects). The N shards' trees
                           together are a single run's, byte for byte: generate writes nothing
                           but the object folders.
+  --unannotated           write annotation tasks instead (docs/annotation.md): the meshes,
+                          result.json, meta.json and bounding_box.json, without mobility.urdf,
+                          mobility_v2.json and semantics.txt; `partsim annotate` turns one back
+                          into a PartNet-Mobility object, and the same command without this
+                          option writes the answer
 categories   lists the 46 categories with the paper's model and part counts.
 check        runs the quality checks on every object folder under DIR and prints the models and
              movable parts per category beside the paper's (`check --help` for more).
@@ -83,6 +89,7 @@ int Generate(const std::vector<std::string>& args) {
   });
   p.Switch("--by-category", [&] { opt.by_category = true; });
   p.Switch("--overwrite", [&] { opt.overwrite = true; });
+  p.Switch("--unannotated", [&] { opt.unannotated = true; });
   p.Option("--shard", [&](const FlagValue& v) {
     std::tie(opt.shard_index, opt.shard_count) = v.Shard();
     opt.shared_out_dir = true;

@@ -28,6 +28,9 @@ struct GeneratedPiece {
   std::string material;                       ///< material name in the .mtl, e.g. "wood"
   Eigen::Vector3d color = Eigen::Vector3d::Constant(0.8);  ///< diffuse colour (Kd), 0..1
   double density = 1000.0;                                 ///< kg/m^3
+  /// Name of its OBJ file in textured_objs/ (without ".obj"); "": original-K, K counting the
+  /// object's pieces in link, part, piece order.
+  std::string file;
 };
 
 /// One annotated part of a link ("handle", "door", "drawer_front", ...), made of convex pieces:
@@ -100,6 +103,8 @@ struct GeneratorOptions {
   /// whose folder is already whole there (same seed and index in its meta.json) is skipped, or
   /// rewritten with overwrite; a folder of that name holding anything else is refused.
   bool shared_out_dir = false;
+  /// WriteUnannotatedObject instead of WriteObject: annotation tasks with a known answer.
+  bool unannotated = false;
 };
 
 /// Suffix of the folder an object is written into before it is renamed into place: an object
@@ -134,6 +139,11 @@ GeneratedObject GenerateObject(const std::string& category, int index, std::uint
 /// else is refused); a process killed meanwhile leaves no torn `dir`. Throws partsim::Error
 /// naming the file it cannot write.
 void WriteObject(const GeneratedObject& object, const std::string& dir);
+
+/// Writes `object` into `dir` as an annotation task (docs/annotation.md): what WriteObject writes
+/// less mobility.urdf, mobility_v2.json and semantics.txt, so the part hierarchy (result.json)
+/// and the meshes are there and the answer is not.
+void WriteUnannotatedObject(const GeneratedObject& object, const std::string& dir);
 
 /// Whether `folder` holds an object WriteObject wrote (its meta.json names partsim's generator).
 bool IsGeneratedObjectFolder(const std::string& folder);

@@ -235,6 +235,8 @@ bool AlreadyWritten(const GeneratorOptions& options, const std::string& category
   dir /= AnnoId(category, index);
   std::error_code ec;
   if (!fs::is_directory(dir, ec) || !IsGeneratedObjectFolder(dir.string())) return false;
+  // the other form (annotated against unannotated) is written again
+  if (fs::exists(dir / "mobility.urdf", ec) == options.unannotated) return false;
   const std::string meta = internal::ReadWholeFile((dir / "meta.json").string(), "meta.json");
   const std::string mine =
       "\"seed\": " + std::to_string(options.seed) + ", \"index\": " + std::to_string(index) + "}";
@@ -297,7 +299,10 @@ int GenerateDataset(const GeneratorOptions& options, const GeneratorProgress& pr
         GeneratedObject o = GenerateObject(work[i].first, work[i].second, options.seed);
         std::filesystem::path dir(options.out_dir);
         if (options.by_category) dir /= o.category;
-        WriteObject(o, (dir / o.anno_id).string());
+        if (options.unannotated)
+          WriteUnannotatedObject(o, (dir / o.anno_id).string());
+        else
+          WriteObject(o, (dir / o.anno_id).string());
         std::lock_guard<std::mutex> lock(mutex);
         ++done;
         if (progress) progress(done, total, o);

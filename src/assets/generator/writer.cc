@@ -1,6 +1,8 @@
 // Writes a GeneratedObject as a PartNet-Mobility folder with the real dataset's structure
 // (docs/partnet_mobility_format.md). Numbers have fixed formats so that the same object always
 // gives the same bytes.
+#include "assets/generator/writer.h"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -76,10 +78,10 @@ std::vector<V3> LinkOrigins(const GeneratedObject& o) {
   return origin;
 }
 
-std::string ObjText(const GeneratedPiece& p, int k) {
+std::string ObjText(const GeneratedPiece& p, const std::string& name) {
   std::string s;
   s.reserve(p.vertices.size() * 40 + p.triangles.size() * 24 + 64);
-  s += "# partsim generator\nmtllib original-" + std::to_string(k) + ".mtl\n";
+  s += "# partsim generator\nmtllib " + name + ".mtl\n";
   for (const V3& v : p.vertices) {
     s += "v ";
     Append(&s, "%.9f", v.x());
@@ -198,7 +200,7 @@ std::string JointXml(const std::string& name, const std::string& type, const V3&
 /// slider that also turns hangs from link_N_helper. Joint joint_N has child link_N; the helpers'
 /// prismatic joints are numbered after the last link. partsim adds <inertial> and <dynamics>,
 /// which the dataset's files lack.
-std::string UrdfText(const GeneratedObject& o, const std::vector<std::vector<int>>& files) {
+std::string UrdfText(const GeneratedObject& o, const std::vector<std::vector<std::string>>& files) {
   std::vector<V3> origin = LinkOrigins(o);
   std::string s = "<?xml version=\"1.0\"?>\n<robot name=\"partnet_" + o.model_id + "\">\n";
   s += "  <link name=\"base\"/>\n";
@@ -209,8 +211,8 @@ std::string UrdfText(const GeneratedObject& o, const std::vector<std::vector<int
     size_t k = 0;
     for (const GeneratedPart& part : l.parts) {
       for (size_t i = 0; i < part.pieces.size(); ++i, ++k) {
-        std::string geo = "      <geometry>\n        <mesh filename=\"textured_objs/original-" +
-                          std::to_string(files[l.id][k]) + ".obj\"/>\n      </geometry>\n";
+        std::string geo = "      <geometry>\n        <mesh filename=\"textured_objs/" +
+                          files[l.id][k] + ".obj\"/>\n      </geometry>\n";
         visuals += "    <visual name=\"" + part.name + "-" + std::to_string(part.id) + "\">\n" +
                    org + geo + "    </visual>\n";
         collisions += "    <collision>\n" + org + geo + "    </collision>\n";
@@ -321,10 +323,9 @@ std::string TitleText(const std::string& name) {
 
 std::string Quoted(const std::string& s) { return "\"" + s + "\""; }
 
-std::string ObjList(const std::vector<int>& files) {
+std::string ObjList(const std::vector<std::string>& files) {
   std::string s = "[";
-  for (size_t i = 0; i < files.size(); ++i)
-    s += (i ? ", " : "") + Quoted("original-" + std::to_string(files[i]));
+  for (size_t i = 0; i < files.size(); ++i) s += (i ? ", " : "") + Quoted(files[i]);
   return s + "]";
 }
 
@@ -332,12 +333,12 @@ std::string ObjList(const std::vector<int>& files) {
 struct Node {
   int id = 0;
   std::string name;
-  std::vector<int> files;  ///< OBJ numbers of the node and all below it
+  std::vector<std::string> files;  ///< OBJ names of the node and all below it
   std::vector<Node> children;
 };
 
 /// The PartNet part hierarchy of the object (ids as NumberPartNodes gave them).
-Node PartTree(const GeneratedObject& o, const std::vector<std::vector<int>>& files) {
+Node PartTree(const GeneratedObject& o, const std::vector<std::vector<std::string>>& files) {
   Node root;
   root.name = SnakeCase(o.category);
   for (const GeneratedLink& l : o.links) {
@@ -424,34 +425,36 @@ bool IsPartialObjectFolder(const std::string& folder) {
          name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-void WriteObject(const GeneratedObject& object, const std::string& dir) {
+namespace internal {
+
+void WriteObjectFolder(const GeneratedObject& object, const std::string& dir,
+                       const ObjectFolderOptions& options) {
   namespace fs = std::filesystem;
   // everything goes to a staging folder, renamed into place at the end (removed on an error)
   const fs::path target(dir);
   std::error_code ec;
   if (fs::exists(target, ec) &&
       !(fs::is_directory(target, ec) &&
-        (fs::is_empty(target, ec) || IsGeneratedObjectFolder(target.string()))))
-    throw Error("WriteObject: '" + dir +
-                "' exists and holds something partsim did not generate: not replaced");
+        (fs::is_empty(target, ec) || options.replaceable(target.string()))))
+    throw Error("WriteObject: '" + dir + "' exists and holds something " + options.writer +
+                " did not write: not replaced");
   internal::StagedPath staged(dir, dir + kPartialSuffix);
   const fs::path root(staged.Temporary());
   fs::remove_all(root, ec);
   fs::create_directories(root / "textured_objs", ec);
   if (ec) throw Error("WriteObject: cannot create '" + (root / "textured_objs").string() + "'");
 
-  // one OBJ per piece, numbered in link, part, piece order
-  std::vector<std::vector<int>> files(object.links.size());
+  // one OBJ per piece, named by the piece or numbered in link, part, piece order
+  std::vector<std::vector<std::string>> files(object.links.size());
   int k = 0;
   V3 lo = V3::Constant(1e30), hi = V3::Constant(-1e30);
   for (const GeneratedLink& l : object.links) {
     for (const GeneratedPart& part : l.parts) {
       for (const GeneratedPiece& piece : part.pieces) {
-        files[l.id].push_back(k);
-        WriteFile(root / "textured_objs" / ("original-" + std::to_string(k) + ".obj"),
-                  ObjText(piece, k));
-        WriteFile(root / "textured_objs" / ("original-" + std::to_string(k) + ".mtl"),
-                  MtlText(piece));
+        const std::string name = piece.file.empty() ? "original-" + std::to_string(k) : piece.file;
+        files[l.id].push_back(name);
+        WriteFile(root / "textured_objs" / (name + ".obj"), ObjText(piece, name));
+        WriteFile(root / "textured_objs" / (name + ".mtl"), MtlText(piece));
         for (const V3& v : piece.vertices) {
           lo = lo.cwiseMin(v);
           hi = hi.cwiseMax(v);
@@ -461,27 +464,37 @@ void WriteObject(const GeneratedObject& object, const std::string& dir) {
     }
   }
   if (k == 0) lo = hi = V3::Zero();
-  WriteFile(root / "mobility.urdf", UrdfText(object, files));
-  WriteFile(root / "mobility_v2.json", MobilityText(object));
-  std::string sem;
-  for (const GeneratedLink& l : object.links) {
-    sem += "link_" + std::to_string(l.id) + " " + SemanticsKind(l) + " " + l.name + "\n";
+  if (options.mobility) {
+    WriteFile(root / "mobility.urdf", UrdfText(object, files));
+    WriteFile(root / "mobility_v2.json", MobilityText(object));
+    std::string sem;
+    for (const GeneratedLink& l : object.links) {
+      sem += "link_" + std::to_string(l.id) + " " + SemanticsKind(l) + " " + l.name + "\n";
+    }
+    WriteFile(root / "semantics.txt", sem);
   }
-  WriteFile(root / "semantics.txt", sem);
   // the dataset's keys (string values), then partsim's provenance
-  WriteFile(
-      root / "meta.json",
-      "{\"model_id\": " + Quoted(object.model_id) + ", \"anno_id\": " + Quoted(object.anno_id) +
-          ", \"user_id\": \"partsim\", \"time_in_sec\": \"0\", \"version\": \"3\", "
-          "\"model_cat\": " +
-          Quoted(object.category) + ", \"generator\": \"partsim assets generate\", \"seed\": " +
-          std::to_string(object.seed) + ", \"index\": " + std::to_string(object.index) + "}\n");
+  WriteFile(root / "meta.json",
+            !options.meta_json.empty()
+                ? options.meta_json
+                : "{\"model_id\": " + Quoted(object.model_id) +
+                      ", \"anno_id\": " + Quoted(object.anno_id) +
+                      ", \"user_id\": \"partsim\", \"time_in_sec\": \"0\", \"version\": \"3\", "
+                      "\"model_cat\": " +
+                      Quoted(object.category) +
+                      ", \"generator\": \"partsim assets generate\", \"seed\": " +
+                      std::to_string(object.seed) + ", \"index\": " + std::to_string(object.index) +
+                      "}\n");
   WriteFile(root / "bounding_box.json",
             "{\"min\": " + Json3(lo) + ", \"max\": " + Json3(hi) + "}\n");
-  const Node tree = PartTree(object, files);
-  WriteFile(root / "result.json", "[" + ResultJson(tree, object.category) + "]\n");
-  int next = 0;
-  WriteFile(root / "result_after_merging.json", "[" + MergedJson(tree, &next) + "]\n");
+  if (!options.result_json.empty()) {
+    WriteFile(root / "result.json", options.result_json);
+  } else {
+    const Node tree = PartTree(object, files);
+    WriteFile(root / "result.json", "[" + ResultJson(tree, object.category) + "]\n");
+    int next = 0;
+    WriteFile(root / "result_after_merging.json", "[" + MergedJson(tree, &next) + "]\n");
+  }
   // complete: into place
   fs::remove_all(target, ec);
   try {
@@ -489,6 +502,18 @@ void WriteObject(const GeneratedObject& object, const std::string& dir) {
   } catch (const Error& e) {
     throw Error(std::string("WriteObject: ") + e.what());
   }
+}
+
+}  // namespace internal
+
+void WriteObject(const GeneratedObject& object, const std::string& dir) {
+  internal::WriteObjectFolder(object, dir, internal::ObjectFolderOptions());
+}
+
+void WriteUnannotatedObject(const GeneratedObject& object, const std::string& dir) {
+  internal::ObjectFolderOptions options;
+  options.mobility = false;
+  internal::WriteObjectFolder(object, dir, options);
 }
 
 }  // namespace partsim
