@@ -42,6 +42,10 @@ int RunServeCommand(int argc, char** argv);
 /// "view"). Returns the exit code (0 success, 1 failure, 2 bad command line).
 int RunViewCommand(int argc, char** argv);
 
+/// `partsim annotate ...`: the mobility annotation tool in the browser (arguments after
+/// "annotate"). Returns the exit code (0 success, 1 failure, 2 bad command line).
+int RunAnnotateCommand(int argc, char** argv);
+
 /// What `partsim serve` and `partsim view` simulate: `scene_file` (a URDF file or a
 /// PartNet-Mobility folder placed at `where` with its root fixed, or a scene file's objects at
 /// their poses), or the built-in cabinet at `where` when it is "". Throws partsim::Error naming

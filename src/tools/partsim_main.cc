@@ -1,6 +1,6 @@
 // The `partsim` program: dispatches to its commands (info, simulate, render, assets, tasks,
-// serve, view, vision, learn; one file each), and prints the help and the version. With no
-// file, info, simulate and render use the built-in cabinet of MakeCabinetUrdf(). Exit codes: 0
+// serve, view, annotate, vision, learn; one file each), and prints the help and the version. With
+// no file, info, simulate and render use the built-in cabinet of MakeCabinetUrdf(). Exit codes: 0
 // success, 1 failure while running (missing or bad file), 2 bad command line.
 #include <mujoco/mujoco.h>
 
@@ -24,6 +24,7 @@ usage:
   partsim tasks demo|evaluate [options]         (see partsim tasks --help)
   partsim serve [SCENE] [options]               (see partsim serve --help)
   partsim view [OBJECT | SCENE] [options]       (see partsim view --help)
+  partsim annotate INPUT --out DIR [options]    (see partsim annotate --help)
   partsim vision detection-dataset|motion-dataset|evaluate-detection|evaluate-motion|show
                  [options]                      (see partsim vision --help)
   partsim learn train|evaluate|sweep|table|curves [options]
@@ -107,15 +108,16 @@ int main(int argc, char** argv) {
   if (command == "tasks") return partsim::tools::RunTasksCommand(argc - 2, argv + 2);
   if (command == "serve") return partsim::tools::RunServeCommand(argc - 2, argv + 2);
   if (command == "view") return partsim::tools::RunViewCommand(argc - 2, argv + 2);
+  if (command == "annotate") return partsim::tools::RunAnnotateCommand(argc - 2, argv + 2);
   if (command == "vision") return partsim::tools::RunVisionCommand(argc - 2, argv + 2);
   if (command == "learn") return partsim::tools::RunLearnCommand(argc - 2, argv + 2);
   if (command != "info" && command != "simulate" && command != "render") {
     const std::string hint = partsim::tools::DidYouMean(
-        command, {"info", "simulate", "render", "assets", "tasks", "serve", "view", "vision",
-                  "learn", "--help", "--version"});
+        command, {"info", "simulate", "render", "assets", "tasks", "serve", "view", "annotate",
+                  "vision", "learn", "--help", "--version"});
     std::fprintf(stderr,
                  "partsim: unknown %s '%s'%s (expected info, simulate, render, assets, tasks, "
-                 "serve, view, vision or learn; see partsim --help)\n",
+                 "serve, view, annotate, vision or learn; see partsim --help)\n",
                  command[0] == '-' ? "option" : "command", command.c_str(), hint.c_str());
     return 2;
   }
