@@ -243,8 +243,8 @@ def test_review_mode_records_a_decision_per_joint(objects, tmp_path):
         joints = state["review"]["joints"]
         assert joints and all(j["decision"] is None for j in joints)
         for k, j in enumerate(joints):
-            v = server.call("/partsim/annotate/review",
-                            {"link": j["link"], "accept": k > 0, "comment": "axis" if k == 0 else ""})
+            review = {"link": j["link"], "accept": k > 0, "comment": "axis" if k == 0 else ""}
+            v = server.call("/partsim/annotate/review", review)
             assert v["success"], v["message"]
         bad = server.call("/partsim/annotate/review", {"link": 10 ** 6, "accept": True})
         assert not bad["success"] and "no joint" in bad["message"]
