@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the viewer's web page (docs/viewer.md) into build/web: index.html, viewer.js (one
-# minified ES module with three.js and roslib in it) and viewer.css. Everything the page needs
+# minified ES module with three.js and roslib in it) and viewer.css; and the annotation tool's
+# page (docs/annotation.md): annotate.html, annotate.js and annotate.css. Everything the page needs
 # is in that folder: nothing is fetched from a CDN at run time.
 # Usage: bash scripts/build_web.sh   (needs node and npm; scripts/setup.sh installs them)
 set -euo pipefail
@@ -21,4 +22,8 @@ mkdir -p "$out"
 web/node_modules/.bin/esbuild web/src/main.js --bundle --minify --format=esm --platform=browser \
   --target=es2022 --alias:ws=./web/src/no_ws.js --legal-comments=eof --log-level=warning --outfile="$out/viewer.js"
 cp web/index.html web/viewer.css "$out/"
+# the annotation page of `partsim annotate` (docs/annotation.md)
+web/node_modules/.bin/esbuild web/src/annotate.js --bundle --minify --format=esm --platform=browser \
+  --target=es2022 --alias:ws=./web/src/no_ws.js --legal-comments=eof --log-level=warning --outfile="$out/annotate.js"
+cp web/annotate.html web/annotate.css "$out/"
 echo "partsim: web page built in $out ($(du -k "$out/viewer.js" | cut -f1) KiB of script)"

@@ -49,6 +49,8 @@ env PATH=/usr/bin:/bin "$src/.venv/bin/python" "$src/examples/cabinet_generator.
   --out "$work/cabinet" >/dev/null
 ls "$work/cabinet" | grep -q . || { echo "cabinet_generator wrote nothing"; exit 1; }
 echo "-- the viewer's page, installed, found by the installed package (from $work)"
-[ -f "$prefix/share/partsim/web/index.html" ] || { echo "no $prefix/share/partsim/web/index.html"; exit 1; }
+for page in index.html annotate.html annotate.js; do
+  [ -f "$prefix/share/partsim/web/$page" ] || { echo "no $prefix/share/partsim/web/$page"; exit 1; }
+done
 /usr/bin/python3 "$src/scripts/smoke_checks.py" viewer "$prefix/share/partsim/web"
 echo "install smoke test: all passed ($prefix)"

@@ -88,12 +88,14 @@ fi
 # only when its inputs changed: a stamp of their contents in build/ (the bundle took 6 s
 # and, being new, made the Debian package below be built again on every run)
 web_inputs() {
-  { find web/src web/index.html web/viewer.css web/package.json web/package-lock.json \
+  { find web/src web/index.html web/viewer.css web/annotate.html web/annotate.css \
+    web/package.json web/package-lock.json \
     web/node_modules/.package-lock.json scripts/build_web.sh -type f -print0 2>/dev/null || true; } |
     sort -z | xargs -0 -r sha256sum
 }
 web_stamp=build/.partsim-web-inputs.sha256  # outside build/web, which is installed as it is
 if [ -f build/web/viewer.js ] && [ -f build/web/index.html ] && [ -f build/web/viewer.css ] &&
+    [ -f build/web/annotate.js ] && [ -f build/web/annotate.html ] &&
     [ -f web/node_modules/.package-lock.json ] && [ -f "$web_stamp" ] &&
     [ "$(web_inputs)" = "$(cat "$web_stamp")" ]; then
   echo "partsim setup: web page in build/web is current"

@@ -53,9 +53,13 @@ class Annotate:
             self.kill()
             pytest.fail("no URL printed:\n" + "".join(self.lines))
         self.port, self.token = int(m.group(1)), m.group(2)
-        self.ws = websocket.create_connection("ws://127.0.0.1:%d/" % self.port, timeout=30)
-        self.ws.send(json.dumps({"op": "auth", "mac": self.token}))
-        assert json.loads(self.ws.recv())["msg"] == "authenticated"
+        try:
+            self.ws = websocket.create_connection("ws://127.0.0.1:%d/" % self.port, timeout=30)
+            self.ws.send(json.dumps({"op": "auth", "mac": self.token}))
+            assert json.loads(self.ws.recv())["msg"] == "authenticated"
+        except BaseException:
+            self.kill()  # no server left behind by a failed start
+            raise
         self.calls = 0
 
     def json(self, path):

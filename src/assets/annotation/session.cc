@@ -335,9 +335,11 @@ Json LinkJson(const AnnotationInput& in, const AnnotationLink& l) {
 
 std::string AnnotationSession::StateJson(bool review_mode) const {
   const AnnotationInput& in = *input_;
+  const bool reviewing = review_mode && Done();
   Json q = {{"index", question_.index},
-            {"phase", review_mode && Done() ? "review" : AnnotationPhaseName(question_.phase)},
-            {"text", question_.text},
+            {"phase", reviewing ? "review" : AnnotationPhaseName(question_.phase)},
+            {"text", reviewing ? "Review each joint: watch it move, then accept or reject it."
+                               : question_.text},
             {"node", question_.node >= 0 ? Json(question_.node) : Json(nullptr)},
             {"link", question_.link >= 0 ? Json(question_.link) : Json(nullptr)}};
   Json units = Json::array(), links = Json::array(), history = Json::array();
