@@ -307,6 +307,18 @@ AnnotationAnswer Answer(int index) {
   return a;
 }
 
+/// A joint's answer: `parent` to `child` about `direction`, over [lower, upper].
+AnnotationAnswer JointAnswer(int index, int parent, int child, double lower, double upper,
+                             const Eigen::Vector3d& direction = Eigen::Vector3d::UnitY()) {
+  AnnotationAnswer a = Answer(index);
+  a.parent = parent;
+  a.child = child;
+  a.lower = lower;
+  a.upper = upper;
+  a.direction = direction;
+  return a;
+}
+
 TEST(AnnotationTest, RefusedAnswersChangeNothingAndUndoReplays) {
   const fs::path dir = TempDir("hand");
   auto in = HandTree(dir / "in");
@@ -356,45 +368,20 @@ TEST(AnnotationTest, RefusedAnswersChangeNothingAndUndoReplays) {
   s.Answer(none);
   ASSERT_EQ(s.Question().phase, AnnotationPhase::kHinge);
   // a hinge with the body as child of the door, then one closing a loop
-  AnnotationAnswer hinge = Answer(4);
-  hinge.parent = 1;
-  hinge.child = 7;
-  hinge.lower = 0;
-  hinge.upper = 90;
-  hinge.direction = Eigen::Vector3d(0, 2, 0);
-  s.Answer(hinge);
+  s.Answer(JointAnswer(4, 1, 7, 0, 90, Eigen::Vector3d(0, 2, 0)));
   EXPECT_EQ(s.Link(7).parent, 1);
   EXPECT_NEAR(s.Link(7).direction.norm(), 1.0, 1e-12);
-  AnnotationAnswer loop = Answer(5);
-  loop.parent = 7;
-  loop.child = 1;
-  EXPECT_THROW(s.Answer(loop), Error);  // the body hangs nowhere, but the door hangs on it
-  AnnotationAnswer twice = Answer(5);
-  twice.parent = 4;
-  twice.child = 7;
-  EXPECT_THROW(s.Answer(twice), Error);  // the door has a parent already
-  AnnotationAnswer bad_limits = Answer(5);
-  bad_limits.parent = 1;
-  bad_limits.child = 4;
-  bad_limits.lower = 1;
-  bad_limits.upper = 0;
-  EXPECT_THROW(s.Answer(bad_limits), Error);
-  AnnotationAnswer no_axis = bad_limits;
-  no_axis.lower = 0;
-  no_axis.direction = Eigen::Vector3d::Zero();
-  EXPECT_THROW(s.Answer(no_axis), Error);
+  EXPECT_THROW(s.Answer(JointAnswer(5, 7, 1, 0, 1)),
+               Error);  // the body hangs nowhere, but the door hangs on it
+  EXPECT_THROW(s.Answer(JointAnswer(5, 4, 7, 0, 1)), Error);  // the door has a parent already
+  EXPECT_THROW(s.Answer(JointAnswer(5, 1, 4, 1, 0)), Error);  // lower above upper
+  EXPECT_THROW(s.Answer(JointAnswer(5, 1, 4, 0, 1, Eigen::Vector3d::Zero())), Error);  // no axis
   // "none" hinges; the drawer slides; one tree now: no "none" slider question, the root next
   AnnotationAnswer no_more = Answer(5);
   no_more.none = true;
   s.Answer(no_more);
   ASSERT_EQ(s.Question().phase, AnnotationPhase::kSlider);
-  AnnotationAnswer slider = Answer(6);
-  slider.parent = 1;
-  slider.child = 4;
-  slider.lower = 0;
-  slider.upper = 0.3;
-  slider.direction = Eigen::Vector3d(0, 0, 1);
-  s.Answer(slider);
+  s.Answer(JointAnswer(6, 1, 4, 0, 0.3, Eigen::Vector3d(0, 0, 1)));
   ASSERT_EQ(s.Question().phase, AnnotationPhase::kRoot);
   EXPECT_EQ(s.Question().link, 1);
   AnnotationAnswer root = Answer(7);
