@@ -416,6 +416,15 @@ TEST(AnnotationTest, RefusedAnswersChangeNothingAndUndoReplays) {
   EXPECT_EQ(o.links[0].joint, "heavy");
   EXPECT_EQ(o.links[1].joint, "slider");  // pre-order: the drawer (node 4) before the door (7)
   EXPECT_EQ(o.links[2].joint, "hinge");
+  // the reviews go with the export, named by the exported links
+  const std::string meta = ReadText(dir / "object" / "meta.json");
+  EXPECT_NE(
+      meta.find(R"({"accept":false,"comment":"the drawer slides the wrong way","link":"link_1"})"),
+      std::string::npos)
+      << meta;
+  EXPECT_NE(meta.find(R"({"accept":false,"comment":"changed my mind","link":"link_2"})"),
+            std::string::npos)
+      << meta;
   // a second export replaces the first; a folder partsim did not write is not replaced
   EXPECT_NO_THROW(ExportAnnotation(s, (dir / "object").string()));
   fs::create_directories(dir / "mine");

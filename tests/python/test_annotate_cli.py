@@ -256,6 +256,12 @@ def test_review_mode_records_a_decision_per_joint(objects, tmp_path):
         assert state["review"]["done"]
         assert [j["decision"] for j in state["review"]["joints"]] == \
             ["reject"] + ["accept"] * (len(joints) - 1)
+        # the export carries the reviews, by the exported links' names
+        folder = server.call("/partsim/annotate/export")["folder"]
+        with open(os.path.join(folder, "meta.json")) as f:
+            meta = json.load(f)
+        assert [r["accept"] for r in meta["reviews"]] == [False] + [True] * (len(joints) - 1)
+        assert all(r["link"].startswith("link_") for r in meta["reviews"])
     finally:
         server.kill()
     with open(session / "session.json") as f:

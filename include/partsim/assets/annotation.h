@@ -211,7 +211,8 @@ class AnnotationStore {
 /// mobility_v2.json, semantics.txt, meta.json, bounding_box.json, result.json as the input's,
 /// textured_objs/NAME.obj for each mesh name): links numbered link_0.. in pre-order of the
 /// forest; fixed roots are "heavy", free roots "free"; outlier roots and what hangs below them
-/// are left out (meta.json lists their parts). The folder appears whole or not at all. Throws
+/// are left out (meta.json lists their parts); meta.json's "reviews" holds the session's reviews
+/// of the joints exported. The folder appears whole or not at all. Throws
 /// partsim::Error when the session is not done or every root is an outlier.
 void ExportAnnotation(const AnnotationSession& session, const std::string& dir);
 

@@ -132,6 +132,7 @@ void ExportAnnotation(const AnnotationSession& session, const std::string& dir) 
   o.model_id = in.model_id.empty() ? in.digest : in.model_id;
   o.anno_id = in.anno_id.empty() ? fs::path(in.folder).filename().string() : in.anno_id;
   Json outliers = Json::array();
+  std::map<int, int> exported_id;  // annotation link id -> N of link_N
   // pre-order of the forest: a parent before its children, as link numbers need
   std::function<void(int, int)> add = [&](int i, int parent) {
     const AnnotationLink& l = links[i];
@@ -169,6 +170,7 @@ void ExportAnnotation(const AnnotationSession& session, const std::string& dir) 
       g.parts.push_back(std::move(part));
     }
     const int id = g.id;
+    exported_id[l.id] = id;
     o.links.push_back(std::move(g));
     for (int c : children[l.id]) add(c, id);
   };
@@ -192,14 +194,24 @@ void ExportAnnotation(const AnnotationSession& session, const std::string& dir) 
     if (first == 0) first = a.time;
     last = a.time;
   }
-  const Json meta = {{"model_id", o.model_id},
-                     {"anno_id", o.anno_id},
-                     {"user_id", "partsim"},
-                     {"time_in_sec", std::to_string(static_cast<long long>(last - first + 0.5))},
-                     {"version", "3"},
-                     {"model_cat", o.category},
-                     {"annotator", kAnnotator},
-                     {"outlier_parts", outliers}};
+  // the reviews of joints exported, by their link's name in the export
+  Json reviews = Json::array();
+  for (const AnnotationReview& r : session.Reviews()) {
+    const auto it = exported_id.find(r.link);
+    if (it == exported_id.end()) continue;
+    reviews.push_back({{"link", "link_" + std::to_string(it->second)},
+                       {"accept", r.accept},
+                       {"comment", r.comment}});
+  }
+  Json meta = {{"model_id", o.model_id},
+               {"anno_id", o.anno_id},
+               {"user_id", "partsim"},
+               {"time_in_sec", std::to_string(static_cast<long long>(last - first + 0.5))},
+               {"version", "3"},
+               {"model_cat", o.category},
+               {"annotator", kAnnotator},
+               {"outlier_parts", outliers}};
+  if (!reviews.empty()) meta["reviews"] = reviews;
   internal::ObjectFolderOptions options;
   options.meta_json = meta.dump() + "\n";
   options.result_json = in.result_json;
