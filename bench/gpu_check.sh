@@ -20,7 +20,8 @@
 #         2. partsim_render_bench --shadows --reps 3       (the sun casting shadows)
 #         3. partsim_render_bench --shadow-modes --reps 3  (maps redrawn, kept, sized, moving)
 #         4. partsim_render_bench --batch --reps 3         (the context kept current, or not)
-#         5. partsim_vision_dataset_bench --reps 1 --seconds 1 --jobs 1,4,8,16 (and the phases)
+#         5. partsim_render_bench --camera-set --reps 3    (4 cameras: Render each, RenderMany)
+#         6. partsim_vision_dataset_bench --reps 1 --seconds 1 --jobs 1,4,8,16 (and the phases)
 #       Each writes its output to $OUT (the device tool's folder; ./gpu-check-out elsewhere), and
 #       summary.md collects the tables with the machine's name. --quick runs each with the
 #       smallest settings (a minute on the build VM's llvmpipe), to check the script.
@@ -125,7 +126,8 @@ run() {
   step render 120 "$dir/bin/partsim_render_bench" "${reps[@]}"
   step shadows 120 "$dir/bin/partsim_render_bench" --shadows "${reps[@]}"
   step shadow_modes 120 "$dir/bin/partsim_render_bench" --shadow-modes "${reps[@]}"
-  step batch 90 "$dir/bin/partsim_render_bench" --batch "${reps[@]}"
+  step batch 75 "$dir/bin/partsim_render_bench" --batch "${reps[@]}"
+  step camera_set 75 "$dir/bin/partsim_render_bench" --camera-set "${reps[@]}"
   step dataset 240 "$dir/bin/partsim_vision_dataset_bench" "${dataset[@]}"
   rm -rf "$libs"
   echo "wrote $out/summary.md"

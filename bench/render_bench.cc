@@ -21,7 +21,7 @@
 // gives medians over repetitions.
 //
 // Usage: partsim_render_bench [--reps N] [--seconds S] [--shadows] [--cpu-time] [--shadow-modes]
-//                             [--batch]
+//                             [--batch] [--camera-set]
 // (--cpu-time: frames per second of process CPU time, all of llvmpipe's threads together)
 //
 // --shadow-modes: instead, partsim alone (c+d, the forward path) under the shadowing sun, against
@@ -35,6 +35,11 @@
 // --batch: instead, partsim c+d with every picture taking and releasing the GL context (as
 // pictures outside a batch do) against the same pictures inside one RenderBatch (the context
 // kept current), with the bare program beside them; the same rotation and medians.
+//
+// --camera-set: instead, four cameras around each scene (shadowing sun): one Render per camera
+// in a batch, against one RenderMany of the four (the world uploaded once, each picture read
+// back through pixel-pack buffers while the next is drawn), for c+d and all outputs; pictures
+// per second and their ratio, the same rotation and medians.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
@@ -360,12 +365,67 @@ int BatchModes(int reps, double seconds) {
   return 0;
 }
 
+// --camera-set (see the file's comment)
+int CameraSetModes(int reps, double seconds) {
+  auto backend = partsim::MakeRasterBackend();
+  std::printf(
+      "device: %s; a set of 4 cameras around the scene, one Render each (in a batch) or one "
+      "RenderMany; pictures per second; %d repetitions of >= %.2f s (%s) per run\n",
+      backend->Device().c_str(), reps, seconds, g_cpu_time ? "process CPU time" : "wall clock");
+  std::printf("%-16s %5s %4s | %9s %9s | %8s\n", "scene", "size", "out", "one each", "many",
+              "many/one");
+  for (int scene = 0; scene < 2; ++scene) {
+    RenderWorld world = scene == 0 ? CabinetScene(true) : SpheresScene(true);
+    const Eigen::Vector3d target =
+        scene == 0 ? Eigen::Vector3d(0.2, 0, 0.25) : Eigen::Vector3d::Zero();
+    for (int size : {128, 512}) {
+      std::vector<CameraParams> cams;
+      for (int k = 0; k < 4; ++k) {
+        const double a = 0.4 + 1.2 * k;  // around the scene
+        cams.push_back(CameraFor(
+            size, target + Eigen::Vector3d(2 * std::cos(a), 2 * std::sin(a), 1.2), target));
+      }
+      std::vector<partsim::Picture> pics(cams.size());
+      std::vector<partsim::Picture*> out;
+      for (partsim::Picture& p : pics) out.push_back(&p);
+      for (unsigned outputs :
+           {unsigned{partsim::kColor | partsim::kPosition}, unsigned{partsim::kAllOutputs}}) {
+        std::vector<double> fps[2], ratio;
+        for (int r = 0; r < reps; ++r) {
+          double f[2] = {0, 0};
+          for (int k = 0; k < 2; ++k) {
+            partsim::RenderBatch batch(*backend);
+            if ((r + k) % 2 == 0) {
+              f[0] = 4 * Fps(
+                             [&] {
+                               for (size_t i = 0; i < cams.size(); ++i)
+                                 backend->Render(world, cams[i], out[i], outputs);
+                             },
+                             seconds);
+            } else {
+              f[1] = 4 * Fps([&] { backend->RenderMany(world, cams, out, outputs); }, seconds);
+            }
+          }
+          for (int k = 0; k < 2; ++k) fps[k].push_back(f[k]);
+          ratio.push_back(f[1] / f[0]);
+        }
+        std::printf("%-16s %5d %4s | %9.1f %9.1f | %8.3f\n",
+                    scene == 0 ? "cabinet+gripper" : "50 spheres", size,
+                    outputs == partsim::kAllOutputs ? "all" : "c+d", Median(fps[0]), Median(fps[1]),
+                    Median(ratio));
+        std::fflush(stdout);
+      }
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int reps = 7;
   double seconds = 0.5;
-  bool shadows = false, shadow_modes = false, batch_modes = false;
+  bool shadows = false, shadow_modes = false, batch_modes = false, camera_set = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--reps") && i + 1 < argc) {
       reps = std::atoi(argv[++i]);
@@ -379,16 +439,19 @@ int main(int argc, char** argv) {
       shadow_modes = true;
     } else if (!std::strcmp(argv[i], "--batch")) {
       batch_modes = true;
+    } else if (!std::strcmp(argv[i], "--camera-set")) {
+      camera_set = true;
     } else {
       std::fprintf(stderr,
                    "usage: %s [--reps N] [--seconds S] [--shadows] [--cpu-time] "
-                   "[--shadow-modes] [--batch]\n",
+                   "[--shadow-modes] [--batch] [--camera-set]\n",
                    argv[0]);
       return 2;
     }
   }
   if (shadow_modes) return ShadowModes(reps, seconds);
   if (batch_modes) return BatchModes(reps, seconds);
+  if (camera_set) return CameraSetModes(reps, seconds);
 
   struct Case {
     const char* name;

@@ -2948,6 +2948,9 @@ class Scene:
     def step(self, n: int = ...) -> None:
         """Advances by n timesteps. The GIL is released meanwhile: other Python threads run; their steps of this scene wait their turn, and their other calls on it raise PartsimError until step returns."""
         ...
+    def take_pictures(self, cameras: typing.Optional[typing.List[Camera]] = ..., outputs: typing.Optional[typing.List[str]] = ...) -> None:
+        """take_picture() of each camera (None: every camera of the scene), rendered together: the rasterizer uploads the scene once and reads one picture back while it draws the next. Each picture is the one take_picture() gives. `outputs` as for take_picture(). The GIL is released meanwhile."""
+        ...
     @property
     def timestep(self) -> float:
         """Timestep in seconds, > 0."""

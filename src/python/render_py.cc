@@ -330,6 +330,23 @@ void BindSceneRender(py::module_& m) {
       .def("update_render", &UpdateRender,
            "Copies the current poses of everything visible (and mounted cameras) into the "
            "render world.")
+      .def(
+          "take_pictures",
+          [](Scene& self, const std::optional<std::vector<Camera>>& cameras,
+             const std::optional<std::vector<std::string>>& outputs) {
+            unsigned mask = kAllOutputs;
+            if (outputs) {
+              mask = 0;
+              for (const std::string& name : *outputs) mask |= PictureOutputFromName(name);
+            }
+            const std::vector<Camera> set = cameras ? *cameras : GetCameras(self);
+            WithoutGil(self, [&] { TakePictures(set, mask); });
+          },
+          py::arg("cameras") = py::none(), py::arg("outputs") = py::none(),
+          "take_picture() of each camera (None: every camera of the scene), rendered together: "
+          "the rasterizer uploads the scene once and reads one picture back while it draws the "
+          "next. Each picture is the one take_picture() gives. `outputs` as for take_picture(). "
+          "The GIL is released meanwhile.")
       .def("get_render_entities", &GetRenderEntities,
            "What the actor/link ids of segmentation (channel 1) name.")
       .def("get_render_visuals", &GetRenderVisuals,

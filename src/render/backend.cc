@@ -40,16 +40,47 @@ void CheckCamera(const RenderBackend& backend, const CameraParams& camera) {
     Fail(backend, "camera.view and camera.projection must be finite");
 }
 
+void CheckOutputs(const RenderBackend& backend, unsigned outputs) {
+  if (outputs == 0 || (outputs & ~unsigned{kAllOutputs}) != 0)
+    Fail(backend,
+         "outputs must name at least one of Color, Albedo, Normal, Position, "
+         "Segmentation (PictureOutput bits 1 to 31), got " +
+             std::to_string(outputs));
+}
+
 }  // namespace
+
+void RenderBackend::RenderMany(const RenderWorld& world, const std::vector<CameraParams>& cameras,
+                               const std::vector<Picture*>& out, unsigned outputs) {
+  if (out.size() != cameras.size())
+    Fail(*this, std::to_string(cameras.size()) + " cameras but " + std::to_string(out.size()) +
+                    " pictures to fill");
+  CheckOutputs(*this, outputs);
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    if (out[i] == nullptr) Fail(*this, "out[" + std::to_string(i) + "] (a picture) is null");
+    try {
+      CheckCamera(*this, cameras[i]);
+    } catch (const Error& e) {
+      throw Error(std::string(e.what()) + " (camera " + std::to_string(i) + " of " +
+                  std::to_string(cameras.size()) + ")");
+    }
+  }
+  // every argument checked: now the pictures hold nothing until DoRenderMany has filled them
+  for (Picture* p : out) p->outputs = 0;
+  DoRenderMany(world, cameras, out, outputs);
+  pictures_ += cameras.size();
+  for (Picture* p : out) internal::KeepOutputs(outputs, p);
+}
+
+void RenderBackend::DoRenderMany(const RenderWorld& world, const std::vector<CameraParams>& cameras,
+                                 const std::vector<Picture*>& out, unsigned outputs) {
+  for (size_t i = 0; i < cameras.size(); ++i) DoRender(world, cameras[i], out[i], outputs);
+}
 
 void RenderBackend::Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
                            unsigned outputs) {
   if (out == nullptr) Fail(*this, "out (the picture to fill) is null");
-  if (outputs == 0 || (outputs & ~unsigned{kAllOutputs}) != 0)
-    Fail(*this,
-         "outputs must name at least one of Color, Albedo, Normal, Position, "
-         "Segmentation (PictureOutput bits 1 to 31), got " +
-             std::to_string(outputs));
+  CheckOutputs(*this, outputs);
   CheckCamera(*this, camera);
   // the picture holds nothing until DoRender has filled it
   out->outputs = 0;

@@ -224,28 +224,28 @@ void Camera::SetParent(const Link& parent, bool keep_pose) {
 
 void Camera::ClearParent(bool keep_pose) { Remount(Entry(scene_, id_), Pose(), keep_pose); }
 
-void Camera::TakePicture(unsigned outputs) {
-  CameraEntry& c = Entry(scene_, id_);
-  // the backend's Render checks `outputs` and the camera, for every backend
-  internal::RenderState& s = RenderOf(*scene_);
-  // the first picture of a scene needs a render world: build it now
-  if (!s.render_world_built) UpdateRender(*scene_);
-  RenderBackend& backend = GetRenderBackend(*scene_);
-  CameraParams params = GetParams();
-  // render into a fresh picture while an older one is still viewed (from Python)
+namespace {
+
+/// The picture a camera renders into next: its last one, unless that is still viewed (from
+/// Python), then a fresh one.
+std::shared_ptr<Picture> NextPicture(const CameraEntry& c) {
   std::shared_ptr<Picture> picture =
       c.picture && c.picture.use_count() == 1 ? c.picture : std::make_shared<Picture>();
   picture->width = c.width;
   picture->height = c.height;
-  try {
-    backend.Render(s.render_world, params, picture.get(), outputs);
-  } catch (...) {
-    // a half-written picture (Render marks it as holding no outputs) is not the last picture; a
-    // refused argument leaves the last picture as it was
-    if (picture == c.picture && picture->outputs == 0) c.picture.reset();
-    throw;
-  }
-  // a backend that fills the wrong sizes is a bug: refuse its picture
+  return picture;
+}
+
+/// After a backend threw: a half-written picture (Render marks it as holding no outputs) is
+/// not the last picture; a refused argument leaves the last picture as it was.
+void DropIfHalfWritten(CameraEntry& c, const std::shared_ptr<Picture>& picture) {
+  if (picture == c.picture && picture->outputs == 0) c.picture.reset();
+}
+
+/// Keeps `picture` as the camera's last one, taken from X_WC; a backend that filled the wrong
+/// sizes is a bug: its picture is refused.
+void KeepPicture(CameraEntry& c, std::shared_ptr<Picture> picture, unsigned outputs,
+                 const Pose& X_WC, const RenderBackend& backend) {
   size_t n = static_cast<size_t>(c.width) * static_cast<size_t>(c.height);
   auto sized = [&](const auto& v, unsigned bit, size_t channels) {
     return !(outputs & bit) || v.size() == channels * n;
@@ -259,7 +259,64 @@ void Camera::TakePicture(unsigned outputs) {
                 "' returned a picture of the wrong size");
   }
   c.picture = std::move(picture);
-  c.picture_X_WC = params.X_WC;
+  c.picture_X_WC = X_WC;
+}
+
+}  // namespace
+
+void Camera::TakePicture(unsigned outputs) {
+  CameraEntry& c = Entry(scene_, id_);
+  // the backend's Render checks `outputs` and the camera, for every backend
+  internal::RenderState& s = RenderOf(*scene_);
+  // the first picture of a scene needs a render world: build it now
+  if (!s.render_world_built) UpdateRender(*scene_);
+  RenderBackend& backend = GetRenderBackend(*scene_);
+  CameraParams params = GetParams();
+  std::shared_ptr<Picture> picture = NextPicture(c);
+  try {
+    backend.Render(s.render_world, params, picture.get(), outputs);
+  } catch (...) {
+    DropIfHalfWritten(c, picture);
+    throw;
+  }
+  KeepPicture(c, std::move(picture), outputs, params.X_WC, backend);
+}
+
+void TakePictures(const std::vector<Camera>& cameras, unsigned outputs) {
+  if (cameras.empty()) return;
+  Scene* scene = cameras[0].GetScene();
+  for (const Camera& camera : cameras)
+    if (camera.GetScene() != scene)
+      throw Error("TakePictures: camera '" + camera.GetName() +
+                  "' belongs to another scene than camera '" + cameras[0].GetName() + "'");
+  internal::RenderState& s = RenderOf(*scene);
+  if (!s.render_world_built) UpdateRender(*scene);
+  RenderBackend& backend = GetRenderBackend(*scene);
+  std::vector<CameraParams> params;
+  std::vector<std::shared_ptr<Picture>> pictures;
+  std::vector<Picture*> out;
+  for (const Camera& camera : cameras) {
+    params.push_back(camera.GetParams());
+    // a camera given twice renders into one picture per place
+    pictures.push_back(std::make_shared<Picture>());
+    out.push_back(pictures.back().get());
+  }
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    CameraEntry& c = Entry(scene, cameras[i].GetId());
+    bool repeated = false;
+    for (size_t j = 0; j < i; ++j) repeated = repeated || cameras[j].GetId() == cameras[i].GetId();
+    if (!repeated) pictures[i] = NextPicture(c);
+    out[i] = pictures[i].get();
+  }
+  try {
+    backend.RenderMany(s.render_world, params, out, outputs);
+  } catch (...) {
+    for (size_t i = 0; i < cameras.size(); ++i)
+      DropIfHalfWritten(Entry(scene, cameras[i].GetId()), pictures[i]);
+    throw;
+  }
+  for (size_t i = 0; i < cameras.size(); ++i)
+    KeepPicture(Entry(scene, cameras[i].GetId()), pictures[i], outputs, params[i].X_WC, backend);
 }
 
 const Picture& Camera::GetPictureData() const { return PictureOf(Entry(scene_, id_)); }

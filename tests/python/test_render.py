@@ -221,6 +221,39 @@ def test_rasterizer_counters_and_a_batch_of_pictures(scene):
         backend.end_batch()
 
 
+def test_take_pictures_of_a_camera_set_equals_each_picture_alone(scene, cabinet):
+    """scene.take_pictures() renders the cameras together (one upload, read-back through
+    pixel-pack buffers): each camera's pictures equal its take_picture(), for every output and
+    for Color and Position alone (the forward pass); a camera of another scene is refused."""
+    scene.set_render_backend("rasterizer")
+    scene.add_ground()
+    scene.add_directional_light([0.3, 0.2, -1], [2, 2, 2], shadow=True)
+    cams = [scene.add_camera("a", 40, 30, 1.0, 0.05, 10.0),
+            scene.add_camera("b", 24, 24, 0.8, 0.05, 10.0),
+            scene.add_camera("c", 40, 30, 1.2, 0.05, 10.0)]
+    for cam, eye in zip(cams, ([1.5, 0.6, 1.0], [0.2, -1.5, 0.8], [-1.2, 0.8, 1.4])):
+        cam.set_pose(look_at(eye, [0, 0, 0.3]))
+    scene.update_render()
+    names = ["Color", "Albedo", "Normal", "Position", "Segmentation"]
+    for outputs in (None, ["Color", "Position"]):
+        alone = []
+        for cam in cams:
+            cam.take_picture(outputs)
+            alone.append({n: cam.get_picture(n).copy() for n in (outputs or names)})
+        scene.take_pictures(outputs=outputs)  # every camera of the scene
+        for cam, pictures in zip(cams, alone):
+            for n, picture in pictures.items():
+                np.testing.assert_array_equal(cam.get_picture(n), picture, err_msg=n)
+    scene.take_pictures([cams[1]], ["Segmentation"])
+    with pytest.raises(partsim.PartsimError):
+        cams[1].get_picture("Color")  # not rendered this time
+    np.testing.assert_array_equal(cams[0].get_picture("Color"), alone[0]["Color"])
+    other = partsim.Scene()
+    stranger = other.add_camera("s", 8, 8, 1.0, 0.1, 10.0)
+    with pytest.raises(partsim.PartsimError, match="another scene"):
+        scene.take_pictures([cams[0], stranger])
+
+
 def test_render_ids_name_actors_and_links(render_scene, cabinet):
     box = build_box(render_scene, name="crate")
     render_scene.update_render()

@@ -464,6 +464,66 @@ TEST(RasterTest, ShadowMapsAreKeptWhileNothingTheyHoldMoves) {
   }
 }
 
+// RenderMany (a camera set in one submission, read back through pixel-pack buffers) gives each
+// camera the picture Render gives it, to the bit: forward and deferred outputs, cameras of
+// different sizes, a shadowed sun and spot, and Segmentation read back as 16-bit numbers when
+// every id fits and as 32-bit ones when one does not.
+TEST(RasterTest, RenderManyGivesEachCameraItsPicture) {
+  RenderWorld world = ShadowWorld(true);
+  world.lights.push_back(SpotAbove());
+  const std::vector<CameraParams> cameras = {CameraAbove(64, 64, {1.5, 0, 2}),
+                                             CameraAbove(96, 48, {1.6, 0.1, 2.2}),
+                                             CameraAbove(64, 64, {1.4, -0.2, 1.8})};
+  RenderWorld wide = world;  // ids beyond 16 bits
+  wide.instances[1].visual_id = 70000;
+  wide.instances[1].entity_id = 123456;
+  for (const RenderWorld* w : {&world, &wide}) {
+    for (unsigned outputs : {unsigned{kAllOutputs}, unsigned{kColor | kPosition},
+                             unsigned{kSegmentation | kNormal}, unsigned{kPosition}}) {
+      SCOPED_TRACE(outputs);
+      std::unique_ptr<RenderBackend> one = MakeRasterBackend(), many = MakeRasterBackend();
+      std::vector<Picture> pictures(cameras.size());
+      std::vector<Picture*> out;
+      for (Picture& p : pictures) out.push_back(&p);
+      many->RenderMany(*w, cameras, out, outputs);
+      for (size_t i = 0; i < cameras.size(); ++i) {
+        Picture expected;
+        one->Render(*w, cameras[i], &expected, outputs);
+        EXPECT_EQ(pictures[i].outputs, outputs);
+        EXPECT_EQ(pictures[i].width, cameras[i].width);
+        EXPECT_EQ(pictures[i].color, expected.color);
+        EXPECT_EQ(pictures[i].albedo, expected.albedo);
+        EXPECT_EQ(pictures[i].normal, expected.normal);
+        EXPECT_EQ(pictures[i].position, expected.position);
+        EXPECT_EQ(pictures[i].segmentation, expected.segmentation);
+      }
+      EXPECT_EQ(many->Counters().pictures, cameras.size());
+      if (w == &wide && (outputs & kSegmentation)) {
+        // the wide ids came back whole
+        bool seen = false;
+        for (size_t k = 0; k < pictures[0].segmentation.size(); k += 2)
+          seen = seen || (pictures[0].segmentation[k] == 70000 &&
+                          pictures[0].segmentation[k + 1] == 123456);
+        EXPECT_TRUE(seen);
+      }
+    }
+  }
+  // arguments are checked before anything is drawn; the error names the camera
+  std::vector<Picture> two(2);
+  std::vector<Picture*> out = {&two[0], &two[1]};
+  two[0].outputs = kColor;
+  EXPECT_THROW(Backend().RenderMany(world, cameras, out), Error);  // 3 cameras, 2 pictures
+  std::vector<CameraParams> bad = {cameras[0], cameras[1]};
+  bad[1].width = 0;
+  try {
+    Backend().RenderMany(world, bad, out);
+    FAIL() << "a camera of width 0 was rendered";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 1 of 2"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(two[0].outputs, unsigned{kColor});  // untouched
+}
+
 // shadow_map_size = 0 sizes the maps from the picture: the same shadow, drawn with maps of
 // 512 texels for a 64 x 64 picture; 2048 for 1024 x 1024 and larger
 TEST(RasterTest, AutomaticShadowMapSizeFollowsThePicture) {

@@ -127,6 +127,14 @@ class RenderBackend {
   /// the backend throws while rendering, out->outputs is 0 (the picture holds nothing usable).
   void Render(const RenderWorld& world, const CameraParams& camera, Picture* out,
               unsigned outputs = kAllOutputs);
+  /// Pictures of one world from several cameras (a camera set), `out[i]` from `cameras[i]`, each
+  /// the same as Render would give it. A backend may submit them together: the rasterizer
+  /// uploads the world once, draws every camera and reads the pictures back through pixel-pack
+  /// buffers, so that drawing the next camera overlaps the copy of the last. Every argument is
+  /// checked before anything is drawn (an error names the camera's index) and then the
+  /// pictures hold nothing until they are filled.
+  void RenderMany(const RenderWorld& world, const std::vector<CameraParams>& cameras,
+                  const std::vector<Picture*>& out, unsigned outputs = kAllOutputs);
 
   /// Largest width or height of a picture (pixels).
   static constexpr int kMaxPictureSize = 16384;
@@ -136,6 +144,10 @@ class RenderBackend {
   /// `outputs` (it may fill others too; Render empties them afterwards).
   virtual void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
                         unsigned outputs) = 0;
+  /// The backend's work for RenderMany, on checked arguments; DoRender for each camera unless
+  /// a backend does better.
+  virtual void DoRenderMany(const RenderWorld& world, const std::vector<CameraParams>& cameras,
+                            const std::vector<Picture*>& out, unsigned outputs);
   /// Pictures drawn so far (Render counts them).
   uint64_t pictures_drawn() const { return pictures_; }
 

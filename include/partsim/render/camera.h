@@ -118,4 +118,11 @@ struct RenderVisualInfo {
   std::string name;  ///< the visual's name (e.g. a PartNet-Mobility part "handle-15")
 };
 
+/// TakePicture of each camera (all of one scene), the pictures rendered together by the scene's
+/// backend (RenderBackend::RenderMany: the rasterizer uploads the world once and overlaps the
+/// read-back of one picture with the drawing of the next); each picture is the one TakePicture
+/// would give. Throws partsim::Error naming a camera of another scene, or what Render throws
+/// (naming the camera's index).
+void TakePictures(const std::vector<Camera>& cameras, unsigned outputs = kAllOutputs);
+
 }  // namespace partsim

@@ -93,16 +93,27 @@ class RasterBackend final : public RenderBackend {
  protected:
   void DoRender(const RenderWorld& world, const CameraParams& camera, Picture* out,
                 unsigned outputs) override {
-    if (batch_depth_ > 0) {
-      CheckBatchThread();
-      // current since BeginBatch, unless another backend took this thread's context meanwhile
-      // (a check of the current context, without a release)
-      context_->MakeCurrent();
-      Draw(world, camera, out, outputs);
-    } else {
-      internal::CurrentContextScope current(*context_);
-      Draw(world, camera, out, outputs);
-    }
+    WithContext([&] { Draw(world, camera, out, outputs); });
+  }
+
+  void DoRenderMany(const RenderWorld& world, const std::vector<CameraParams>& cameras,
+                    const std::vector<Picture*>& out, unsigned outputs) override {
+    auto draw_all = [&] {
+      // the world uploaded once; each picture read into pixel-pack buffers as soon as it is
+      // drawn, the copies collected once every picture is drawn
+      resources_.Sync(world);
+      const Eigen::AlignedBox3d scene_box = resources_.UpdateBounds(world);
+      const bool narrow = NarrowIds(world);
+      read_back_.BeginQueue();
+      for (const CameraParams& camera : cameras) {
+        if (DrawTargets(world, camera, scene_box, outputs))
+          read_back_.QueueForward(passes_.targets(), camera, outputs);
+        else
+          read_back_.QueueDeferred(passes_.targets(), outputs, narrow);
+      }
+      for (size_t i = 0; i < cameras.size(); ++i) read_back_.Collect(i, out[i]);
+    };
+    WithContext(draw_all);
   }
 
  private:
@@ -113,10 +124,41 @@ class RasterBackend final : public RenderBackend {
           "pictures of a batch come from the thread that began it)");
   }
 
+  /// Runs `fn` with the GL context current: kept current since BeginBatch in a batch (made
+  /// current again, without a release, in case another backend took this thread's context
+  /// meanwhile), else taken for the call and released.
+  template <typename Fn>
+  void WithContext(const Fn& fn) {
+    if (batch_depth_ > 0) {
+      CheckBatchThread();
+      context_->MakeCurrent();
+      fn();
+    } else {
+      internal::CurrentContextScope current(*context_);
+      fn();
+    }
+  }
+
+  /// Whether every id of the world fits in 16 bits (Segmentation then reads back narrow).
+  static bool NarrowIds(const RenderWorld& world) {
+    for (const RenderInstance& i : world.instances)
+      if (i.visual_id > 0xffff || i.entity_id > 0xffff) return false;
+    return true;
+  }
+
   void Draw(const RenderWorld& world, const CameraParams& camera, Picture* out, unsigned outputs) {
-    passes_.targets().Ensure(camera.width, camera.height);
     resources_.Sync(world);
-    Eigen::AlignedBox3d scene_box = resources_.UpdateBounds(world);
+    const Eigen::AlignedBox3d scene_box = resources_.UpdateBounds(world);
+    if (DrawTargets(world, camera, scene_box, outputs))
+      read_back_.Forward(passes_.targets(), camera, outputs, out);
+    else
+      read_back_.Deferred(passes_.targets(), outputs, NarrowIds(world), out);
+  }
+
+  /// Draws a picture of the synced world into the targets; true when it took the forward path.
+  bool DrawTargets(const RenderWorld& world, const CameraParams& camera,
+                   const Eigen::AlignedBox3d& scene_box, unsigned outputs) {
+    passes_.targets().Ensure(camera.width, camera.height);
 
     // shadows and lights only matter for colour
     int num_shadows = 0;
@@ -129,12 +171,11 @@ class RasterBackend final : public RenderBackend {
     LightUniforms lights = passes_.PrepareLights(world, camera);
     if (UsesForwardPath(outputs)) {
       passes_.Forward(world, camera, lights, num_shadows);
-      read_back_.Forward(passes_.targets(), camera, outputs, out);
-    } else {
-      passes_.Gbuffer(world, camera);
-      if (outputs & kColor) passes_.Lighting(world, lights, num_shadows);
-      read_back_.Deferred(passes_.targets(), outputs, out);
+      return true;
     }
+    passes_.Gbuffer(world, camera);
+    if (outputs & kColor) passes_.Lighting(world, lights, num_shadows);
+    return false;
   }
 
   // the forward path: only Color and Position asked for, and the built-in shaders
@@ -145,6 +186,7 @@ class RasterBackend final : public RenderBackend {
   }
 
   void DeleteGlObjects() {
+    read_back_.Delete();
     resources_.Delete();
     passes_.Delete();
     shadows_.Delete();

@@ -44,12 +44,7 @@ void ReadBack::Forward(const Targets& targets, const CameraParams& camera, unsig
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
   const Eigen::Matrix4d P = FlippedProjection(camera);
   const int parts = (outputs & kPosition) ? ConversionParts(n) : 0;
-  auto convert = [&](int part) {
-    internal::PositionFromDepth(
-        P, width, height, window_depth_.data(), out->position.data(),
-        static_cast<int>(static_cast<int64_t>(height) * part / parts),
-        static_cast<int>(static_cast<int64_t>(height) * (part + 1) / parts));
-  };
+  auto convert = [&](int part) { ConvertRows(P, width, height, part, parts, out); };
   bool started = false;
   if (outputs & kPosition) {
     Read(targets, targets.forward_fbo(), GL_COLOR_ATTACHMENT0, GL_DEPTH_COMPONENT, GL_FLOAT,
@@ -92,7 +87,30 @@ int ReadBack::ConversionWorkers() {
   return std::clamp(cores - 1, 1, 4);
 }
 
-void ReadBack::Deferred(const Targets& targets, unsigned outputs, Picture* out) {
+void ReadBack::ConvertRows(const Eigen::Matrix4d& P, int width, int height, int part, int parts,
+                           Picture* out) const {
+  internal::PositionFromDepth(P, width, height, window_depth_.data(), out->position.data(),
+                              static_cast<int>(static_cast<int64_t>(height) * part / parts),
+                              static_cast<int>(static_cast<int64_t>(height) * (part + 1) / parts));
+}
+
+void ReadBack::ConvertDepth(const CameraParams& camera, int width, int height, Picture* out) {
+  const Eigen::Matrix4d P = FlippedProjection(camera);
+  const int parts = ConversionParts(static_cast<size_t>(width) * height);
+  auto convert = [&](int part) { ConvertRows(P, width, height, part, parts, out); };
+  if (parts > 1) {
+    try {
+      conversion_workers_.Start(parts, convert);
+      conversion_workers_.Wait();
+      return;
+    } catch (const std::system_error&) {
+      // no thread to be had: this thread converts
+    }
+  }
+  for (int part = 0; part < parts; ++part) convert(part);
+}
+
+void ReadBack::Deferred(const Targets& targets, unsigned outputs, bool narrow_ids, Picture* out) {
   const int width = targets.width(), height = targets.height();
   size_t n = static_cast<size_t>(width) * height;
   out->width = width;
@@ -120,13 +138,149 @@ void ReadBack::Deferred(const Targets& targets, unsigned outputs, Picture* out) 
     Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetPosition, GL_RGBA, GL_FLOAT,
          out->position.data(), out->position.size() * sizeof(float));
   }
-  if (outputs & kSegmentation) {
+  if ((outputs & kSegmentation) && narrow_ids) {
+    // ids below 65536 come back exactly as 16-bit numbers: half the bytes
+    narrow_ids_.resize(n * 2);
+    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER,
+         GL_UNSIGNED_SHORT, narrow_ids_.data(), narrow_ids_.size() * sizeof(uint16_t));
+    std::copy(narrow_ids_.begin(), narrow_ids_.end(), out->segmentation.begin());
+  } else if (outputs & kSegmentation) {
     Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER,
          GL_UNSIGNED_INT, out->segmentation.data(), out->segmentation.size() * sizeof(uint32_t));
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   GLenum err = glGetError();
   if (err == GL_OUT_OF_MEMORY) throw Error("rasterizer: out of GPU memory");
+}
+
+void ReadBack::BeginQueue() {
+  queued_.clear();
+  pool_used_ = 0;
+}
+
+void ReadBack::Queue(const Targets& targets, GLuint fbo, GLenum attachment, GLenum format,
+                     GLenum type, size_t bytes, unsigned what, bool narrow, Queued* q) {
+  if (pool_used_ == pool_.size()) {
+    GLuint b = 0;
+    glCreateBuffers(1, &b);
+    pool_.push_back({b, 0});
+  }
+  auto& [buffer, size] = pool_[pool_used_++];
+  if (size < bytes) {
+    glNamedBufferData(buffer, static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_READ);
+    size = bytes;
+  }
+  glNamedFramebufferReadBuffer(fbo, attachment);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, buffer);
+  glReadnPixels(0, 0, targets.width(), targets.height(), format, type, static_cast<GLsizei>(bytes),
+                nullptr);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  q->reads.push_back({what, buffer, bytes, narrow});
+}
+
+void ReadBack::QueueForward(const Targets& targets, const CameraParams& camera, unsigned outputs) {
+  Queued q;
+  q.forward = true;
+  q.camera = camera;
+  q.outputs = outputs;
+  q.width = targets.width();
+  q.height = targets.height();
+  const size_t n = static_cast<size_t>(q.width) * q.height;
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  if (outputs & kPosition)
+    Queue(targets, targets.forward_fbo(), GL_COLOR_ATTACHMENT0, GL_DEPTH_COMPONENT, GL_FLOAT,
+          n * sizeof(float), 0, false, &q);
+  if (outputs & kColor)
+    Queue(targets, targets.forward_fbo(), GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT,
+          n * 4 * sizeof(float), kColor, false, &q);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  queued_.push_back(std::move(q));
+}
+
+void ReadBack::QueueDeferred(const Targets& targets, unsigned outputs, bool narrow_ids) {
+  Queued q;
+  q.outputs = outputs;
+  q.width = targets.width();
+  q.height = targets.height();
+  const size_t n = static_cast<size_t>(q.width) * q.height;
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  const GLuint g = targets.gbuffer_fbo();
+  if (outputs & kColor)
+    Queue(targets, targets.color_fbo(), GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT,
+          n * 4 * sizeof(float), kColor, false, &q);
+  if (outputs & kAlbedo)
+    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetAlbedo, GL_RGBA, GL_FLOAT,
+          n * 4 * sizeof(float), kAlbedo, false, &q);
+  if (outputs & kNormal)
+    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetNormal, GL_RGBA, GL_FLOAT,
+          n * 4 * sizeof(float), kNormal, false, &q);
+  if (outputs & kPosition)
+    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetPosition, GL_RGBA, GL_FLOAT,
+          n * 4 * sizeof(float), kPosition, false, &q);
+  if (outputs & kSegmentation)
+    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER,
+          narrow_ids ? GL_UNSIGNED_SHORT : GL_UNSIGNED_INT,
+          n * 2 * (narrow_ids ? sizeof(uint16_t) : sizeof(uint32_t)), kSegmentation, narrow_ids,
+          &q);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  queued_.push_back(std::move(q));
+}
+
+void ReadBack::Collect(size_t index, Picture* out) {
+  const Queued& q = queued_.at(index);
+  const size_t n = static_cast<size_t>(q.width) * q.height;
+  out->width = q.width;
+  out->height = q.height;
+  internal::KeepOutputs(q.outputs, out);
+  for (const QueuedRead& r : q.reads) {
+    void* dst = nullptr;
+    switch (r.what) {
+      case 0:
+        window_depth_.resize(n);
+        dst = window_depth_.data();
+        break;
+      case kColor:
+        out->color.resize(n * 4);
+        dst = out->color.data();
+        break;
+      case kAlbedo:
+        out->albedo.resize(n * 4);
+        dst = out->albedo.data();
+        break;
+      case kNormal:
+        out->normal.resize(n * 4);
+        dst = out->normal.data();
+        break;
+      case kPosition:
+        out->position.resize(n * 4);
+        dst = out->position.data();
+        break;
+      case kSegmentation:
+        out->segmentation.resize(n * 2);
+        if (r.narrow) narrow_ids_.resize(n * 2);
+        dst = r.narrow ? static_cast<void*>(narrow_ids_.data()) : out->segmentation.data();
+        break;
+      default:
+        break;
+    }
+    glGetNamedBufferSubData(r.buffer, 0, static_cast<GLsizeiptr>(r.bytes), dst);
+    if (r.what == kSegmentation && r.narrow)
+      std::copy(narrow_ids_.begin(), narrow_ids_.end(), out->segmentation.begin());
+  }
+  if (q.forward && (q.outputs & kPosition)) {
+    out->position.resize(n * 4);
+    ConvertDepth(q.camera, q.width, q.height, out);
+  }
+  GLenum err = glGetError();
+  if (err == GL_OUT_OF_MEMORY) throw Error("rasterizer: out of GPU memory");
+}
+
+void ReadBack::Delete() {
+  for (auto& [buffer, size] : pool_) glDeleteBuffers(1, &buffer);
+  pool_.clear();
+  queued_.clear();
+  pool_used_ = 0;
 }
 
 }  // namespace partsim::internal::raster
