@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <future>
 #include <memory>
@@ -522,6 +523,39 @@ TEST(RasterTest, RenderManyGivesEachCameraItsPicture) {
     EXPECT_NE(std::string(e.what()).find("camera 1 of 2"), std::string::npos) << e.what();
   }
   EXPECT_EQ(two[0].outputs, unsigned{kColor});  // untouched
+}
+
+// With the built-in G-buffer shader the deferred path reads Position back as x, y, z (w = -z is
+// set on the CPU): the same bytes as a backend given that shader as a custom one, which reads all
+// four channels, alone and through RenderMany.
+TEST(RasterTest, PositionReadAsXyzEqualsTheFourChannels) {
+  const std::string dir = std::string(PARTSIM_SOURCE_DIR) + "/shaders/";
+  RasterOptions custom;
+  custom.gbuffer_fragment_shader =
+      "#version 450 core\n" + ReadFile(dir + "surface.glsl") + ReadFile(dir + "gbuffer_main.glsl");
+  std::unique_ptr<RenderBackend> four = MakeRasterBackend(custom), xyz = MakeRasterBackend();
+  RenderWorld world = ShadowWorld(false);
+  // high enough to see past the ground's edges
+  const std::vector<CameraParams> cameras = {CameraAbove(48, 40, {1.5, 0, 8}),
+                                             CameraAbove(32, 32, {1.2, 0.3, 9})};
+  for (unsigned outputs : {unsigned{kAllOutputs}, unsigned{kPosition | kNormal}}) {
+    std::vector<Picture> many(cameras.size());
+    std::vector<Picture*> out = {&many[0], &many[1]};
+    xyz->RenderMany(world, cameras, out, outputs);
+    for (size_t i = 0; i < cameras.size(); ++i) {
+      Picture a, b;
+      four->Render(world, cameras[i], &a, outputs);
+      xyz->Render(world, cameras[i], &b, outputs);
+      ASSERT_EQ(a.position.size(), b.position.size());
+      EXPECT_EQ(0, std::memcmp(a.position.data(), b.position.data(), a.position.size() * 4));
+      EXPECT_EQ(0, std::memcmp(a.position.data(), many[i].position.data(), a.position.size() * 4));
+      // both a surface and the background are in the picture
+      int seen = 0, empty = 0;
+      for (size_t k = 3; k < b.position.size(); k += 4) (b.position[k] > 0 ? seen : empty)++;
+      EXPECT_GT(seen, 0);
+      EXPECT_GT(empty, 0);
+    }
+  }
 }
 
 // shadow_map_size = 0 sizes the maps from the picture: the same shadow, drawn with maps of

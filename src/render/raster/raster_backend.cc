@@ -38,7 +38,8 @@ class RasterBackend final : public RenderBackend {
       : options_(options),
         programs_(options),
         shadows_(options.shadow_map_size, options.reuse_shadow_maps),
-        passes_(programs_, resources_, shadows_) {
+        passes_(programs_, resources_, shadows_),
+        read_back_(options.gbuffer_fragment_shader.empty()) {
     if (options_.shadow_map_size != 0 &&
         (options_.shadow_map_size < 16 || options_.shadow_map_size > 16384)) {
       throw Error("RasterOptions::shadow_map_size must be 0 (automatic) or in [16, 16384], got " +

@@ -24,6 +24,20 @@ void Read(const Targets& targets, GLuint fbo, GLenum attachment, GLenum format, 
                 dst);
 }
 
+// Position read back as x, y, z triples at the front of `p` (n pixels): spread to x, y, z, w
+// with w = -z, the depth the built-in G-buffer shader writes (0 where nothing was drawn), from
+// the last pixel back so that no triple is overwritten before it is read.
+void SpreadPosition(std::vector<float>* p, size_t n) {
+  float* d = p->data();
+  for (size_t i = n; i-- > 0;) {
+    const float x = d[3 * i], y = d[3 * i + 1], z = d[3 * i + 2];
+    d[4 * i] = x;
+    d[4 * i + 1] = y;
+    d[4 * i + 2] = z;
+    d[4 * i + 3] = z < 0 ? -z : 0.0f;
+  }
+}
+
 }  // namespace
 
 // The depth buffer is read back first and converted on worker threads while this thread reads the
@@ -135,8 +149,10 @@ void ReadBack::Deferred(const Targets& targets, unsigned outputs, bool narrow_id
          out->normal.data(), out->normal.size() * sizeof(float));
   }
   if (outputs & kPosition) {
-    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetPosition, GL_RGBA, GL_FLOAT,
-         out->position.data(), out->position.size() * sizeof(float));
+    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetPosition,
+         xyz_position_ ? GL_RGB : GL_RGBA, GL_FLOAT, out->position.data(),
+         out->position.size() * sizeof(float));
+    if (xyz_position_) SpreadPosition(&out->position, n);
   }
   if ((outputs & kSegmentation) && narrow_ids) {
     // ids below 65536 come back exactly as 16-bit numbers: half the bytes
@@ -216,8 +232,8 @@ void ReadBack::QueueDeferred(const Targets& targets, unsigned outputs, bool narr
     Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetNormal, GL_RGBA, GL_FLOAT,
           n * 4 * sizeof(float), kNormal, false, &q);
   if (outputs & kPosition)
-    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetPosition, GL_RGBA, GL_FLOAT,
-          n * 4 * sizeof(float), kPosition, false, &q);
+    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetPosition, xyz_position_ ? GL_RGB : GL_RGBA,
+          GL_FLOAT, n * (xyz_position_ ? 3 : 4) * sizeof(float), kPosition, xyz_position_, &q);
   if (outputs & kSegmentation)
     Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER,
           narrow_ids ? GL_UNSIGNED_SHORT : GL_UNSIGNED_INT,
@@ -267,6 +283,7 @@ void ReadBack::Collect(size_t index, Picture* out) {
     glGetNamedBufferSubData(r.buffer, 0, static_cast<GLsizeiptr>(r.bytes), dst);
     if (r.what == kSegmentation && r.narrow)
       std::copy(narrow_ids_.begin(), narrow_ids_.end(), out->segmentation.begin());
+    if (r.what == kPosition && r.narrow) SpreadPosition(&out->position, n);
   }
   if (q.forward && (q.outputs & kPosition)) {
     out->position.resize(n * 4);

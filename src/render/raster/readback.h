@@ -17,7 +17,10 @@ namespace partsim::internal::raster {
 /// worker threads.
 class ReadBack {
  public:
-  ReadBack() = default;
+  /// `xyz_position`: the G-buffer's Position is (x, y, z, -z) as the built-in shader writes it,
+  /// so the deferred path reads x, y, z alone (three quarters of the bytes) and sets w here;
+  /// false (custom G-buffer shaders) reads all four.
+  explicit ReadBack(bool xyz_position = true) : xyz_position_(xyz_position) {}
   ReadBack(const ReadBack&) = delete;
   ReadBack& operator=(const ReadBack&) = delete;
 
@@ -51,7 +54,7 @@ class ReadBack {
     unsigned what = 0;  ///< a PictureOutput bit, or 0 for the forward path's depth
     GLuint buffer = 0;
     size_t bytes = 0;
-    bool narrow = false;  ///< Segmentation as 16-bit numbers
+    bool narrow = false;  ///< Segmentation as 16-bit numbers, Position as x, y, z
   };
   struct Queued {
     bool forward = false;
@@ -71,6 +74,7 @@ class ReadBack {
   int ConversionParts(size_t n) const;
   static int ConversionWorkers();
 
+  bool xyz_position_ = true;
   std::vector<float> window_depth_;   // forward path: the depth buffer read back
   std::vector<uint16_t> narrow_ids_;  // Segmentation read as 16-bit numbers
   WorkerPool conversion_workers_{ConversionWorkers()};
