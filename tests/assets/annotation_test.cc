@@ -214,7 +214,7 @@ Annotated AnnotateFromTruth(const GeneratedObject& o, const fs::path& dir) {
 
 TEST(AnnotationTest, EveryCategoryAnnotatedFromItsTruthExportsTheTruth) {
   const fs::path root = TempDir("all");
-  int hinges = 0, sliders = 0, screws = 0;
+  int hinges = 0, sliders = 0, screws = 0, named = 0;
   for (const std::string& category : GeneratorCategories()) {
     SCOPED_TRACE(category);
     const GeneratedObject o = GenerateObject(category, 0, 7);
@@ -250,6 +250,10 @@ TEST(AnnotationTest, EveryCategoryAnnotatedFromItsTruthExportsTheTruth) {
       for (const PartNetPart& p : e.parts) got_parts.insert(p.id);
       EXPECT_EQ(got_parts, want_parts);
       EXPECT_EQ(e.joint, l.joint) << "link_" << e.id;
+      if (e.partnet_name == l.partnet_name) {  // a link named as the generator names it
+        ++named;
+        EXPECT_EQ(e.semantic_label, l.name);  // "drawer", "rotation_door": what tasks look for
+      }
       if (l.parent < 0) {
         EXPECT_EQ(e.parent, -1);
         continue;
@@ -273,6 +277,8 @@ TEST(AnnotationTest, EveryCategoryAnnotatedFromItsTruthExportsTheTruth) {
     // the part hierarchy and the meshes are the input's
     EXPECT_EQ(ReadText(dir / "object" / "result.json"), ReadText(dir / "task" / "result.json"));
   }
+  // the movable-part vocabulary comes back for links the input names as the dataset does
+  EXPECT_GT(named, 100);
   // the categories cover every kind of joint
   EXPECT_GT(hinges, 20);
   EXPECT_GT(sliders, 5);

@@ -165,6 +165,7 @@ def test_annotate_every_object_through_the_services_with_a_kill_in_the_middle(ob
                                                                               tmp_path):
     root, names = objects
     load = require("partsim", "the partsim module")
+    exported = {}
     for name in names:
         truth = Truth(root / "truth" / name)
         session = tmp_path / name
@@ -226,6 +227,19 @@ def test_annotate_every_object_through_the_services_with_a_kill_in_the_middle(ob
         loader = scene.create_partnet_mobility_loader()
         loader.strict = True
         loader.load(folder)
+        exported[name] = folder
+    # the annotated cabinet's drawers or doors carry the labels the tasks look for: the
+    # heuristic solver pulls or opens one
+    cabinet = [n for n in names if '"StorageFurniture"' in (root / "tasks" / n /
+                                                            "meta.json").read_text()]
+    assert cabinet
+    shutil.copytree(exported[cabinet[0]], tmp_path / "dataset" / cabinet[0])
+    with open(os.path.join(exported[cabinet[0]], "semantics.txt")) as f:
+        task = "drawer" if " drawer\n" in f.read() else "door"
+    r = subprocess.run([CLI, "tasks", "evaluate", "--task", task, "--dataset",
+                        str(tmp_path / "dataset"), "--no-cameras"], capture_output=True,
+                       text=True, timeout=300)
+    assert r.returncode == 0 and "1 / 1 succeeded" in r.stdout, r.stdout + r.stderr
 
 
 def test_review_mode_records_a_decision_per_joint(objects, tmp_path):
@@ -360,6 +374,12 @@ def test_the_real_bottle_annotated_from_its_own_annotation(tmp_path):
                 assert g["jointData"]["axis"][key] == \
                     pytest.approx(e["jointData"]["axis"][key], abs=1e-6)
             assert g["jointData"]["limit"] == pytest.approx(e["jointData"]["limit"], abs=1e-6)
+    # semantics.txt in the dataset's movable-part vocabulary ("slider+ rotation_lid",
+    # "free bottle_body"), the links numbered in another order
+    def kinds_and_labels(folder):
+        with open(os.path.join(folder, "semantics.txt")) as f:
+            return sorted(tuple(line.split()[1:]) for line in f if line.strip())
+    assert kinds_and_labels(folder) == kinds_and_labels(src)
     with open(os.path.join(src, "result.json"), "rb") as a, \
             open(os.path.join(folder, "result.json"), "rb") as b:
         assert a.read() == b.read()

@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 
+#include "assets/generator/categories.h"
 #include "assets/generator/writer.h"
 #include "core/atomic_file.h"
 #include "core/file_read.h"
@@ -141,7 +142,11 @@ void ExportAnnotation(const AnnotationSession& session, const std::string& dir) 
     g.parent = parent;
     g.joint = !l.joint.empty() ? l.joint : l.root == "free" ? "free" : "heavy";
     g.partnet_name = in.nodes[l.units[0]].name;
-    g.name = g.partnet_name;
+    // the movable-part vocabulary where the generator's tables know the name ("drawer",
+    // "rotation_door", "furniture_body", ...), which tasks look links up by; else the name
+    g.name =
+        internal::gen::SemanticLabelOf(in.category, g.partnet_name, parent < 0, l.joint, l.rotates);
+    if (g.name.empty()) g.name = g.partnet_name;
     g.axis_origin = l.origin;
     g.axis_direction = l.direction;
     g.limit_a = l.lower;

@@ -68,5 +68,12 @@ void BuildStapler(ObjectBuilder& b, Rng& rng);
 /// category's tables; the body (the link joined to base) gets the category's body label. Throws
 /// partsim::Error naming a (category, key) that has no entry.
 void ApplyLabels(GeneratedObject* object);
+/// The semantics.txt label the tables give a link with PartNet name `partnet_name` in
+/// `category`: the category's body label for a root, else the label of the first entry (the
+/// category's own, then the defaults) with that PartNet name, its '%' turned into the motion
+/// ("rotation" for hinges and sliders that also turn, "translation" for sliders). "" when the
+/// tables have none (the annotation tool's export then uses the PartNet name).
+std::string SemanticLabelOf(const std::string& category, const std::string& partnet_name, bool root,
+                            const std::string& joint, bool rotates);
 
 }  // namespace partsim::internal::gen

@@ -91,6 +91,7 @@ const PartLabel kParts[] = {
     {"Lamp", "head", "head", "lamp_head"},
     {"Lamp", "rotation_bar", "rotation_bar", "lamp_arm"},
     {"Phone", "screen", "rotation_screen", "screen"},
+    {"Display", "screen", "rotation_screen", "screen"},  // (its builder says rotation_screen)
     {"Safe", "handle", "knob", "handle"},
     {"Stapler", "body", "stapler_body", "body"},
     {"Toaster", "slider", "slider", "lever"},
@@ -138,7 +139,30 @@ const PartLabel* FindPart(const std::string& category, const std::string& key) {
   return nullptr;
 }
 
+/// '%' of a label turned into the motion of a link.
+std::string WithMotion(std::string label, const std::string& joint, bool rotates) {
+  if (size_t k = label.find('%'); k != std::string::npos) {
+    const bool translation = joint == "slider" && !rotates;
+    label.replace(k, 1, translation ? "translation" : "rotation");
+  }
+  return label;
+}
+
 }  // namespace
+
+std::string SemanticLabelOf(const std::string& category, const std::string& partnet_name, bool root,
+                            const std::string& joint, bool rotates) {
+  if (root) {
+    for (const BodyLabel& b : kBodies)
+      if (category == b.category) return b.label;
+    return "";
+  }
+  for (const char* c : {category.c_str(), "*"})
+    for (const PartLabel& p : kParts)
+      if (partnet_name == p.partnet && std::strcmp(c, p.category) == 0)
+        return WithMotion(p.label, joint, rotates);
+  return "";
+}
 
 void ApplyLabels(GeneratedObject* object) {
   for (GeneratedLink& l : object->links) {
@@ -156,12 +180,7 @@ void ApplyLabels(GeneratedObject* object) {
     if (!p) {
       throw Error("generator: no label for " + object->category + " link key '" + l.name + "'");
     }
-    std::string label = p->label;
-    if (size_t k = label.find('%'); k != std::string::npos) {
-      bool translation = l.joint == "slider" && !l.rotates;
-      label.replace(k, 1, translation ? "translation" : "rotation");
-    }
-    l.name = label;
+    l.name = WithMotion(p->label, l.joint, l.rotates);
     l.partnet_name = p->partnet;
   }
 }
