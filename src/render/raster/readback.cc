@@ -124,45 +124,71 @@ void ReadBack::ConvertDepth(const CameraParams& camera, int width, int height, P
   for (int part = 0; part < parts; ++part) convert(part);
 }
 
-void ReadBack::Deferred(const Targets& targets, unsigned outputs, bool narrow_ids, Picture* out) {
-  const int width = targets.width(), height = targets.height();
-  size_t n = static_cast<size_t>(width) * height;
-  out->width = width;
-  out->height = height;
-  internal::KeepOutputs(outputs, out);
-  if (outputs & kColor) out->color.resize(n * 4);
-  if (outputs & kAlbedo) out->albedo.resize(n * 4);
-  if (outputs & kNormal) out->normal.resize(n * 4);
-  if (outputs & kPosition) out->position.resize(n * 4);
-  if (outputs & kSegmentation) out->segmentation.resize(n * 2);
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  if (outputs & kColor) {
-    Read(targets, targets.color_fbo(), GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, out->color.data(),
-         out->color.size() * sizeof(float));
+std::vector<ReadBack::TargetRead> ReadBack::DeferredReads(const Targets& targets, unsigned outputs,
+                                                          bool narrow_ids) const {
+  const GLuint g = targets.gbuffer_fbo();
+  const size_t rgba = 4 * sizeof(float);
+  std::vector<TargetRead> reads;
+  if (outputs & kColor)
+    reads.push_back({kColor, targets.color_fbo(), GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, rgba});
+  if (outputs & kAlbedo)
+    reads.push_back({kAlbedo, g, GL_COLOR_ATTACHMENT0 + kTargetAlbedo, GL_RGBA, GL_FLOAT, rgba});
+  if (outputs & kNormal)
+    reads.push_back({kNormal, g, GL_COLOR_ATTACHMENT0 + kTargetNormal, GL_RGBA, GL_FLOAT, rgba});
+  if (outputs & kPosition)
+    reads.push_back({kPosition, g, GL_COLOR_ATTACHMENT0 + kTargetPosition,
+                     GLenum(xyz_position_ ? GL_RGB : GL_RGBA), GL_FLOAT,
+                     (xyz_position_ ? 3 : 4) * sizeof(float), xyz_position_});
+  // ids below 65536 come back exactly as 16-bit numbers: half the bytes
+  if (outputs & kSegmentation)
+    reads.push_back({kSegmentation, g, GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER,
+                     GLenum(narrow_ids ? GL_UNSIGNED_SHORT : GL_UNSIGNED_INT),
+                     2 * (narrow_ids ? sizeof(uint16_t) : sizeof(uint32_t)), narrow_ids});
+  return reads;
+}
+
+void* ReadBack::Destination(unsigned what, bool narrow, size_t n, Picture* out) {
+  switch (what) {
+    case kColor:
+      out->color.resize(n * 4);
+      return out->color.data();
+    case kAlbedo:
+      out->albedo.resize(n * 4);
+      return out->albedo.data();
+    case kNormal:
+      out->normal.resize(n * 4);
+      return out->normal.data();
+    case kPosition:
+      out->position.resize(n * 4);
+      return out->position.data();
+    case kSegmentation:
+      out->segmentation.resize(n * 2);
+      if (!narrow) return out->segmentation.data();
+      narrow_ids_.resize(n * 2);
+      return narrow_ids_.data();
+    default:  // the forward path's depth
+      window_depth_.resize(n);
+      return window_depth_.data();
   }
-  if (outputs & kAlbedo) {
-    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetAlbedo, GL_RGBA, GL_FLOAT,
-         out->albedo.data(), out->albedo.size() * sizeof(float));
-  }
-  if (outputs & kNormal) {
-    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetNormal, GL_RGBA, GL_FLOAT,
-         out->normal.data(), out->normal.size() * sizeof(float));
-  }
-  if (outputs & kPosition) {
-    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetPosition,
-         xyz_position_ ? GL_RGB : GL_RGBA, GL_FLOAT, out->position.data(),
-         out->position.size() * sizeof(float));
-    if (xyz_position_) SpreadPosition(&out->position, n);
-  }
-  if ((outputs & kSegmentation) && narrow_ids) {
-    // ids below 65536 come back exactly as 16-bit numbers: half the bytes
-    narrow_ids_.resize(n * 2);
-    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER,
-         GL_UNSIGNED_SHORT, narrow_ids_.data(), narrow_ids_.size() * sizeof(uint16_t));
+}
+
+void ReadBack::Widen(unsigned what, bool narrow, size_t n, Picture* out) {
+  if (!narrow) return;
+  if (what == kSegmentation)
     std::copy(narrow_ids_.begin(), narrow_ids_.end(), out->segmentation.begin());
-  } else if (outputs & kSegmentation) {
-    Read(targets, targets.gbuffer_fbo(), GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER,
-         GL_UNSIGNED_INT, out->segmentation.data(), out->segmentation.size() * sizeof(uint32_t));
+  if (what == kPosition) SpreadPosition(&out->position, n);
+}
+
+void ReadBack::Deferred(const Targets& targets, unsigned outputs, bool narrow_ids, Picture* out) {
+  const size_t n = static_cast<size_t>(targets.width()) * targets.height();
+  out->width = targets.width();
+  out->height = targets.height();
+  internal::KeepOutputs(outputs, out);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  for (const TargetRead& r : DeferredReads(targets, outputs, narrow_ids)) {
+    Read(targets, r.fbo, r.attachment, r.format, r.type, Destination(r.what, r.narrow, n, out),
+         n * r.bytes_per_pixel);
+    Widen(r.what, r.narrow, n, out);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   GLenum err = glGetError();
@@ -174,8 +200,8 @@ void ReadBack::BeginQueue() {
   pool_used_ = 0;
 }
 
-void ReadBack::Queue(const Targets& targets, GLuint fbo, GLenum attachment, GLenum format,
-                     GLenum type, size_t bytes, unsigned what, bool narrow, Queued* q) {
+void ReadBack::Queue(const Targets& targets, const TargetRead& r, Queued* q) {
+  const size_t bytes = static_cast<size_t>(targets.width()) * targets.height() * r.bytes_per_pixel;
   if (pool_used_ == pool_.size()) {
     GLuint b = 0;
     glCreateBuffers(1, &b);
@@ -186,13 +212,13 @@ void ReadBack::Queue(const Targets& targets, GLuint fbo, GLenum attachment, GLen
     glNamedBufferData(buffer, static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_READ);
     size = bytes;
   }
-  glNamedFramebufferReadBuffer(fbo, attachment);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+  glNamedFramebufferReadBuffer(r.fbo, r.attachment);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, r.fbo);
   glBindBuffer(GL_PIXEL_PACK_BUFFER, buffer);
-  glReadnPixels(0, 0, targets.width(), targets.height(), format, type, static_cast<GLsizei>(bytes),
-                nullptr);
+  glReadnPixels(0, 0, targets.width(), targets.height(), r.format, r.type,
+                static_cast<GLsizei>(bytes), nullptr);
   glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-  q->reads.push_back({what, buffer, bytes, narrow});
+  q->reads.push_back({r.what, buffer, bytes, r.narrow});
 }
 
 void ReadBack::QueueForward(const Targets& targets, const CameraParams& camera, unsigned outputs) {
@@ -202,14 +228,12 @@ void ReadBack::QueueForward(const Targets& targets, const CameraParams& camera, 
   q.outputs = outputs;
   q.width = targets.width();
   q.height = targets.height();
-  const size_t n = static_cast<size_t>(q.width) * q.height;
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  if (outputs & kPosition)
-    Queue(targets, targets.forward_fbo(), GL_COLOR_ATTACHMENT0, GL_DEPTH_COMPONENT, GL_FLOAT,
-          n * sizeof(float), 0, false, &q);
+  const GLuint f = targets.forward_fbo();
+  if (outputs & kPosition)  // the depth buffer, converted to Position by Collect
+    Queue(targets, {0, f, GL_COLOR_ATTACHMENT0, GL_DEPTH_COMPONENT, GL_FLOAT, sizeof(float)}, &q);
   if (outputs & kColor)
-    Queue(targets, targets.forward_fbo(), GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT,
-          n * 4 * sizeof(float), kColor, false, &q);
+    Queue(targets, {kColor, f, GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT, 4 * sizeof(float)}, &q);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   queued_.push_back(std::move(q));
 }
@@ -219,26 +243,8 @@ void ReadBack::QueueDeferred(const Targets& targets, unsigned outputs, bool narr
   q.outputs = outputs;
   q.width = targets.width();
   q.height = targets.height();
-  const size_t n = static_cast<size_t>(q.width) * q.height;
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  const GLuint g = targets.gbuffer_fbo();
-  if (outputs & kColor)
-    Queue(targets, targets.color_fbo(), GL_COLOR_ATTACHMENT0, GL_RGBA, GL_FLOAT,
-          n * 4 * sizeof(float), kColor, false, &q);
-  if (outputs & kAlbedo)
-    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetAlbedo, GL_RGBA, GL_FLOAT,
-          n * 4 * sizeof(float), kAlbedo, false, &q);
-  if (outputs & kNormal)
-    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetNormal, GL_RGBA, GL_FLOAT,
-          n * 4 * sizeof(float), kNormal, false, &q);
-  if (outputs & kPosition)
-    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetPosition, xyz_position_ ? GL_RGB : GL_RGBA,
-          GL_FLOAT, n * (xyz_position_ ? 3 : 4) * sizeof(float), kPosition, xyz_position_, &q);
-  if (outputs & kSegmentation)
-    Queue(targets, g, GL_COLOR_ATTACHMENT0 + kTargetSegmentation, GL_RG_INTEGER,
-          narrow_ids ? GL_UNSIGNED_SHORT : GL_UNSIGNED_INT,
-          n * 2 * (narrow_ids ? sizeof(uint16_t) : sizeof(uint32_t)), kSegmentation, narrow_ids,
-          &q);
+  for (const TargetRead& r : DeferredReads(targets, outputs, narrow_ids)) Queue(targets, r, &q);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   queued_.push_back(std::move(q));
 }
@@ -250,40 +256,9 @@ void ReadBack::Collect(size_t index, Picture* out) {
   out->height = q.height;
   internal::KeepOutputs(q.outputs, out);
   for (const QueuedRead& r : q.reads) {
-    void* dst = nullptr;
-    switch (r.what) {
-      case 0:
-        window_depth_.resize(n);
-        dst = window_depth_.data();
-        break;
-      case kColor:
-        out->color.resize(n * 4);
-        dst = out->color.data();
-        break;
-      case kAlbedo:
-        out->albedo.resize(n * 4);
-        dst = out->albedo.data();
-        break;
-      case kNormal:
-        out->normal.resize(n * 4);
-        dst = out->normal.data();
-        break;
-      case kPosition:
-        out->position.resize(n * 4);
-        dst = out->position.data();
-        break;
-      case kSegmentation:
-        out->segmentation.resize(n * 2);
-        if (r.narrow) narrow_ids_.resize(n * 2);
-        dst = r.narrow ? static_cast<void*>(narrow_ids_.data()) : out->segmentation.data();
-        break;
-      default:
-        break;
-    }
-    glGetNamedBufferSubData(r.buffer, 0, static_cast<GLsizeiptr>(r.bytes), dst);
-    if (r.what == kSegmentation && r.narrow)
-      std::copy(narrow_ids_.begin(), narrow_ids_.end(), out->segmentation.begin());
-    if (r.what == kPosition && r.narrow) SpreadPosition(&out->position, n);
+    glGetNamedBufferSubData(r.buffer, 0, static_cast<GLsizeiptr>(r.bytes),
+                            Destination(r.what, r.narrow, n, out));
+    Widen(r.what, r.narrow, n, out);
   }
   if (q.forward && (q.outputs & kPosition)) {
     out->position.resize(n * 4);

@@ -49,12 +49,20 @@ class ReadBack {
   void Delete();
 
  private:
+  /// One target an output comes from, and how it is read.
+  struct TargetRead {
+    unsigned what = 0;  ///< a PictureOutput bit, or 0 for the forward path's depth
+    GLuint fbo = 0;
+    GLenum attachment = 0, format = 0, type = 0;
+    size_t bytes_per_pixel = 0;
+    bool narrow = false;  ///< Segmentation as 16-bit numbers, Position as x, y, z
+  };
   /// One target of a queued picture, in a pixel-pack buffer.
   struct QueuedRead {
-    unsigned what = 0;  ///< a PictureOutput bit, or 0 for the forward path's depth
+    unsigned what = 0;
     GLuint buffer = 0;
     size_t bytes = 0;
-    bool narrow = false;  ///< Segmentation as 16-bit numbers, Position as x, y, z
+    bool narrow = false;
   };
   struct Queued {
     bool forward = false;
@@ -63,9 +71,16 @@ class ReadBack {
     int width = 0, height = 0;
     std::vector<QueuedRead> reads;
   };
-  /// Reads one target of `fbo` into a pixel-pack buffer of the pool and records it.
-  void Queue(const Targets& targets, GLuint fbo, GLenum attachment, GLenum format, GLenum type,
-             size_t bytes, unsigned what, bool narrow, Queued* q);
+  /// The targets the deferred path's `outputs` are read from, in the order they are read.
+  std::vector<TargetRead> DeferredReads(const Targets& targets, unsigned outputs,
+                                        bool narrow_ids) const;
+  /// Where the `n` pixels of output `what` are read to: the picture's buffer (sized here), the
+  /// depth buffer, or the 16-bit buffer of narrow ids.
+  void* Destination(unsigned what, bool narrow, size_t n, Picture* out);
+  /// After a read into Destination: narrow ids widened, x, y, z positions spread to four.
+  void Widen(unsigned what, bool narrow, size_t n, Picture* out);
+  /// Reads `r` of `targets` into a pixel-pack buffer of the pool and records it in `q`.
+  void Queue(const Targets& targets, const TargetRead& r, Queued* q);
   /// Position from the depth in window_depth_ (read back with `camera`), on the workers.
   void ConvertDepth(const CameraParams& camera, int width, int height, Picture* out);
   /// Part `part` of `parts` of the rows of that conversion, with the flipped projection `P`.
