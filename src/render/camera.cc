@@ -295,18 +295,14 @@ void TakePictures(const std::vector<Camera>& cameras, unsigned outputs) {
   std::vector<CameraParams> params;
   std::vector<std::shared_ptr<Picture>> pictures;
   std::vector<Picture*> out;
-  for (const Camera& camera : cameras) {
-    params.push_back(camera.GetParams());
-    // a camera given twice renders into one picture per place
-    pictures.push_back(std::make_shared<Picture>());
-    out.push_back(pictures.back().get());
-  }
   for (size_t i = 0; i < cameras.size(); ++i) {
-    CameraEntry& c = Entry(scene, cameras[i].GetId());
+    params.push_back(cameras[i].GetParams());
+    // a camera given twice renders into a fresh picture at its later places
     bool repeated = false;
     for (size_t j = 0; j < i; ++j) repeated = repeated || cameras[j].GetId() == cameras[i].GetId();
-    if (!repeated) pictures[i] = NextPicture(c);
-    out[i] = pictures[i].get();
+    pictures.push_back(repeated ? std::make_shared<Picture>()
+                                : NextPicture(Entry(scene, cameras[i].GetId())));
+    out.push_back(pictures.back().get());
   }
   try {
     backend.RenderMany(s.render_world, params, out, outputs);
