@@ -165,6 +165,7 @@ class AnnotationSession {
   std::shared_ptr<const AnnotationInput> input_;
   AnnotationQuestion question_;
   std::vector<AnnotationAnswer> answers_;
+  std::vector<AnnotationQuestion> asked_;  ///< the question each answer answered
   std::vector<AnnotationReview> reviews_;
   AnnotationPhase phase_ = AnnotationPhase::kMotion;  ///< the step after the motion step
   bool links_sorted_ = false;  ///< the motion step is over and links_ are in pre-order

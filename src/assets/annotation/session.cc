@@ -276,6 +276,7 @@ void AnnotationSession::Answer(AnnotationAnswer answer) {
   // checked and applied on a copy: a refused answer leaves this session as it was
   AnnotationSession next = *this;
   next.Apply(answer);
+  next.asked_.push_back(question_);
   next.answers_.push_back(std::move(answer));
   next.Advance();
   *this = std::move(next);
@@ -349,16 +350,10 @@ std::string AnnotationSession::StateJson(bool review_mode) const {
     units.push_back({{"node", in.nodes[u].id}, {"leaves", leaves}});
   }
   for (const AnnotationLink& l : links_) links.push_back(LinkJson(in, l));
-  // the questions answered, replayed to recover their texts
-  {
-    AnnotationSession replay(input_);
-    for (const AnnotationAnswer& a : answers_) {
-      history.push_back({{"phase", AnnotationPhaseName(replay.question_.phase)},
-                         {"text", replay.question_.text},
-                         {"answer", Json::parse(AnnotationAnswerToJson(a))}});
-      replay.Answer(a);
-    }
-  }
+  for (size_t i = 0; i < answers_.size(); ++i)
+    history.push_back({{"phase", AnnotationPhaseName(asked_[i].phase)},
+                       {"text", asked_[i].text},
+                       {"answer", Json::parse(AnnotationAnswerToJson(answers_[i]))}});
   Json j = {
       {"question", q},      {"units", units}, {"links", links},   {"answers", answers_.size()},
       {"history", history}, {"done", Done()}, {"review", nullptr}};
