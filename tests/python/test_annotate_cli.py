@@ -194,6 +194,14 @@ def test_annotate_every_object_through_the_services_with_a_kill_in_the_middle(ob
             stale = server.call("/partsim/annotate/answer", {"index": 0, "moves": True})
             assert not stale["success"] and "question" in stale["message"]
             assert stale["state"]["answers"] == answered
+            # so are hostile answers: huge numbers, non-ASCII garbage, deep nesting
+            for hostile in ({"index": 10 ** 30}, {"index": answered, "links": [2 ** 62, 1]},
+                            {"index": answered, "kind": "\u00e9\u6f22\ud83d\ude00\x00"},
+                            {"index": answered, "origin": [[[[[[[[1]]]]]]]] * 3},
+                            {"index": answered, "lower": "\xff" * 1000}):
+                v = server.call("/partsim/annotate/answer", hostile)
+                assert not v["success"] and v["message"], (hostile, v)
+                assert v["state"]["answers"] == answered
             values = server.call("/partsim/annotate/export")
             assert values["success"], values["message"]
             folder = values["folder"]
